@@ -1,0 +1,41 @@
+//! The command-line front end. Every subcommand calls into the library; nothing here does maths.
+
+pub mod bsdf;
+pub mod gpu_info;
+pub mod params_args;
+
+use clap::{Parser, Subcommand};
+
+/// strandlight: physically based hair appearance under HDR environments.
+#[derive(Parser, Debug)]
+#[command(name = "strandlight", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Evaluate the exact Marschner scattering function S_R, S_TT, S_TRT for given angles (JSON).
+    Bsdf(Box<bsdf::BsdfArgs>),
+    /// Print the GPU adapter strandlight would render with (JSON).
+    GpuInfo {
+        /// Ask for a software adapter (lavapipe) even if a GPU exists.
+        #[arg(long)]
+        software: bool,
+    },
+}
+
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Some(Command::Bsdf(args)) => bsdf::run(*args),
+        Some(Command::GpuInfo { software }) => gpu_info::run(software),
+        None => {
+            // The editor will open here once it exists; until then, say what there is.
+            use clap::CommandFactory;
+            Cli::command().print_help()?;
+            println!();
+            Ok(())
+        }
+    }
+}

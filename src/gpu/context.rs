@@ -1,0 +1,103 @@
+//! Headless wgpu device creation.
+
+use serde::Serialize;
+
+/// How to pick an adapter.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// Ask for a software (CPU) adapter such as lavapipe. Also set by `STRANDLIGHT_SOFTWARE_GPU=1`.
+    pub force_software: bool,
+}
+
+impl GpuOptions {
+    pub fn from_env() -> Self {
+        let force_software = std::env::var("STRANDLIGHT_SOFTWARE_GPU")
+            .map(|v| v == "1" || v.eq_ignore_ascii_case("true"))
+            .unwrap_or(false);
+        Self { force_software }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error(
+        "no GPU adapter found ({0}). Install a Vulkan driver; on Debian/Ubuntu without a GPU: \
+         `apt-get install mesa-vulkan-drivers libvulkan1` (software Vulkan, lavapipe)"
+    )]
+    NoAdapter(String),
+    #[error("the GPU adapter '{adapter}' refused a device: {source}")]
+    RequestDevice {
+        adapter: String,
+        source: wgpu::RequestDeviceError,
+    },
+}
+
+/// What was chosen, for logs and benchmark JSON.
+#[derive(Clone, Debug, Serialize)]
+pub struct AdapterSummary {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+}
+
+impl AdapterSummary {
+    fn new(info: &wgpu::AdapterInfo) -> Self {
+        Self {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+        }
+    }
+}
+
+/// A device and queue, with the adapter they came from.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub summary: AdapterSummary,
+}
+
+impl GpuContext {
+    /// Creates a device without a window. Backends can be restricted with `WGPU_BACKEND`
+    /// (e.g. `vulkan`); the device gets the adapter's own limits and the optional features
+    /// strandlight uses when they are available (timestamp queries, float32 filtering).
+    pub fn new_headless(options: &GpuOptions) -> Result<Self, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: options.force_software,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let summary = AdapterSummary::new(&info);
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::FLOAT32_FILTERABLE;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("strandlight device"),
+            required_features: adapter.features() & wanted,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|source| GpuError::RequestDevice {
+            adapter: summary.name.clone(),
+            source,
+        })?;
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            summary,
+        })
+    }
+}

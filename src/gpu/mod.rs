@@ -1,0 +1,5 @@
+//! GPU access through wgpu: headless device creation shared by the CLI, tests and (later) the editor.
+
+pub mod context;
+
+pub use context::{GpuContext, GpuError, GpuOptions};

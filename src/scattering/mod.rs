@@ -1,0 +1,12 @@
+//! Hair scattering maths: the exact Marschner model (reference) and, later, the fast forms.
+
+pub mod frame;
+pub mod fresnel;
+pub mod marschner;
+pub mod numeric;
+pub mod params;
+pub mod reference;
+
+pub use frame::{FiberAngles, FiberFrame, HalfAngles};
+pub use marschner::{LobeValues, Rgb, scattering_s, scattering_s_p};
+pub use params::{CausticModel, FresnelModel, HairParams, Lobe, ModelVariant, Preset};

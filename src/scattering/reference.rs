@@ -1,0 +1,119 @@
+//! Brute-force integrals of the exact model: the numbers fast forms and tests are checked against.
+//! Each works on one colour channel (`channel` in 0..3) so no work is repeated per channel.
+
+use super::marschner::{AzimuthalLobe, CausticFix, azimuthal_n_p, longitudinal_m_p};
+use super::numeric::integrate_piecewise_relative;
+use super::params::{CausticModel, HairParams, Lobe, ModelVariant};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Relative accuracy of the reference integrals.
+pub const REFERENCE_REL_TOL: f64 = 1e-9;
+
+/// Energy fraction one fiber scatters into lobe p: (1/2) integral_{-1}^{1} A_p(h) dh (MATH-NOTES,
+/// "Normalisation trap"). By the change of variables phi = phi(p, h) this equals integral N_p dphi
+/// for the bare root sum.
+pub fn scatter_fraction(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta_d: f64,
+    phi_h: f64,
+    channel: usize,
+) -> f64 {
+    let az = AzimuthalLobe::new(params, variant, lobe, theta_d, phi_h);
+    0.5 * integrate_piecewise_relative(
+        &|h| az.attenuation_a_p(h)[channel],
+        &[-1.0, 0.0, 1.0],
+        REFERENCE_REL_TOL,
+    )
+}
+
+/// integral_{-pi}^{pi} N_p(phi) dphi at fixed theta_d (and phi_h), by quadrature in phi split at
+/// the azimuths where roots appear, vanish or merge (caustics) and around the caustic Gaussians.
+pub fn azimuthal_energy(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta_d: f64,
+    phi_h: f64,
+    channel: usize,
+) -> f64 {
+    let az = AzimuthalLobe::new(params, variant, lobe, theta_d, phi_h);
+    let mut breaks = az.breakpoints();
+    if variant.caustic == CausticModel::Marschner
+        && lobe == Lobe::TRT
+        && let Some(fix) = CausticFix::new(params, &az)
+    {
+        {
+            for s in [-1.0, 1.0] {
+                for k in [-4.0, -2.0, 0.0, 2.0, 4.0] {
+                    let x = s * fix.phi_c + k * fix.w_c;
+                    if x > -PI && x < PI {
+                        breaks.push(x);
+                    }
+                }
+            }
+            breaks.sort_by(f64::total_cmp);
+        }
+    }
+    integrate_piecewise_relative(
+        &|phi| azimuthal_n_p(params, variant, &az, phi)[channel],
+        &breaks,
+        REFERENCE_REL_TOL,
+    )
+}
+
+/// Directional albedo E_p(theta_i) = integral over the sphere of S_p(omega_i, omega_o) cos(theta_o) d omega_o
+/// = integral_{-pi/2}^{pi/2} integral_{-pi}^{pi} S_p cos^2(theta_o) dphi dtheta_o, for a circular fiber
+/// (eccentricity is set to 1).
+///
+/// Because M_p is a unit-area Gaussian in theta_h = (theta_i + theta_o)/2, it integrates to 2 over
+/// theta_o, so E is close to 2 x the scattered fraction for narrow lobes (MATH-NOTES).
+pub fn directional_albedo(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta_i: f64,
+    channel: usize,
+) -> f64 {
+    let mut p = *params;
+    p.eccentricity = 1.0;
+    let beta = p.beta(lobe);
+    // Split theta_o around the lobe centre theta_o* = 2 alpha_p - theta_i (M has std 2 beta in theta_o).
+    let centre = 2.0 * p.alpha(lobe) - theta_i;
+    let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
+    for k in [-8.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
+        let x = centre + 2.0 * k * beta;
+        if x > -FRAC_PI_2 && x < FRAC_PI_2 {
+            breaks.push(x);
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    let integrand = |theta_o: f64| -> f64 {
+        let theta_h = 0.5 * (theta_i + theta_o);
+        let theta_d = 0.5 * (theta_o - theta_i);
+        let m = longitudinal_m_p(&p, lobe, theta_h);
+        if m < 1e-200 {
+            return 0.0;
+        }
+        let n = azimuthal_energy(&p, variant, lobe, theta_d, 0.0, channel);
+        m * n * theta_o.cos().powi(2) / theta_d.cos().powi(2)
+    };
+    integrate_piecewise_relative(&integrand, &breaks, 1e-7)
+}
+
+/// The narrow-lobe limit of [`directional_albedo`]: 2 f_p(theta_d*) cos^2(theta_o*) / cos^2(theta_d*), with
+/// theta_o* = 2 alpha_p - theta_i the lobe centre and f_p the scattered fraction there. Exact as beta -> 0
+/// when the lobe stays inside (-pi/2, pi/2).
+pub fn directional_albedo_narrow_limit(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta_i: f64,
+    channel: usize,
+) -> f64 {
+    let theta_o = 2.0 * params.alpha(lobe) - theta_i;
+    let theta_d = 0.5 * (theta_o - theta_i);
+    let f = scatter_fraction(params, variant, lobe, theta_d, 0.0, channel);
+    2.0 * f * theta_o.cos().powi(2) / theta_d.cos().powi(2)
+}

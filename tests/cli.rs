@@ -1,0 +1,133 @@
+//! The command-line interface as a user meets it.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn strandlight() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_strandlight"))
+}
+
+#[test]
+fn no_subcommand_lists_the_subcommands() {
+    let out = strandlight().output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("bsdf") && text.contains("gpu-info"), "{text}");
+}
+
+#[test]
+fn bsdf_answers_json_that_matches_the_library() {
+    let out = strandlight()
+        .args([
+            "bsdf",
+            "--theta-i",
+            "10",
+            "--theta-o",
+            "-5",
+            "--phi-o",
+            "160",
+            "--preset",
+            "blond",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let total: Vec<f64> = serde_json::from_value(v["S"]["total"].clone()).unwrap();
+    use strandlight::scattering::*;
+    let lib = scattering_s(
+        &Preset::Blond.params(),
+        ModelVariant::MARSCHNER,
+        FiberAngles::new(10f64.to_radians(), 0.0),
+        FiberAngles::new((-5f64).to_radians(), 160f64.to_radians()),
+    )
+    .total();
+    for c in 0..3 {
+        assert!(
+            (total[c] - lib[c]).abs() <= 1e-12 * lib[c].abs(),
+            "{total:?} vs {lib:?}"
+        );
+    }
+    assert!((v["theta_h"].as_f64().unwrap() - 2.5).abs() < 1e-9);
+}
+
+#[test]
+fn bsdf_batch_from_stdin_and_overrides() {
+    let mut child = strandlight()
+        .args(["bsdf", "--stdin", "--beta-r", "4"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(
+            br#"[{"theta_i": 20, "theta_o": -10, "phi_o": 30},
+                 {"theta_i": 20, "theta_o": -10, "phi_o": 30, "params": {"beta_r": 8, "variant": "xu", "sigma_a": [0.1, 0.2, 0.3]}}]"#,
+        )
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let arr = v.as_array().unwrap();
+    assert_eq!(arr.len(), 2);
+    assert!((arr[0]["params"]["beta_deg"][0].as_f64().unwrap() - 4.0).abs() < 1e-12);
+    assert!((arr[1]["params"]["beta_deg"][0].as_f64().unwrap() - 8.0).abs() < 1e-12);
+    assert_eq!(arr[1]["variant"], "xu");
+    assert!((arr[1]["params"]["beta_deg"][2].as_f64().unwrap() - 16.0).abs() < 1e-12);
+}
+
+#[test]
+fn bad_input_is_a_one_line_error_with_nonzero_exit() {
+    for (args, stdin, needle) in [
+        (
+            vec!["bsdf", "--theta-i", "120", "--theta-o", "0"],
+            "",
+            "theta_i",
+        ),
+        (
+            vec!["bsdf", "--theta-i", "0", "--theta-o", "0", "--eta", "-3"],
+            "",
+            "eta",
+        ),
+        (vec!["bsdf", "--stdin"], "not json", "JSON"),
+        (
+            vec!["bsdf", "--stdin"],
+            r#"[{"theta_i": 0, "theta_o": 0, "colour": 1}]"#,
+            "colour",
+        ),
+        (
+            vec!["bsdf", "--stdin"],
+            r#"[{"theta_i": 0, "theta_o": 0, "params": {"sigma_a": [1, 2]}}]"#,
+            "sigma_a",
+        ),
+    ] {
+        let mut child = strandlight()
+            .args(&args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(stdin.as_bytes())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error:") && err.trim_end().lines().count() == 1,
+            "{err}"
+        );
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
