@@ -131,3 +131,51 @@ fn bad_input_is_a_one_line_error_with_nonzero_exit() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn make_hair_then_info_and_a_corrupt_file() {
+    let dir = std::env::temp_dir().join(format!("strandlight-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("bob.hair");
+    let status = strandlight()
+        .args([
+            "make-hair",
+            "--style",
+            "bob",
+            "--strands",
+            "500",
+            "--points",
+            "12",
+            "--seed",
+            "9",
+            "-o",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let info = strandlight().arg("info").arg(&out).output().unwrap();
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v["strands"], 500);
+    assert_eq!(v["points"], 6000);
+    assert_eq!(v["normalization"]["up"], "+Y");
+    assert_eq!(v["normalization"]["units"], "centimetres");
+    assert!(v["length_cm"]["min"].as_f64().unwrap() >= 13.9);
+    // A truncated copy: exit 1, one line, the file named.
+    let bytes = std::fs::read(&out).unwrap();
+    let bad = dir.join("cut.hair");
+    std::fs::write(&bad, &bytes[..bytes.len() / 2]).unwrap();
+    let e = strandlight().arg("info").arg(&bad).output().unwrap();
+    let err = String::from_utf8_lossy(&e.stderr);
+    assert_eq!(e.status.code(), Some(1));
+    assert!(
+        err.trim_end().lines().count() == 1 && err.contains("cut.hair"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -2,6 +2,8 @@
 
 pub mod bsdf;
 pub mod gpu_info;
+pub mod info;
+pub mod make_hair;
 pub mod params_args;
 
 use clap::{Parser, Subcommand};
@@ -18,6 +20,10 @@ pub struct Cli {
 pub enum Command {
     /// Evaluate the exact Marschner scattering function S_R, S_TT, S_TRT for given angles (JSON).
     Bsdf(Box<bsdf::BsdfArgs>),
+    /// Describe a hair file: counts, bounds, detected up axis and units, lengths, optional arrays (JSON).
+    Info(info::InfoArgs),
+    /// Generate a procedural hairstyle around a generated head and write it as cyHair.
+    MakeHair(make_hair::MakeHairArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -29,6 +35,8 @@ pub enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bsdf(args)) => bsdf::run(*args),
+        Some(Command::Info(args)) => info::run(args),
+        Some(Command::MakeHair(args)) => make_hair::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.

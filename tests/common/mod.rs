@@ -1,0 +1,135 @@
+//! Helpers shared by integration tests: small valid files of every format, and the shared data.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// `../shared/data` next to the repository, if present.
+pub fn shared_data() -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        println!("skipped: ../shared/data is absent (tests on third-party files need it)");
+        None
+    }
+}
+
+fn f32s(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// A TressFX 3.x file: 296-byte header, float3 positions.
+pub fn tressfx3(strands: u32, per: u32) -> Vec<u8> {
+    let mut b = vec![0u8; 296];
+    b[0..4].copy_from_slice(&3.0f32.to_le_bytes());
+    b[4..8].copy_from_slice(&strands.to_le_bytes());
+    b[8..12].copy_from_slice(&per.to_le_bytes());
+    for s in 0..strands {
+        for k in 0..per {
+            b.extend(f32s(&[s as f32, 10.0 - k as f32, 0.5 * k as f32]));
+        }
+    }
+    b
+}
+
+/// A TressFX 4.x file: 160-byte header with offsets, float4 positions, float2 strand UVs.
+pub fn tressfx4(strands: u32, per: u32) -> Vec<u8> {
+    let mut b = vec![0u8; 160];
+    let pos = 160u32;
+    let uv = pos + strands * per * 16;
+    b[0..4].copy_from_slice(&4.0f32.to_le_bytes());
+    b[4..8].copy_from_slice(&strands.to_le_bytes());
+    b[8..12].copy_from_slice(&per.to_le_bytes());
+    b[12..16].copy_from_slice(&pos.to_le_bytes());
+    b[16..20].copy_from_slice(&uv.to_le_bytes());
+    for s in 0..strands {
+        for k in 0..per {
+            b.extend(f32s(&[
+                s as f32,
+                1.0 - 0.1 * k as f32,
+                0.05 * k as f32,
+                if k < 2 { 0.0 } else { 1.0 },
+            ]));
+        }
+    }
+    for s in 0..strands {
+        b.extend(f32s(&[s as f32 / strands as f32, 0.5]));
+    }
+    b
+}
+
+/// A GLB with one LINE_STRIP strand, two LINES strands, and a TRIANGLES quad, under a node
+/// translated by (0, 10, 0).
+pub fn glb() -> Vec<u8> {
+    let strip: Vec<f32> = (0..5).flat_map(|k| [0.0, -(k as f32), 0.0]).collect();
+    let lines_pos: Vec<f32> = (0..6)
+        .flat_map(|k| [1.0, -(k as f32 % 3.0), k as f32 / 3.0])
+        .collect();
+    let lines_idx: [u32; 8] = [0, 1, 1, 2, 3, 4, 4, 5];
+    let tri_pos: [f32; 12] = [
+        -1.0, 0.0, -1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 1.0,
+    ];
+    let tri_idx: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut push = |bytes: Vec<u8>, bin: &mut Vec<u8>| {
+        let off = bin.len();
+        bin.extend(bytes);
+        views.push((off, bin.len() - off));
+    };
+    push(f32s(&strip), &mut bin);
+    push(f32s(&lines_pos), &mut bin);
+    push(
+        lines_idx.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        &mut bin,
+    );
+    push(f32s(&tri_pos), &mut bin);
+    push(
+        tri_idx.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        &mut bin,
+    );
+    let bv: Vec<String> = views
+        .iter()
+        .map(|(o, l)| format!(r#"{{"buffer":0,"byteOffset":{o},"byteLength":{l}}}"#))
+        .collect();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+"nodes":[{{"mesh":0,"translation":[0,10,0]}}],
+"meshes":[{{"primitives":[
+ {{"attributes":{{"POSITION":0}},"mode":3}},
+ {{"attributes":{{"POSITION":1}},"indices":2,"mode":1}},
+ {{"attributes":{{"POSITION":3}},"indices":4,"mode":4}}]}}],
+"buffers":[{{"byteLength":{}}}],
+"bufferViews":[{}],
+"accessors":[
+ {{"bufferView":0,"componentType":5126,"count":5,"type":"VEC3","min":[0,-4,0],"max":[0,0,0]}},
+ {{"bufferView":1,"componentType":5126,"count":6,"type":"VEC3","min":[1,-2,0],"max":[1,0,1.6666666]}},
+ {{"bufferView":2,"componentType":5125,"count":8,"type":"SCALAR"}},
+ {{"bufferView":3,"componentType":5126,"count":4,"type":"VEC3","min":[-1,0,-1],"max":[1,0,1]}},
+ {{"bufferView":4,"componentType":5125,"count":6,"type":"SCALAR"}}]}}"#,
+        bin.len(),
+        bv.join(",")
+    );
+    let mut j = json.into_bytes();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(0x4E4F_534Au32.to_le_bytes());
+    out.extend(j);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(0x004E_4942u32.to_le_bytes());
+    out.extend(bin);
+    out
+}
+
+pub const OBJ: &str =
+    "o quad\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvn 0 1 0\nf 1//1 2//1 3//1 4//1\n";

@@ -1,0 +1,99 @@
+//! Every parser fed 10^5 mutated versions of a valid file: errors are fine, panics are not.
+
+mod common;
+
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+use std::path::Path;
+use strandlight::hair::cyhair::{read_cyhair, write_cyhair};
+use strandlight::hair::gltf_io::read_gltf;
+use strandlight::hair::mesh::read_obj;
+use strandlight::hair::procedural::{Style, StyleParams, generate};
+use strandlight::hair::tressfx::read_tressfx;
+
+const CASES: u32 = 100_000;
+
+/// Byte edits (position, value), an optional truncation and an optional 32-bit field overwrite
+/// (aimed at counts and offsets in headers).
+type Mutation = (Vec<(usize, u8)>, Option<usize>, Option<(usize, u32)>);
+
+fn mutations() -> impl Strategy<Value = Mutation> {
+    (
+        prop::collection::vec((any::<usize>(), any::<u8>()), 0..8),
+        prop::option::of(any::<usize>()),
+        prop::option::of((0usize..64, any::<u32>())),
+    )
+}
+
+fn mutate(valid: &[u8], m: &Mutation) -> Vec<u8> {
+    let mut b = valid.to_vec();
+    for &(pos, v) in &m.0 {
+        let n = b.len();
+        b[pos % n] = v;
+    }
+    if let Some((word, v)) = m.2 {
+        let at = 4 * word;
+        if at + 4 <= b.len() {
+            b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        }
+    }
+    if let Some(t) = m.1 {
+        let n = b.len();
+        b.truncate(t % (n + 1));
+    }
+    b
+}
+
+fn fuzz(name: &str, valid: Vec<u8>, parse: impl Fn(&[u8]) -> bool) {
+    let mut runner = TestRunner::new(Config {
+        cases: CASES,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let accepted = std::cell::Cell::new(0u32);
+    runner
+        .run(&mutations(), |m| {
+            let bytes = mutate(&valid, &m);
+            if parse(&bytes) {
+                accepted.set(accepted.get() + 1);
+            }
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    println!(
+        "{name}: {CASES} mutated inputs, {} still parsed, none panicked",
+        accepted.get()
+    );
+}
+
+#[test]
+fn cyhair_parser_survives_mutations() {
+    let hair = generate(&StyleParams::new(Style::Wavy, 6, 5, 1)).unwrap();
+    fuzz("cyHair", write_cyhair(&hair, "fuzz"), |b| {
+        read_cyhair(b, Path::new("f.hair")).is_ok()
+    });
+}
+
+#[test]
+fn tressfx_parsers_survive_mutations() {
+    fuzz("TressFX 3", common::tressfx3(4, 5), |b| {
+        read_tressfx(b, Path::new("f.tfx")).is_ok()
+    });
+    fuzz("TressFX 4", common::tressfx4(3, 4), |b| {
+        read_tressfx(b, Path::new("f.tfx")).is_ok()
+    });
+}
+
+#[test]
+fn gltf_parser_survives_mutations() {
+    fuzz("glTF (GLB)", common::glb(), |b| {
+        read_gltf(b, Path::new("f.glb"), None).is_ok()
+    });
+}
+
+#[test]
+fn obj_parser_survives_mutations() {
+    fuzz("OBJ", common::OBJ.as_bytes().to_vec(), |b| {
+        read_obj(b, Path::new("f.obj")).is_ok()
+    });
+}
