@@ -1,6 +1,7 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
 pub mod bsdf;
+pub mod fit_env;
 pub mod gpu_info;
 pub mod info;
 pub mod make_hair;
@@ -24,6 +25,8 @@ pub enum Command {
     Info(info::InfoArgs),
     /// Generate a procedural hairstyle around a generated head and write it as cyHair.
     MakeHair(make_hair::MakeHairArgs),
+    /// Fit an HDR environment (.hdr, .exr) with SRBF lights and write them as .srbf.json.
+    FitEnv(fit_env::FitEnvArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -37,6 +40,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Bsdf(args)) => bsdf::run(*args),
         Some(Command::Info(args)) => info::run(args),
         Some(Command::MakeHair(args)) => make_hair::run(args),
+        Some(Command::FitEnv(args)) => fit_env::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.
