@@ -179,3 +179,49 @@ fn make_hair_then_info_and_a_corrupt_file() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn fit_env_caches_by_content_and_rotates() {
+    let dir = std::env::temp_dir().join(format!("strandlight-fit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let env = dir.join("studio.exr");
+    std::fs::copy(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/envmaps/studio.exr"),
+        &env,
+    )
+    .unwrap();
+    let run = |extra: &[&str]| {
+        let out = strandlight()
+            .env("STRANDLIGHT_CACHE", dir.join("cache"))
+            .args(["fit-env", "--lights", "6"])
+            .arg(&env)
+            .arg("-o")
+            .arg(dir.join("out.srbf.json"))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let first = run(&[]);
+    assert!(!first.contains("(cached)"), "{first}");
+    let plain = std::fs::read_to_string(dir.join("out.srbf.json")).unwrap();
+    let second = run(&[
+        "--yaw",
+        "90",
+        "--preview",
+        dir.join("p.png").to_str().unwrap(),
+    ]);
+    assert!(second.contains("(cached)"), "{second}");
+    let turned: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out.srbf.json")).unwrap()).unwrap();
+    let plain: serde_json::Value = serde_json::from_str(&plain).unwrap();
+    assert_eq!(turned["lights"][0]["lambda"], plain["lights"][0]["lambda"]);
+    assert!((turned["yaw"].as_f64().unwrap() - 90f64.to_radians()).abs() < 1e-12);
+    assert!(std::fs::metadata(dir.join("p.png")).unwrap().len() > 100);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -17,7 +17,8 @@ pub struct FitEnvArgs {
     /// Output light file (.srbf.json); default: next to the environment.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Also write the reconstruction as an equirectangular EXR of the source's size.
+    /// Also write the reconstruction, of the source's size: linear EXR, or a tone-mapped PNG if the
+    /// name ends in .png.
     #[arg(long)]
     pub preview: Option<PathBuf>,
     /// Turn the lights about +Y by this many degrees (no refit).
@@ -77,9 +78,15 @@ pub fn run(args: FitEnvArgs) -> anyhow::Result<()> {
                 (env.width, env.height)
             }
         };
-        set.render(w, h)
-            .write_exr(preview)
-            .context("writing the preview")?;
+        let recon = set.render(w, h);
+        if preview
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            recon.write_png_preview(preview, 1.0)?;
+        } else {
+            recon.write_exr(preview).context("writing the preview")?;
+        }
     }
     let stats = set.fit.clone().unwrap_or_default();
     eprintln!(

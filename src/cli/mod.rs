@@ -1,9 +1,11 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
+pub mod bench_fit;
 pub mod bsdf;
 pub mod fit_env;
 pub mod gpu_info;
 pub mod info;
+pub mod make_env;
 pub mod make_hair;
 pub mod params_args;
 
@@ -27,6 +29,10 @@ pub enum Command {
     MakeHair(make_hair::MakeHairArgs),
     /// Fit an HDR environment (.hdr, .exr) with SRBF lights and write them as .srbf.json.
     FitEnv(fit_env::FitEnvArgs),
+    /// Generate the project's own environments (sunny sky, overcast, studio) as EXR, with their fits.
+    MakeEnv(make_env::MakeEnvArgs),
+    /// Benchmark the SRBF fit on environments (CPU seconds, JSON).
+    BenchFit(bench_fit::BenchFitArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -41,6 +47,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Info(args)) => info::run(args),
         Some(Command::MakeHair(args)) => make_hair::run(args),
         Some(Command::FitEnv(args)) => fit_env::run(args),
+        Some(Command::MakeEnv(args)) => make_env::run(args),
+        Some(Command::BenchFit(args)) => bench_fit::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.

@@ -3,8 +3,11 @@
 //! Minimises the solid-angle-weighted squared error between the (box-downsampled, power-preserving)
 //! environment and the sum of pixel-filtered SRBFs ([`filtered_lobe`]) over free centres,
 //! bandwidths and non-negative RGB amplitudes:
-//! 1. Initialisation by energy-weighted spherical k-means of the pixels (clustering the
-//!    environment's energy distribution): a strong sun is a cluster of its own from the start.
+//! 0. Strong compact sources (suns) are taken out at full resolution by moment matching
+//!    ([`extract_suns`]): right direction and power, and the rest of the sky is not sacrificed to
+//!    the residual of a sub-pixel disc.
+//! 1. Initialisation by energy-weighted spherical k-means of the remaining pixels (clustering the
+//!    environment's energy distribution).
 //! 2. Joint refinement with L-BFGS (argmin) on (direction vector, ln lambda, ln amplitude) per light,
 //!    with analytic gradients evaluated in parallel (rayon).
 //!
@@ -319,6 +322,64 @@ fn initialise(p: &Problem, lights: usize) -> Vec<f64> {
     x
 }
 
+/// Compact sources brighter than this multiple of the 99th-percentile luminance are suns.
+const SUN_THRESHOLD: f32 = 20.0;
+/// Pixels within this angle of a sun's brightest pixel belong to it.
+const SUN_RADIUS_DEG: f64 = 5.0;
+
+/// Takes strong compact sources (suns, lamps) out of `env` at full resolution: pixels brighter than
+/// `SUN_THRESHOLD` x the 99th-percentile luminance, grouped within `SUN_RADIUS_DEG` of the brightest,
+/// each become one light by moment matching (energy-weighted centroid direction, exact power,
+/// bandwidth from the spread: E[1 - cos] = lambda^2 / 2, at least 0.01). Extended bright regions
+/// (softboxes, overcast skies) cover more than 1 % of the sphere and never qualify. Returns the
+/// lights and the environment with those pixels set to 0.
+pub fn extract_suns(env: &EnvMap, max_suns: usize) -> (Vec<SrbfLight>, EnvMap) {
+    let lum = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let l: Vec<f32> = env.pixels.iter().map(|c| lum(*c)).collect();
+    let mut sorted = l.clone();
+    let k = (((sorted.len() as f64) * 0.99) as usize).min(sorted.len().saturating_sub(1));
+    let p99 = *sorted.select_nth_unstable_by(k, f32::total_cmp).1;
+    let threshold = SUN_THRESHOLD * p99.max(1e-6);
+    let mut candidates: Vec<usize> = (0..l.len()).filter(|&i| l[i] > threshold).collect();
+    candidates.sort_by(|&a, &b| l[b].total_cmp(&l[a]));
+    let mut grouped = vec![false; candidates.len()];
+    let mut out = env.clone();
+    let mut suns = Vec::new();
+    let cos_r = SUN_RADIUS_DEG.to_radians().cos();
+    for a in 0..candidates.len() {
+        if grouped[a] || suns.len() >= max_suns {
+            continue;
+        }
+        let seed = env.direction(candidates[a] % env.width, candidates[a] / env.width);
+        let (mut power, mut m, mut e) = ([0f64; 3], DVec3::ZERO, 0f64);
+        for b in a..candidates.len() {
+            let i = candidates[b];
+            let (x, y) = (i % env.width, i / env.width);
+            let d = env.direction(x, y);
+            if grouped[b] || d.dot(seed) < cos_r {
+                continue;
+            }
+            grouped[b] = true;
+            let sa = env.solid_angle(y);
+            for c in 0..3 {
+                power[c] += env.pixels[i][c] as f64 * sa;
+            }
+            m += d * (l[i] as f64 * sa);
+            e += l[i] as f64 * sa;
+            out.pixels[i] = [0.0; 3];
+        }
+        let spread = (1.0 - m.length() / e.max(1e-300)).max(0.0);
+        let lambda = (2.0 * spread).sqrt().max(0.01);
+        let integral = super::srbf::srbf_integral(lambda);
+        suns.push(SrbfLight {
+            direction: m.normalize_or(seed).to_array(),
+            lambda,
+            rgb: power.map(|p| p / integral),
+        });
+    }
+    (suns, out)
+}
+
 /// Fits `options.lights` SRBF lights to `env`. `progress` receives coarse progress.
 pub fn fit_srbf(
     env: &EnvMap,
@@ -332,8 +393,11 @@ pub fn fit_srbf(
         ));
     }
     let start = Instant::now();
+    // Suns first (at most a quarter of the lights), then the rest of the map.
+    let (suns, rest) = extract_suns(env, options.lights / 4);
+    let remaining = options.lights - suns.len();
     let factor = downsample_factor(env, options.fit_width);
-    let small = env.downsample(factor);
+    let small = rest.downsample(factor);
     let (w, h) = (small.width, small.height);
     let mut dirs = Vec::with_capacity(w * h);
     let mut weights = Vec::with_capacity(w * h);
@@ -379,14 +443,18 @@ pub fn fit_srbf(
             })
         }),
     };
-    let x0 = initialise(&problem, options.lights);
+    let x0 = initialise(&problem, remaining);
     let linesearch = MoreThuenteLineSearch::new();
     let solver = LBFGS::new(linesearch, 8)
         .with_tolerance_cost(1e-12)
         .map_err(|e| e.to_string())?;
-    let result = Executor::new(problem, solver)
-        .configure(|state| state.param(x0.clone()).max_iters(total))
-        .run();
+    let result = if remaining > 0 {
+        Executor::new(problem, solver)
+            .configure(|state| state.param(x0.clone()).max_iters(total))
+            .run()
+    } else {
+        Err(ArgminError::msg("every light is a sun"))
+    };
     let (x, evaluations) = match result {
         Ok(r) => {
             let evals = r
@@ -400,13 +468,17 @@ pub fn fit_srbf(
         // A failed line search leaves the initial guess, which is already a valid fit.
         Err(_) => (x0, counter.load(Ordering::Relaxed)),
     };
-    let lights: Vec<SrbfLight> = unpack(&x, lambda_min(pixel_rho2(h)))
+    let lights: Vec<SrbfLight> = suns
         .into_iter()
-        .map(|l| SrbfLight {
-            direction: l.dir.to_array(),
-            lambda: l.lambda2.sqrt(),
-            rgb: l.amp,
-        })
+        .chain(
+            unpack(&x, lambda_min(pixel_rho2(h)))
+                .into_iter()
+                .map(|l| SrbfLight {
+                    direction: l.dir.to_array(),
+                    lambda: l.lambda2.sqrt(),
+                    rgb: l.amp,
+                }),
+        )
         .collect();
     let mut set = SrbfSet {
         version: SRBF_FILE_VERSION,

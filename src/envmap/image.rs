@@ -153,6 +153,27 @@ impl EnvMap {
         }
     }
 
+    /// Writes a tone-mapped 8-bit sRGB PNG preview (Reinhard on exposure-scaled radiance; the EXR
+    /// stays the linear data, this is only for looking at).
+    pub fn write_png_preview(&self, path: &Path, exposure: f32) -> Result<(), EnvError> {
+        let srgb = |x: f32| {
+            let x = x.clamp(0.0, 1.0);
+            let v = if x <= 0.0031308 {
+                12.92 * x
+            } else {
+                1.055 * x.powf(1.0 / 2.4) - 0.055
+            };
+            (v * 255.0 + 0.5) as u8
+        };
+        let mut img = image::RgbImage::new(self.width as u32, self.height as u32);
+        for (i, px) in img.pixels_mut().enumerate() {
+            let c = self.pixels[i].map(|v| v * exposure);
+            px.0 = c.map(|v| srgb(v / (1.0 + v)));
+        }
+        img.save(path)
+            .map_err(|e| EnvError::format(path, format!("writing PNG: {e}")))
+    }
+
     /// Writes a float32 RGB OpenEXR (ZIP compressed).
     pub fn write_exr(&self, path: &Path) -> Result<(), EnvError> {
         use exr::prelude::*;

@@ -4,6 +4,7 @@ pub mod cache;
 pub mod direction;
 pub mod fit;
 pub mod image;
+pub mod procedural;
 pub mod srbf;
 
 pub use fit::{FitOptions, FitProgress, fit_srbf};

@@ -18,14 +18,31 @@ pub struct GltfContent {
 }
 
 /// Parses a glTF or GLB from bytes; external buffers are resolved next to `path` when `base` is given.
+///
+/// The `gltf` crate (1.4) panics on some malformed files (unchecked accessor indices while
+/// validating, `unreachable!` for float index accessors while reading). [`precheck`] rejects the
+/// cases the fuzz tests found; the whole read also runs under `catch_unwind` so that any other
+/// such panic becomes an error instead of taking the editor down.
 pub fn read_gltf(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<GltfContent, HairError> {
     let err = |m: String| HairError::format(path, m);
-    precheck_accessor_indices(bytes).map_err(|m| err(format!("invalid glTF: {m}")))?;
-    // gltf-json 1.4 indexes arrays without bounds checks in places while validating (the accessor
-    // check above covers the one the fuzz tests found); a panic there must not take the editor down.
-    let parsed = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
-        .map_err(|_| err("invalid glTF: the glTF parser failed on malformed data".into()))?;
-    let gltf = parsed.map_err(|e| err(format!("invalid glTF: {e}")))?;
+    precheck(bytes).map_err(|m| err(format!("invalid glTF: {m}")))?;
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        read_gltf_unchecked(bytes, path, base)
+    }))
+    .unwrap_or_else(|_| {
+        Err(err(
+            "invalid glTF: the glTF library failed on malformed data".into(),
+        ))
+    })
+}
+
+fn read_gltf_unchecked(
+    bytes: &[u8],
+    path: &Path,
+    base: Option<&Path>,
+) -> Result<GltfContent, HairError> {
+    let err = |m: String| HairError::format(path, m);
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err(format!("invalid glTF: {e}")))?;
     let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
         .map_err(|e| err(format!("glTF buffers: {e}")))?;
     let mut out = GltfContent::default();
@@ -106,9 +123,11 @@ pub fn read_gltf(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<GltfC
     Ok(out)
 }
 
-/// Every accessor index a mesh primitive names (attributes, indices, morph targets) must exist;
-/// gltf-json 1.4's validation indexes `accessors` with them unchecked.
-fn precheck_accessor_indices(bytes: &[u8]) -> Result<(), String> {
+/// Every accessor index a mesh primitive names (attributes, indices, morph targets) must exist
+/// (gltf-json 1.4's validation indexes `accessors` with them unchecked), and index accessors must be
+/// unsigned integers (5121, 5123, 5125) as the specification requires (gltf 1.4 hits
+/// `unreachable!` otherwise).
+fn precheck(bytes: &[u8]) -> Result<(), String> {
     let json: &[u8] = if bytes.starts_with(b"glTF") {
         // GLB: 12-byte header, then the JSON chunk (length, type, data).
         let len = bytes
@@ -157,6 +176,19 @@ fn precheck_accessor_indices(bytes: &[u8]) -> Result<(), String> {
         }
         if let Some(i) = prim.get("indices") {
             check(i)?;
+            let component = i.as_u64().and_then(|k| {
+                root.get("accessors")?
+                    .get(k as usize)?
+                    .get("componentType")?
+                    .as_u64()
+            });
+            if let Some(c) = component
+                && !matches!(c, 5121 | 5123 | 5125)
+            {
+                return Err(format!(
+                    "index accessor has component type {c}, not an unsigned integer"
+                ));
+            }
         }
     }
     Ok(())
