@@ -252,6 +252,27 @@ fn bad_environment_files_are_errors_not_panics() {
             .unwrap();
         println!("{name}: {cases} mutated files, no panic");
     }
+    // Random bytes, alone and behind each format's magic.
+    let mut state = 0x1234_5678_u64;
+    for k in 0..2000 {
+        let junk: Vec<u8> = (0..k % 300)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 56) as u8
+            })
+            .collect();
+        assert!(decode_hdr(&junk, Path::new("r.hdr")).is_err());
+        assert!(decode_exr(&junk, Path::new("r.exr")).is_err());
+        let _ = decode_hdr(
+            &[b"#?RADIANCE\n".as_slice(), &junk].concat(),
+            Path::new("r.hdr"),
+        );
+        let exr_magic = [0x76u8, 0x2f, 0x31, 0x01];
+        assert!(decode_exr(&[exr_magic.as_slice(), &junk].concat(), Path::new("r.exr")).is_err());
+    }
+    println!("random bytes: 2000 inputs per format, all refused without a panic");
     for (bytes, needle) in [
         (&b""[..], "Radiance"),
         (&b"#?RADIANCE\n\n-Y 3 +X 3\n"[..], ""),

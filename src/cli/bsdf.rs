@@ -5,7 +5,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
 use std::io::Read;
-use strandlight::scattering::{FiberAngles, HalfAngles, Rgb, scattering_s};
+use strandlight::scattering::{FiberAngles, HalfAngles, LobeValues, Rgb, scattering_s};
 
 #[derive(Args, Debug)]
 pub struct BsdfArgs {
@@ -44,14 +44,11 @@ pub struct Query {
     pub params: ParamArgs,
 }
 
+/// The lobes (R, TT, TRT) and their sum.
 #[derive(Serialize)]
 pub struct LobeReport {
-    #[serde(rename = "R")]
-    pub r: Rgb,
-    #[serde(rename = "TT")]
-    pub tt: Rgb,
-    #[serde(rename = "TRT")]
-    pub trt: Rgb,
+    #[serde(flatten)]
+    pub lobes: LobeValues,
     pub total: Rgb,
 }
 
@@ -104,10 +101,8 @@ pub fn evaluate(q: &Query, defaults: &ParamArgs) -> anyhow::Result<Answer> {
         variant,
         params: ParamsReport::new(&params),
         s: LobeReport {
-            r: v.r,
-            tt: v.tt,
-            trt: v.trt,
             total: v.total(),
+            lobes: v,
         },
     })
 }

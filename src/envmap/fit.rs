@@ -134,7 +134,8 @@ impl Problem {
                     for (j, l) in lights.iter().enumerate() {
                         let (k, mu) = per_light[j];
                         let e = 2.0 * (w.dot(l.dir) - 1.0) / mu;
-                        g[j] = if e > -700.0 { k * e.exp() } else { 0.0 };
+                        // exp(-40) ~ 4e-18: such a lobe contributes nothing at this pixel.
+                        g[j] = if e > -40.0 { k * e.exp() } else { 0.0 };
                         for c in 0..3 {
                             model[c] += l.amp[c] * g[j];
                         }
