@@ -8,6 +8,7 @@ pub mod info;
 pub mod make_env;
 pub mod make_hair;
 pub mod params_args;
+pub mod precompute;
 
 use clap::{Parser, Subcommand};
 
@@ -33,6 +34,8 @@ pub enum Command {
     MakeEnv(make_env::MakeEnvArgs),
     /// Benchmark the SRBF fit on environments (CPU seconds, JSON).
     BenchFit(bench_fit::BenchFitArgs),
+    /// Rebuild the Xu 2011 tables (C_k, H_k^TT, H_k^TRT) in luts/ as float32 EXR plus a manifest.
+    Precompute(precompute::PrecomputeArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -49,6 +52,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::FitEnv(args)) => fit_env::run(args),
         Some(Command::MakeEnv(args)) => make_env::run(args),
         Some(Command::BenchFit(args)) => bench_fit::run(args),
+        Some(Command::Precompute(args)) => precompute::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.

@@ -6,6 +6,8 @@ pub mod marschner;
 pub mod numeric;
 pub mod params;
 pub mod reference;
+pub mod tables;
+pub mod tables_io;
 
 pub use frame::{FiberAngles, FiberFrame, HalfAngles};
 pub use marschner::{LobeValues, Rgb, scattering_s, scattering_s_p};

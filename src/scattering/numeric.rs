@@ -73,6 +73,36 @@ pub fn integrate_piecewise_relative<F: Fn(f64) -> f64>(f: &F, breaks: &[f64], re
         .sum()
 }
 
+/// Fixed composite Gauss-Legendre (20 points on each of `panels` equal panels per piece) of a
+/// vector-valued integrand, split at `breaks`. For smooth pieces where all components share the
+/// expensive part of the integrand (tables of moments).
+pub fn integrate_fixed<const K: usize>(
+    f: impl Fn(f64) -> [f64; K],
+    breaks: &[f64],
+    panels: usize,
+) -> [f64; K] {
+    let mut acc = [0.0; K];
+    let pairs = rule().as_node_weight_pairs();
+    for w in breaks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b <= a {
+            continue;
+        }
+        let h = (b - a) / panels as f64;
+        for p in 0..panels {
+            let (lo, hi) = (a + h * p as f64, a + h * (p + 1) as f64);
+            let (c, d) = (0.5 * (hi - lo), 0.5 * (hi + lo));
+            for &(x, wt) in pairs {
+                let v = f(c * x + d);
+                for k in 0..K {
+                    acc[k] += c * wt * v[k];
+                }
+            }
+        }
+    }
+    acc
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
