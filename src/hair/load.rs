@@ -133,7 +133,7 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
                 content.strands.iter().map(|s| s.points.len() as u64).sum(),
             );
             let (hair, clean) =
-                Hair::from_strands(content.strands, super::tressfx::TRESSFX_DEFAULT_THICKNESS);
+                Hair::from_strands(content.strands, super::model::DEFAULT_FIBER_DIAMETER);
             if hair.strand_count() == 0 {
                 return Err(HairError::format(
                     path,

@@ -44,6 +44,9 @@ pub struct CleanReport {
     pub short_strands_dropped: usize,
 }
 
+/// Fiber diameter (cm) for files that carry none (TressFX, glTF): 70 micrometres, a typical human hair.
+pub const DEFAULT_FIBER_DIAMETER: f32 = 0.007;
+
 /// Points closer than this (world units) are merged: their segment has no direction.
 pub const MIN_SEGMENT_LENGTH: f32 = 1e-6;
 

@@ -8,12 +8,9 @@
 
 use super::bytes::Reader;
 use super::error::{HairError, MAX_POINTS};
-use super::model::{CleanReport, Hair, RawStrand};
+use super::model::{CleanReport, DEFAULT_FIBER_DIAMETER, Hair, RawStrand};
 use glam::Vec3;
 use std::path::Path;
-
-/// Default fiber diameter for TressFX files, which carry none: 0.007 cm (70 micrometres).
-pub const TRESSFX_DEFAULT_THICKNESS: f32 = 0.007;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TressFxInfo {
@@ -95,7 +92,7 @@ pub fn read_tressfx(
             ..Default::default()
         })
         .collect();
-    let (hair, report) = Hair::from_strands(raw, TRESSFX_DEFAULT_THICKNESS);
+    let (hair, report) = Hair::from_strands(raw, DEFAULT_FIBER_DIAMETER);
     if hair.strand_count() == 0 {
         return Err(r.err("no strand has two or more distinct points"));
     }

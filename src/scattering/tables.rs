@@ -74,12 +74,9 @@ pub struct Table2D {
     pub data: Vec<Vec<f32>>,
 }
 
-/// C_k(lambda', dphi) for one point (Xu Eq. 14), by quadrature split at the Gaussian's centre and at
-/// the kink of |cos| (x = dphi - pi).
-pub fn cos_gaussian_integral(k: u32, lambda: f64, dphi: f64) -> f64 {
-    let kappa = 2.0 / (lambda * lambda);
-    let f =
-        |x: f64| ((0.5 * (dphi - x)).cos().abs()).powi(k as i32) * (kappa * (x.cos() - 1.0)).exp();
+/// Where the C_k integrand needs splitting: the Gaussian's centre and multiples of its width, and
+/// the kink of |cos((dphi - x)/2)| at x = dphi - pi.
+fn c_breaks(lambda: f64, dphi: f64) -> Vec<f64> {
     let mut breaks = vec![-PI, PI, 0.0, dphi - PI];
     for m in [1.0, 2.0, 4.0, 8.0, 16.0] {
         breaks.extend([-m * lambda, m * lambda]);
@@ -87,6 +84,16 @@ pub fn cos_gaussian_integral(k: u32, lambda: f64, dphi: f64) -> f64 {
     breaks.retain(|b| (-PI..=PI).contains(b));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() < 1e-15);
+    breaks
+}
+
+/// C_k(lambda', dphi) for one point (Xu Eq. 14), by quadrature split at the Gaussian's centre and at
+/// the kink of |cos| (x = dphi - pi).
+pub fn cos_gaussian_integral(k: u32, lambda: f64, dphi: f64) -> f64 {
+    let kappa = 2.0 / (lambda * lambda);
+    let f =
+        |x: f64| ((0.5 * (dphi - x)).cos().abs()).powi(k as i32) * (kappa * (x.cos() - 1.0)).exp();
+    let breaks = c_breaks(lambda, dphi);
     integrate_piecewise_relative(&f, &breaks, REL_TOL)
 }
 
@@ -105,13 +112,7 @@ pub fn fresnel_moment(trt: bool, k: u32, eta: f64, theta_d: f64) -> f64 {
 /// ~1e-7 relative (tested).
 pub fn cos_gaussian_integrals(lambda: f64, dphi: f64) -> [f64; 7] {
     let kappa = 2.0 / (lambda * lambda);
-    let mut breaks = vec![-PI, PI, 0.0, dphi - PI];
-    for m in [1.0, 2.0, 4.0, 8.0, 16.0] {
-        breaks.extend([-m * lambda, m * lambda]);
-    }
-    breaks.retain(|b| (-PI..=PI).contains(b));
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup_by(|a, b| (*a - *b).abs() < 1e-15);
+    let breaks = c_breaks(lambda, dphi);
     integrate_fixed(
         |x| {
             let g = (kappa * (x.cos() - 1.0)).exp();
