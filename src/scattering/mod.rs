@@ -1,5 +1,6 @@
 //! Hair scattering maths: the exact Marschner model (reference) and, later, the fast forms.
 
+pub mod circular_gaussian;
 pub mod frame;
 pub mod fresnel;
 pub mod marschner;
