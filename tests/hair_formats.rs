@@ -145,17 +145,17 @@ fn shared_files_match_their_headers_and_sources() {
         let l = load_hair(&data.join(file), &LoadOptions::default()).unwrap();
         println!(
             "{file}: declared {:?}, kept {} strands / {} points, {:?} zero-length segments removed, up {:?}, units {:?}",
-            l.declared,
-            l.hair.strand_count(),
-            l.hair.point_count(),
-            l.clean.zero_length_segments_removed,
+            l.file.declared,
+            l.file.hair.strand_count(),
+            l.file.hair.point_count(),
+            l.file.clean.zero_length_segments_removed,
             l.normalization.up,
             l.normalization.units
         );
-        assert_eq!(l.declared, (strands, points), "{file}");
-        assert_eq!(l.hair.strand_count() as u64, strands);
+        assert_eq!(l.file.declared, (strands, points), "{file}");
+        assert_eq!(l.file.hair.strand_count() as u64, strands);
         assert_eq!(
-            l.hair.point_count() as u64 + l.clean.zero_length_segments_removed as u64,
+            l.file.hair.point_count() as u64 + l.file.clean.zero_length_segments_removed as u64,
             points
         );
         assert_eq!(
@@ -171,8 +171,8 @@ fn shared_files_match_their_headers_and_sources() {
     }
     // straight.hair carries a constant colour array (1.0, 0.925, 0.569).
     let l = load_hair(&data.join("hair/straight.hair"), &LoadOptions::default()).unwrap();
-    assert!(l.arrays.colour && !l.arrays.thickness);
-    let c = l.hair.colour.unwrap()[123];
+    assert!(l.file.arrays.colour && !l.file.arrays.thickness);
+    let c = l.file.hair.colour.unwrap()[123];
     assert!((c[1] - 0.925).abs() < 1e-3);
 }
 
@@ -191,7 +191,7 @@ fn tressfx_ponytail_roots_sit_on_the_head_mesh() {
         &l.normalization,
     )
     .unwrap();
-    let hair = &l.hair;
+    let hair = &l.file.hair;
     // The file joins four TressFX parts in this order (SOURCES.md); the tail's roots start at the
     // hair band around the ponytail, the other three on the scalp.
     let parts = [

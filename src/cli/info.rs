@@ -86,18 +86,18 @@ struct Info {
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     let loaded =
         load_hair(&args.file, &args.space.options()).context("could not read hair file")?;
-    let h = &loaded.hair;
+    let h = &loaded.file.hair;
     let (lo, hi) = h.bounds();
     let info = Info {
         file: args.file.display().to_string(),
-        format: loaded.format,
-        declared_strands: loaded.declared.0,
-        declared_points: loaded.declared.1,
+        format: loaded.file.format,
+        declared_strands: loaded.file.declared.0,
+        declared_points: loaded.file.declared.1,
         strands: h.strand_count(),
         points: h.point_count(),
         points_per_strand: Stats::of((0..h.strand_count()).map(|s| h.strand_range(s).len() as f32)),
-        zero_length_segments_removed: loaded.clean.zero_length_segments_removed,
-        short_strands_dropped: loaded.clean.short_strands_dropped,
+        zero_length_segments_removed: loaded.file.clean.zero_length_segments_removed,
+        short_strands_dropped: loaded.file.clean.short_strands_dropped,
         source_bounds: [
             loaded.source_bounds.0.to_array(),
             loaded.source_bounds.1.to_array(),
@@ -110,8 +110,8 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
                 .flat_map(|s| h.strand_range(s).map(move |p| (s, p)))
                 .map(|(s, p)| h.thickness_at(s, p)),
         ),
-        arrays: loaded.arrays,
-        occluder_triangles: loaded.mesh.as_ref().map_or(0, |m| m.triangles.len()),
+        arrays: loaded.file.arrays,
+        occluder_triangles: loaded.file.mesh.as_ref().map_or(0, |m| m.triangles.len()),
     };
     println!("{}", serde_json::to_string_pretty(&info)?);
     eprintln!(

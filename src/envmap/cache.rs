@@ -2,7 +2,7 @@
 //! Cache folder: `$STRANDLIGHT_CACHE`, else `$XDG_CACHE_HOME/strandlight`, else `~/.cache/strandlight`.
 
 use super::fit::{FitOptions, FitProgress, fit_srbf};
-use super::image::{EnvError, Sanitised, load_env};
+use super::image::{EnvError, Sanitised, decode_env};
 use super::srbf::SrbfSet;
 use std::path::{Path, PathBuf};
 
@@ -60,7 +60,7 @@ pub fn fit_file(
             sanitised: Sanitised::default(),
         });
     }
-    let (env, sanitised) = load_env(path)?;
+    let (env, sanitised) = decode_env(&bytes, path)?;
     let mut set = fit_srbf(&env, options, progress).map_err(|message| FitError::Fit {
         path: path.into(),
         message,

@@ -203,14 +203,19 @@ pub fn load_env(path: &Path) -> Result<(EnvMap, Sanitised), EnvError> {
         path: path.into(),
         source,
     })?;
+    decode_env(&bytes, path)
+}
+
+/// Decodes environment bytes by the extension of `path` (which names the file in errors).
+pub fn decode_env(bytes: &[u8], path: &Path) -> Result<(EnvMap, Sanitised), EnvError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
     match ext.as_str() {
-        "hdr" => decode_hdr(&bytes, path),
-        "exr" => decode_exr(&bytes, path),
+        "hdr" => decode_hdr(bytes, path),
+        "exr" => decode_exr(bytes, path),
         _ => Err(EnvError::format(
             path,
             "unsupported environment type (expected .hdr or .exr)",

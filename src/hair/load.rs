@@ -39,15 +39,9 @@ pub struct ArraysPresent {
     pub strand_uvs: bool,
 }
 
+/// A hair file in world space: what was read (hair and mesh already transformed) and how.
 pub struct LoadedHair {
-    pub hair: Hair,
-    /// Occluder triangles found in the same file (glTF).
-    pub mesh: Option<TriangleMesh>,
-    pub format: &'static str,
-    /// Strand and point counts the file declares (before cleaning).
-    pub declared: (u64, u64),
-    pub arrays: ArraysPresent,
-    pub clean: CleanReport,
+    pub file: RawHairFile,
     /// Bounds in the file's own space.
     pub source_bounds: (Vec3, Vec3),
     pub normalization: Normalization,
@@ -64,11 +58,13 @@ fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
-/// A hair file as read, before normalisation.
+/// A hair file as read.
 pub struct RawHairFile {
     pub hair: Hair,
+    /// Occluder triangles found in the same file (glTF).
     pub mesh: Option<TriangleMesh>,
     pub format: &'static str,
+    /// Strand and point counts the file declares (before cleaning).
     pub declared: (u64, u64),
     pub arrays: ArraysPresent,
     pub clean: CleanReport,
@@ -156,14 +152,15 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
 
 /// Reads a hair file and brings it into world space (cm, +Y up), detecting what is not given.
 pub fn load_hair(path: &Path, options: &LoadOptions) -> Result<LoadedHair, HairError> {
+    let mut file = read_hair_raw(path)?;
     let RawHairFile {
-        mut hair,
-        mut mesh,
+        hair,
+        mesh,
         format,
-        declared,
         arrays,
-        clean,
-    } = read_hair_raw(path)?;
+        ..
+    } = &mut file;
+    let format = *format;
     let source_bounds = hair.bounds();
     let roots: Vec<Vec3> = (0..hair.strand_count())
         .map(|s| hair.strand(s)[0])
@@ -200,7 +197,7 @@ pub fn load_hair(path: &Path, options: &LoadOptions) -> Result<LoadedHair, HairE
         1.0
     };
     hair.transform(|p| normalization.apply(p), thickness_scale);
-    if let Some(m) = &mut mesh {
+    if let Some(m) = mesh {
         m.positions
             .iter_mut()
             .for_each(|p| *p = normalization.apply(*p));
@@ -214,12 +211,7 @@ pub fn load_hair(path: &Path, options: &LoadOptions) -> Result<LoadedHair, HairE
         ));
     }
     Ok(LoadedHair {
-        hair,
-        mesh,
-        format,
-        declared,
-        arrays,
-        clean,
+        file,
         source_bounds,
         normalization,
     })
