@@ -225,3 +225,94 @@ fn fit_env_caches_by_content_and_rotates() {
     assert!(std::fs::metadata(dir.join("p.png")).unwrap().len() > 100);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn srbf_response_fast_against_reference_and_batch() {
+    let out = strandlight()
+        .args([
+            "srbf-response",
+            "--theta-j",
+            "20",
+            "--phi-j",
+            "150",
+            "--lambda",
+            "0.3",
+            "--theta-o",
+            "-10",
+            "--preset",
+            "blond",
+            "--reference",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for c in 0..3 {
+        let e = v["relative_error"][c].as_f64().unwrap();
+        assert!(e < 0.01, "channel {c}: {e}");
+        let total = v["fast"]["total"][c].as_f64().unwrap();
+        assert!(total > 0.0);
+    }
+    // Batch from stdin; an impossible query names itself.
+    let mut child = strandlight()
+        .args(["srbf-response", "--stdin"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(br#"[{"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10}, {"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10, "params": {"sigma_a": [5]}}]"#)
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let arr = v.as_array().unwrap();
+    let tt = |k: usize| arr[k]["fast"]["TT"][0].as_f64().unwrap();
+    assert!(
+        tt(1) < 0.01 * tt(0),
+        "dark hair transmits less: {} vs {}",
+        tt(1),
+        tt(0)
+    );
+    for (args, needle) in [
+        (
+            vec![
+                "srbf-response",
+                "--theta-j",
+                "20",
+                "--lambda",
+                "0",
+                "--theta-o",
+                "0",
+            ],
+            "lambda",
+        ),
+        (
+            vec![
+                "srbf-response",
+                "--theta-j",
+                "20",
+                "--lambda",
+                "0.3",
+                "--theta-o",
+                "0",
+                "--variant",
+                "marschner",
+            ],
+            "variant",
+        ),
+    ] {
+        let out = strandlight().args(&args).output().unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}

@@ -1,5 +1,6 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
+pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;
 pub mod fit_env;
@@ -9,6 +10,7 @@ pub mod make_env;
 pub mod make_hair;
 pub mod params_args;
 pub mod precompute;
+pub mod srbf_response;
 
 use clap::{Parser, Subcommand};
 
@@ -36,6 +38,10 @@ pub enum Command {
     BenchFit(bench_fit::BenchFitArgs),
     /// Rebuild the Xu 2011 tables (C_k, H_k^TT, H_k^TRT) in luts/ as float32 EXR plus a manifest.
     Precompute(precompute::PrecomputeArgs),
+    /// The fast per-SRBF single-scattering response (Xu 2011), optionally against brute force (JSON).
+    SrbfResponse(Box<srbf_response::SrbfResponseArgs>),
+    /// Benchmark the LUT build, the dual-scattering tables and the 40-light fast response (CPU, JSON).
+    BenchFast(bench_fast::BenchFastArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -53,6 +59,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::MakeEnv(args)) => make_env::run(args),
         Some(Command::BenchFit(args)) => bench_fit::run(args),
         Some(Command::Precompute(args)) => precompute::run(args),
+        Some(Command::SrbfResponse(args)) => srbf_response::run(*args),
+        Some(Command::BenchFast(args)) => bench_fast::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.

@@ -108,6 +108,18 @@ pub fn gaussian_linear_integral(a: f32, b: f32, mu: f32, lambda: f32, c0: f32, c
     (c0 + c1 * mu) * i0 + c1 * i1
 }
 
+/// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx with y = x - mu, in closed form (the quadratic
+/// pieces of the quadrature). With u = y / lambda: integral e^(-u^2) = (sqrt(pi)/2)(erf ub - erf ua),
+/// integral u e^(-u^2) = (e^(-ua^2) - e^(-ub^2))/2, integral u^2 e^(-u^2) = (1/2) integral e^(-u^2) - [u e^(-u^2)/2].
+pub fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: [f32; 3]) -> f32 {
+    let (ua, ub) = ((a - mu) / lambda, (b - mu) / lambda);
+    let (ea, eb) = ((-ua * ua).exp(), (-ub * ub).exp());
+    let m0 = 0.5 * PI.sqrt() * (erf_approx(ub) - erf_approx(ua));
+    let m1 = 0.5 * (ea - eb);
+    let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
+    lambda * (d[0] * m0 + d[1] * lambda * m1 + d[2] * lambda * lambda * m2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

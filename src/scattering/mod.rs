@@ -1,12 +1,20 @@
 //! Hair scattering maths: the exact Marschner model (reference) and, later, the fast forms.
 
 pub mod circular_gaussian;
+pub mod dual_response;
+pub mod dual_terms;
+pub mod fast_azimuthal;
+pub mod fast_exact_azimuthal;
+pub mod fast_params;
+pub mod fast_response;
 pub mod frame;
 pub mod fresnel;
+pub mod lut;
 pub mod marschner;
 pub mod numeric;
 pub mod params;
 pub mod reference;
+pub mod srbf_reference;
 pub mod tables;
 pub mod tables_io;
 

@@ -60,6 +60,17 @@ pub fn integrate_endpoint_singular<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64, tol
 /// Integral over [breaks[0], breaks[last]] to relative accuracy `rel`, split at every break (where
 /// `f` may jump or have integrable 1/sqrt singularities). A coarse pass sets the absolute target.
 pub fn integrate_piecewise_relative<F: Fn(f64) -> f64>(f: &F, breaks: &[f64], rel: f64) -> f64 {
+    integrate_piecewise(f, breaks, rel, 1e-300)
+}
+
+/// As [`integrate_piecewise_relative`], but never refining below the absolute error `abs_min`
+/// (for integrals whose size only matters next to others).
+pub fn integrate_piecewise<F: Fn(f64) -> f64>(
+    f: &F,
+    breaks: &[f64],
+    rel: f64,
+    abs_min: f64,
+) -> f64 {
     let pieces = breaks.windows(2).filter(|w| w[1] > w[0]);
     let rough: f64 = pieces
         .clone()
@@ -67,7 +78,7 @@ pub fn integrate_piecewise_relative<F: Fn(f64) -> f64>(f: &F, breaks: &[f64], re
         .sum::<f64>()
         .abs();
     let n = breaks.len().saturating_sub(1).max(1) as f64;
-    let tol = (rough * rel / n).max(1e-300);
+    let tol = (rough * rel / n).max(abs_min / n);
     pieces
         .map(|w| integrate_endpoint_singular(f, w[0], w[1], tol))
         .sum()

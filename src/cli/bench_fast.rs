@@ -1,0 +1,135 @@
+//! `strandlight bench-fast`: CPU cost of the Xu 2011 preprocessing (LUT build, dual-scattering tables)
+//! and of the fast single-scattering response for one shading point under a 40-light SRBF set, as JSON.
+
+use clap::Args;
+use glam::DVec3;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+use strandlight::envmap::SrbfSet;
+use strandlight::scattering::dual_terms::DualTables;
+use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
+use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
+use strandlight::scattering::lut::Luts;
+use strandlight::scattering::tables::build_all;
+use strandlight::scattering::{CausticModel, FiberFrame, FresnelModel, HairParams, ModelVariant};
+
+#[derive(Args, Debug)]
+pub struct BenchFastArgs {
+    /// SRBF lights (.srbf.json); default: the project's sunny sky.
+    #[arg(long)]
+    pub lights: Option<PathBuf>,
+    /// Repeats of each measurement; medians are reported.
+    #[arg(long, default_value_t = 9)]
+    pub repeats: usize,
+    /// Shading points (random fiber tangents and views) per repeat of the response timing.
+    #[arg(long, default_value_t = 200)]
+    pub points: usize,
+}
+
+#[derive(Serialize)]
+struct Report {
+    machine_threads: usize,
+    lut_build_seconds_median: f64,
+    lut_build_seconds_all: Vec<f64>,
+    dual_tables_build_seconds_median: f64,
+    lights_file: String,
+    lights: usize,
+    quadrature_segments: u32,
+    /// One thread: all lights' R, TT and TRT responses (RGB) at one shading point.
+    response_microseconds_per_point_median: f64,
+    response_microseconds_per_light: f64,
+    /// Sum over lights and points of the response's total (a checksum that the work was done).
+    checksum: f64,
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
+    let repeats = args.repeats.max(1);
+    let mut lut_times: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            let tables = build_all();
+            std::hint::black_box(&tables);
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    let all = lut_times.clone();
+    let lut_median = median(&mut lut_times);
+    let params = HairParams::default();
+    let variant = ModelVariant {
+        fresnel: FresnelModel::XuSchlick,
+        caustic: CausticModel::None,
+    };
+    let mut dual_times: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            std::hint::black_box(DualTables::build(&params, variant));
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    let path = args.lights.clone().unwrap_or_else(|| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json")
+    });
+    let set = SrbfSet::read(&path)?;
+    let luts = Luts::default_tables();
+    let fp = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS);
+    // Deterministic shading points: tangents and views spread over the sphere (golden spiral).
+    let dir = |k: usize, n: usize, twist: f64| {
+        let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let a = k as f64 * 2.399_963 + twist;
+        DVec3::new(r * a.cos(), z, r * a.sin())
+    };
+    let points: Vec<(Vec<SrbfInFrame>, f32, f32)> = (0..args.points.max(1))
+        .map(|k| {
+            let frame = FiberFrame::from_tangent(dir(k, args.points, 0.0));
+            let view = frame.angles(dir(k, args.points, 1.3));
+            let lights = set
+                .lights
+                .iter()
+                .map(|l| {
+                    let a = frame.angles(l.dir());
+                    SrbfInFrame {
+                        theta: a.theta as f32,
+                        phi: a.phi as f32,
+                        lambda: l.lambda as f32,
+                    }
+                })
+                .collect();
+            (lights, view.theta as f32, view.phi as f32)
+        })
+        .collect();
+    let mut checksum = 0.0;
+    let mut per_point: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            for (lights, theta_o, phi_o) in &points {
+                for l in lights {
+                    let r = srbf_response(&luts, &fp, *l, *theta_o, *phi_o);
+                    checksum += r.iter().flatten().map(|v| *v as f64).sum::<f64>();
+                }
+            }
+            t.elapsed().as_secs_f64() * 1e6 / points.len() as f64
+        })
+        .collect();
+    let per_point_median = median(&mut per_point);
+    let report = Report {
+        machine_threads: rayon::current_num_threads(),
+        lut_build_seconds_median: lut_median,
+        lut_build_seconds_all: all,
+        dual_tables_build_seconds_median: median(&mut dual_times),
+        lights_file: path.display().to_string(),
+        lights: set.lights.len(),
+        quadrature_segments: fp.quadrature_segments,
+        response_microseconds_per_point_median: per_point_median,
+        response_microseconds_per_light: per_point_median / set.lights.len().max(1) as f64,
+        checksum: checksum / repeats as f64,
+    };
+    println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(())
+}

@@ -1,0 +1,120 @@
+//! Multiple scattering per SRBF light by dual scattering (Xu et al. 2011 Sec. 4.3; Zinke et al. 2008),
+//! given what the renderer supplies per shaded point and light: the forward-scattering transmittance
+//! T_f, the spread sigma_f^2 and the direct fraction. f32, as the WGSL twin.
+//!
+//! The forward-scattered light of SRBF j arrives spread over the front half of the azimuths around phi_j
+//! (s_f = 1/pi) and over theta_i as a unit-area Gaussian around theta_j of variance
+//! sigma^2 = sigma_f^2 + lambda_j^2 / 2 (Xu's Eq. 27 uses sigma_f alone; the light's own longitudinal
+//! spread, a standard deviation of lambda_j / sqrt(2), is added here so wide SRBFs are not treated as
+//! directional). Responses are per unit light power; the renderer multiplies by the SRBF's power
+//! pi lambda_j^2 (1 - e^(-4 / lambda_j^2)) and radiance.
+
+use super::dual_terms::DualTables;
+use super::fast_azimuthal::Rgb32;
+use super::fast_exact_azimuthal::azimuthal_window_integral;
+use super::fast_params::FastHairParams;
+use super::fast_response::{SrbfInFrame, gaussian_product, linear_quadrature};
+use super::lut::wrap_angle_f32;
+use std::f32::consts::{FRAC_PI_2, PI, SQRT_2};
+
+/// Standard deviation of the forward-scattered light's longitudinal spread.
+pub fn forward_spread(sigma_f2: f32, lambda_j: f32) -> f32 {
+    (sigma_f2 + 0.5 * lambda_j * lambda_j).max(1e-6).sqrt()
+}
+
+/// calN_t^G(phi_o - phi_j, theta_d) = (1/pi) integral_{-pi/2}^{pi/2} N_t(theta_d, phi_o - phi_j - x) dx (Xu Eq. 28),
+/// from the exact N_t.
+pub fn inner_integral_global(p: &FastHairParams, lobe: u32, theta_d: f32, dphi: f32) -> Rgb32 {
+    azimuthal_window_integral(lobe, p.eta, p.sigma_a_rgb(), theta_d, dphi, 0.0, FRAC_PI_2)
+        .map(|v| v / PI)
+}
+
+/// M_t^G per unit light power (Xu Eq. 27): (1/cos theta_j) integral g^u(theta_i; theta_j, sigma) M_t(theta_h)
+/// cos^2(theta_i) / cos^2(theta_d) calN_t^G d theta_i, by the quadrature of Sec. 4.2.2 against the
+/// product of the two Gaussians.
+pub fn global_response_lobe(
+    p: &FastHairParams,
+    lobe: u32,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+    sigma_f2: f32,
+) -> Rgb32 {
+    let sigma = forward_spread(sigma_f2, light.lambda);
+    let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
+    // g^u with std sigma is Xu's g with bandwidth sqrt(2) sigma, over sqrt(2 pi) sigma.
+    let (scale, mu, l) = gaussian_product(
+        light.theta,
+        SQRT_2 * sigma,
+        2.0 * alpha - theta_o,
+        2.0 * SQRT_2 * beta,
+    );
+    let c = scale / (2.0 * PI * sigma * beta * light.theta.cos().max(1e-3));
+    if c < 1e-30 {
+        return [0.0; 3];
+    }
+    let dphi = phi_o - light.phi;
+    linear_quadrature(p.quadrature_segments, mu, l, |ti| {
+        let theta_d = 0.5 * (theta_o - ti);
+        let w = ti.cos().powi(2) / theta_d.cos().powi(2).max(1e-8);
+        inner_integral_global(p, lobe, theta_d, dphi).map(|n| w * n)
+    })
+    .map(|v| (c * v).max(0.0))
+}
+
+/// M^L per unit light power (Xu Eq. 29-31): (2 / cos theta_j) (pi - |phi_j - phi_o|) / pi^2 times
+/// integral g^u(theta_i; theta_j, sigma) g^u(theta_i; Delta_b~ - theta_o, sigma_b~) A_b(theta_d) cos^2(theta_i) / cos^2(theta_d) d theta_i,
+/// with Delta_b~, sigma_b~ the means of Delta_b, sigma_b over theta_i in theta_j +- sigma (from the SATs).
+pub fn local_response(
+    p: &FastHairParams,
+    tables: &DualTables,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+    sigma_f2: f32,
+) -> Rgb32 {
+    let sigma = forward_spread(sigma_f2, light.lambda);
+    let azimuthal = (PI - wrap_angle_f32(light.phi - phi_o).abs()) / (PI * PI);
+    let lo = 0.5 * (theta_o - (light.theta + sigma));
+    let hi = 0.5 * (theta_o - (light.theta - sigma));
+    let (delta, sig_b) = tables.mean_delta_sigma(lo, hi);
+    let mut out = [0.0; 3];
+    for c in 0..3 {
+        let sb = sig_b[c].max(1e-3);
+        let (scale, mu, l) =
+            gaussian_product(light.theta, SQRT_2 * sigma, delta[c] - theta_o, SQRT_2 * sb);
+        let k = 2.0 * azimuthal * scale / (2.0 * PI * sigma * sb * light.theta.cos().max(1e-3));
+        if k < 1e-30 {
+            continue;
+        }
+        let v = linear_quadrature(p.quadrature_segments, mu, l, |ti| {
+            let theta_d = 0.5 * (theta_o - ti);
+            let a = tables.lookup(theta_d).big_a_b[c];
+            [a * ti.cos().powi(2) / theta_d.cos().powi(2).max(1e-8); 3]
+        });
+        out[c] = (k * v[0]).max(0.0);
+    }
+    out
+}
+
+/// Zinke's shader (Fig. 5) per SRBF light: the direct part carries single scattering plus d_b f_back, the
+/// forward-scattered part (T_f - direct fraction) d_f (global + d_b local). `single` is M_R + M_TT + M_TRT,
+/// `local_direct` the local term with sigma_f = 0, `global` and `local` with the supplied sigma_f^2.
+/// Returns (direct, scattered) per channel; their sum is the light's response. Zinke's pseudo code
+/// multiplies f_back by pi in the scattered part because its f_back still holds s_b = 1/pi for one
+/// azimuth; Xu's M^L has already integrated the azimuthal spread (Eq. 30), so no pi appears here.
+pub fn dual_scattering_combine(
+    p: &FastHairParams,
+    direct_fraction: f32,
+    transmittance_f: Rgb32,
+    single: Rgb32,
+    local_direct: Rgb32,
+    global: Rgb32,
+    local: Rgb32,
+) -> (Rgb32, Rgb32) {
+    let direct = std::array::from_fn(|c| direct_fraction * (single[c] + p.d_b * local_direct[c]));
+    let scattered = std::array::from_fn(|c| {
+        (transmittance_f[c] - direct_fraction).max(0.0) * p.d_f * (global[c] + p.d_b * local[c])
+    });
+    (direct, scattered)
+}

@@ -1,0 +1,254 @@
+//! Dual-scattering fiber terms (Zinke et al. 2008 Sec. 3; Xu et al. 2011 Eq. 32-33), sampled into 1D
+//! tables over the incident inclination theta and rebuilt on the CPU whenever hair parameters change.
+//!
+//! NORMALISATION (MATH-NOTES "Normalisation trap"). a_f and a_b are ENERGY FRACTIONS: for incident
+//! inclination theta, lobe t,
+//!   a_{f,t}(theta) = L_t(theta) F_{f,t}(theta),   a_{b,t}(theta) = L_t(theta) F_{b,t}(theta),
+//!   L_t(theta) = (1/2) integral_{-pi/2}^{pi/2} M_t((theta + theta_o)/2) d theta_o
+//! (the longitudinal fraction: M_t integrates to 2 over theta_o, hence the 1/2; L_t = 1 unless the lobe is cut
+//! at a pole). The factor cos^2(theta_o) / cos^2(theta_d) that (1/2) S cos(theta_o) d omega_o carries is left
+//! out: it is 1 on the specular cone and departs from 1 only through the scale tilt alpha (by 4% at
+//! alpha = -7.5 deg), which is not an absorption, so a_f + a_b stays the fraction the fiber scatters. And
+//!   F_{f,t} = (1/pi) integral_{-pi}^{pi} |phi| N_t(theta, phi) d phi = (1/pi) integral_{-1}^{1} (A_t(h)/2) |phi_t(h)| dh,
+//!   F_{b,t} = integral N_t d phi - F_{f,t} = (1/2) integral A_t dh - F_{f,t}.
+//! The weights |phi|/pi and 1 - |phi|/pi are Zinke's Eq. 6 / 12 (and Xu's Eq. 33): irradiance spread
+//! evenly over the incident azimuths of one side of the fiber, radiance counted on the front / back half
+//! of the outgoing azimuths; Xu's "2 integral_0^pi phi N dphi" is the same integral. So
+//! a_f + a_b = sum_t L_t (1/2) integral A_t dh <= 1 (~0.99 at eta = 1.55, sigma_a = 0).
+//! N_t is evaluated at the difference angle of the lobe's centre, theta_d = alpha_t - theta (theta_o = 2 alpha_t - theta;
+//! Xu Eq. 33 takes theta_o = -theta, which at theta = 45 deg and sigma_a = 1.5 put a_f 12% off), for a
+//! circular fiber (Zinke: eccentricity is averaged away by the isotropic azimuthal irradiance).
+//!
+//! alpha_f, beta_f^2 (and _b): lobe shifts and variances averaged with the per-lobe a_{f,t} as weights.
+//! A_b, Delta_b, sigma_b: Zinke Eq. 11-17 ([`backscatter_attenuation`], [`backscatter_shift`],
+//! [`backscatter_width`]). Eq. 17's denominator is printed garbled in the extracted text
+//! ("a_b + a_b^3 (2 beta_f + 3 beta_b)", which mixes a number with an angle); it is the sum of the weights
+//! a_b + a_b^3 of the two averaged standard deviations, and is implemented so.
+
+use super::frame::wrap_angle;
+use super::marschner::{AzimuthalLobe, longitudinal_m_p, phi_p};
+use super::numeric::integrate_fixed;
+use super::params::{HairParams, Lobe, ModelVariant};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Samples of the incident inclination theta over [-pi/2, pi/2] (sample i at -pi/2 + pi i / (N - 1)).
+pub const DUAL_SAMPLES: usize = 128;
+
+/// L_t(theta), the longitudinal energy fraction of lobe t (see the module notes): the part of the unit-area
+/// M_t that leaves into theta_o in [-pi/2, pi/2].
+pub fn longitudinal_fraction(params: &HairParams, lobe: Lobe, theta: f64) -> f64 {
+    let centre = 2.0 * params.alpha(lobe) - theta;
+    let width = 2.0 * params.beta(lobe);
+    let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
+    for k in [-6.0, -3.0, -1.5, 0.0, 1.5, 3.0, 6.0] {
+        let x = centre + k * width;
+        if x > -FRAC_PI_2 && x < FRAC_PI_2 {
+            breaks.push(x);
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    let [v] = integrate_fixed(
+        |theta_o| [0.5 * longitudinal_m_p(params, lobe, 0.5 * (theta + theta_o))],
+        &breaks,
+        2,
+    );
+    v
+}
+
+/// (F_f, F_b) of lobe t at theta_d, per channel (see the module notes), by h = sin t quadrature.
+pub fn azimuthal_split(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta_d: f64,
+) -> ([f64; 3], [f64; 3]) {
+    let mut p = *params;
+    p.eccentricity = 1.0;
+    let az = AzimuthalLobe::new(&p, variant, lobe, theta_d, 0.0);
+    let [f0, f1, f2, e0, e1, e2] = integrate_fixed(
+        |t| {
+            let h = t.sin();
+            let a = az.attenuation_a_p(h);
+            let w = t.cos() * 0.5;
+            let frac = wrap_angle(phi_p(lobe.p(), h, az.eta_perp)).abs() / PI;
+            [
+                w * a[0] * frac,
+                w * a[1] * frac,
+                w * a[2] * frac,
+                w * a[0],
+                w * a[1],
+                w * a[2],
+            ]
+        },
+        &[-FRAC_PI_2, -0.75, 0.0, 0.75, FRAC_PI_2],
+        6,
+    );
+    ([f0, f1, f2], [e0 - f0, e1 - f1, e2 - f2])
+}
+
+/// A_b = a_b a_f^2 / (1 - a_f^2) + a_b^3 a_f^2 / (1 - a_f^2)^3 (Zinke Eq. 11, 13, 14).
+pub fn backscatter_attenuation(a_f: f32, a_b: f32) -> f32 {
+    let f2 = a_f * a_f;
+    let q = (1.0 - f2).max(1e-6);
+    a_b * f2 / q + a_b * a_b * a_b * f2 / (q * q * q)
+}
+
+/// Delta_b (Zinke Eq. 16).
+pub fn backscatter_shift(a_f: f32, a_b: f32, alpha_f: f32, alpha_b: f32) -> f32 {
+    let f2 = a_f * a_f;
+    let q = (1.0 - f2).max(1e-6);
+    alpha_b * (1.0 - 2.0 * a_b * a_b / (q * q))
+        + alpha_f * (2.0 * q * q + 4.0 * f2 * a_b * a_b) / (q * q * q)
+}
+
+/// sigma_b, a standard deviation (Zinke Eq. 17, denominator a_b + a_b^3; see the module notes).
+pub fn backscatter_width(a_f: f32, a_b: f32, beta_f2: f32, beta_b2: f32) -> f32 {
+    let b3 = a_b * a_b * a_b;
+    let den = (a_b + b3).max(1e-30);
+    (1.0 + 0.7 * a_f * a_f)
+        * (a_b * (2.0 * beta_f2 + beta_b2).sqrt() + b3 * (2.0 * beta_f2 + 3.0 * beta_b2).sqrt())
+        / den
+}
+
+/// The dual-scattering terms at one inclination, per channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DualSample {
+    pub a_f: [f32; 3],
+    pub a_b: [f32; 3],
+    pub alpha_f: [f32; 3],
+    pub alpha_b: [f32; 3],
+    pub beta_f2: [f32; 3],
+    pub beta_b2: [f32; 3],
+    pub big_a_b: [f32; 3],
+    pub delta_b: [f32; 3],
+    pub sigma_b: [f32; 3],
+}
+
+/// Computes every term at theta from the exact model (variant: the fast model's Fresnel).
+pub fn dual_sample(params: &HairParams, variant: ModelVariant, theta: f64) -> DualSample {
+    let mut s = DualSample::default();
+    let (mut wf, mut wb) = ([0f64; 3], [0f64; 3]);
+    let (mut af, mut ab, mut bf, mut bb) = ([0f64; 3], [0f64; 3], [0f64; 3], [0f64; 3]);
+    for lobe in Lobe::ALL {
+        let l = longitudinal_fraction(params, lobe, theta);
+        let (ff, fb) = azimuthal_split(params, variant, lobe, params.alpha(lobe) - theta);
+        let (alpha, beta2) = (params.alpha(lobe), params.beta(lobe).powi(2));
+        for c in 0..3 {
+            let (f, b) = (l * ff[c], l * fb[c]);
+            wf[c] += f;
+            wb[c] += b;
+            af[c] += f * alpha;
+            ab[c] += b * alpha;
+            bf[c] += f * beta2;
+            bb[c] += b * beta2;
+        }
+    }
+    for c in 0..3 {
+        // Lobes evaluated at their own theta_d can together pass 1 near the poles (each is a fraction
+        // of a different cone); keep the total a fraction so A_b's 1 / (1 - a_f^2) stays finite.
+        let total = wf[c] + wb[c];
+        let k = if total > 0.999 { 0.999 / total } else { 1.0 };
+        s.a_f[c] = (k * wf[c]) as f32;
+        s.a_b[c] = (k * wb[c]) as f32;
+        let (nf, nb) = (wf[c].max(1e-300), wb[c].max(1e-300));
+        s.alpha_f[c] = (af[c] / nf) as f32;
+        s.alpha_b[c] = (ab[c] / nb) as f32;
+        s.beta_f2[c] = (bf[c] / nf) as f32;
+        s.beta_b2[c] = (bb[c] / nb) as f32;
+        s.big_a_b[c] = backscatter_attenuation(s.a_f[c], s.a_b[c]);
+        s.delta_b[c] = backscatter_shift(s.a_f[c], s.a_b[c], s.alpha_f[c], s.alpha_b[c]);
+        s.sigma_b[c] = backscatter_width(s.a_f[c], s.a_b[c], s.beta_f2[c], s.beta_b2[c]);
+    }
+    s
+}
+
+/// The 1D tables over theta with summed-area tables of Delta_b and sigma_b (Xu Sec. 4.3.2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DualTables {
+    pub samples: Vec<DualSample>,
+    /// sat_delta[i][c] = sum_{k < i} delta_b[k][c] (DUAL_SAMPLES + 1 entries).
+    pub sat_delta: Vec<[f32; 3]>,
+    pub sat_sigma: Vec<[f32; 3]>,
+}
+
+/// theta of sample i.
+pub fn dual_theta(i: usize) -> f64 {
+    -FRAC_PI_2 + PI * i as f64 / (DUAL_SAMPLES - 1) as f64
+}
+
+impl DualTables {
+    /// Builds the tables (rayon; a few ms on two cores).
+    pub fn build(params: &HairParams, variant: ModelVariant) -> Self {
+        use rayon::prelude::*;
+        let samples: Vec<DualSample> = (0..DUAL_SAMPLES)
+            .into_par_iter()
+            .map(|i| dual_sample(params, variant, dual_theta(i)))
+            .collect();
+        let prefix = |f: &dyn Fn(&DualSample) -> [f32; 3]| {
+            let mut out = vec![[0f32; 3]];
+            let mut acc = [0f64; 3];
+            for s in &samples {
+                let v = f(s);
+                for c in 0..3 {
+                    acc[c] += v[c] as f64;
+                }
+                out.push(acc.map(|x| x as f32));
+            }
+            out
+        };
+        let sat_delta = prefix(&|s| s.delta_b);
+        let sat_sigma = prefix(&|s| s.sigma_b);
+        Self {
+            samples,
+            sat_delta,
+            sat_sigma,
+        }
+    }
+
+    /// Linear interpolation of the terms at theta (clamped to [-pi/2, pi/2]).
+    pub fn lookup(&self, theta: f32) -> DualSample {
+        let x = ((theta + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
+            * (DUAL_SAMPLES - 1) as f32;
+        let i = (x as usize).min(DUAL_SAMPLES - 2);
+        let w = x - i as f32;
+        let (a, b) = (&self.samples[i], &self.samples[i + 1]);
+        let mix = |u: [f32; 3], v: [f32; 3]| std::array::from_fn(|c| u[c] + w * (v[c] - u[c]));
+        DualSample {
+            a_f: mix(a.a_f, b.a_f),
+            a_b: mix(a.a_b, b.a_b),
+            alpha_f: mix(a.alpha_f, b.alpha_f),
+            alpha_b: mix(a.alpha_b, b.alpha_b),
+            beta_f2: mix(a.beta_f2, b.beta_f2),
+            beta_b2: mix(a.beta_b2, b.beta_b2),
+            big_a_b: mix(a.big_a_b, b.big_a_b),
+            delta_b: mix(a.delta_b, b.delta_b),
+            sigma_b: mix(a.sigma_b, b.sigma_b),
+        }
+    }
+
+    /// Means of Delta_b and sigma_b over theta in [lo, hi] from the SATs (Xu Eq. 31); the SAT is read
+    /// with linear interpolation between its entries, so the mean is exact for the piecewise-constant
+    /// reading of the samples.
+    pub fn mean_delta_sigma(&self, lo: f32, hi: f32) -> ([f32; 3], [f32; 3]) {
+        let pos = |t: f32| {
+            ((t + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
+                * (DUAL_SAMPLES - 1) as f32
+                + 0.5
+        };
+        let (a, b) = (pos(lo.min(hi)), pos(lo.max(hi)));
+        if b - a < 1e-4 {
+            let s = self.lookup(0.5 * (lo + hi));
+            return (s.delta_b, s.sigma_b);
+        }
+        let read = |sat: &[[f32; 3]], x: f32| -> [f32; 3] {
+            let i = (x as usize).min(DUAL_SAMPLES - 1);
+            let w = x - i as f32;
+            std::array::from_fn(|c| sat[i][c] + w * (sat[i + 1][c] - sat[i][c]))
+        };
+        let mean = |sat: &[[f32; 3]]| {
+            let (u, v) = (read(sat, a), read(sat, b));
+            std::array::from_fn(|c| (v[c] - u[c]) / (b - a))
+        };
+        (mean(&self.sat_delta), mean(&self.sat_sigma))
+    }
+}

@@ -1,0 +1,300 @@
+//! Xu et al. 2011 Sec. 4.2: the single-scattering response of one SRBF light,
+//!   M_t(omega_j, lambda_j, omega_o) = integral G_j(omega_i) S_t(omega_i, omega_o) cos(theta_i) d omega_i   (Eq. 11)
+//!   ~ integral g(theta_i; theta_j, lambda_j) M_t(theta_h) cos^2(theta_i) / cos^2(theta_d) calN_t(lambda', phi_o - phi_j, theta_d) d theta_i,
+//! with lambda' = lambda_j / sqrt(cos theta_i cos theta_j), and the outer integral done by the linear
+//! quadrature of Sec. 4.2.2 against the product Gaussian g(theta_i; theta_j, lambda_j) M_t.
+//!
+//! Angles are in the fiber frame ([`super::frame`]); f32 as in the WGSL twin.
+//!
+//! Sample placement (Sec. 4.2.2), m segments: the ends -pi/2 and pi/2 plus m - 1 samples evenly over
+//! mu +- (m - 2) lambda / 2 CLIPPED to [-pi/2, pi/2]. For m = 4 and a lobe inside the range this is the
+//! paper's rule (mu - lambda, mu, mu + lambda); clipping keeps every sample useful and lets a large m
+//! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
+
+use super::circular_gaussian::{gaussian_linear_integral, gaussian_quadratic_integral};
+use super::fast_azimuthal::{LobeFit, Rgb32, eta_star_mean, inner_integral_r, trt_lobes, tt_lobe};
+use super::fast_exact_azimuthal::inner_integral_blended;
+use super::fast_params::FastHairParams;
+use super::lut::Luts;
+use std::f32::consts::{FRAC_PI_2, PI};
+
+/// lambda' is clamped to this (the C_k table's end); the azimuthal Gaussian is nearly flat there.
+pub const LAMBDA_PRIME_MAX: f32 = 10.0;
+
+/// The product of Xu's 1D Gaussians g(x; mu1, l1) g(x; mu2, l2) = scale g(x; mu, l)
+/// (g(x; mu, l) = exp(-(x - mu)^2 / l^2)). Returns (scale, mu, l).
+pub fn gaussian_product(mu1: f32, l1: f32, mu2: f32, l2: f32) -> (f32, f32, f32) {
+    let (a, b) = (l1 * l1, l2 * l2);
+    let s = a + b;
+    let d = mu1 - mu2;
+    (
+        (-d * d / s).exp(),
+        (mu1 * b + mu2 * a) / s,
+        (a * b / s).sqrt(),
+    )
+}
+
+/// Sample s (0..=m) of the quadrature over [-pi/2, pi/2] for a Gaussian (mu, lambda): the ends, and m - 1
+/// samples evenly over mu +- (m - 2) lambda / 2 (Xu Sec. 4.2.2). Where that span crosses an end it is
+/// clipped and the samples spread evenly strictly inside it, so none coincides with the end.
+pub fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
+    if s == 0 {
+        return -FRAC_PI_2;
+    }
+    if s >= m {
+        return FRAC_PI_2;
+    }
+    let half = 0.5 * (m as f32 - 2.0) * lambda;
+    let (lo, hi) = (mu - half, mu + half);
+    let lo_clipped = lo <= -FRAC_PI_2;
+    let hi_clipped = hi >= FRAC_PI_2;
+    let (lo, hi) = (
+        lo.clamp(-FRAC_PI_2, FRAC_PI_2),
+        hi.clamp(-FRAC_PI_2, FRAC_PI_2),
+    );
+    let inner = m - 1;
+    let denom = (inner - 1) + lo_clipped as u32 + hi_clipped as u32;
+    if denom == 0 {
+        return mu.clamp(-FRAC_PI_2, FRAC_PI_2);
+    }
+    let k = (s - 1) + lo_clipped as u32;
+    lo + (hi - lo) * k as f32 / denom as f32
+}
+
+/// integral_{-pi/2}^{pi/2} g(x; mu, lambda) f(x) dx from m + 1 samples of f (Sec. 4.2.2). Xu interpolates f
+/// linearly on every segment. Here segments are taken in pairs and f is interpolated by the parabola
+/// through each pair's three samples (the paper's suggested "higher order polynomial"); a last unpaired
+/// segment (m odd) stays linear. f contains cos^2(theta_i), which vanishes quadratically at the ends
+/// +-pi/2: near the poles the linear rule was off by up to 12% from m = 200.
+pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) -> Rgb32) -> Rgb32 {
+    let mut out = [0.0; 3];
+    let mut x0 = quadrature_sample(0, m, mu, lambda);
+    let mut f0 = f(x0);
+    let mut s = 1;
+    while s <= m {
+        let pair = s < m;
+        let x1 = quadrature_sample(s, m, mu, lambda);
+        let f1 = f(x1);
+        if pair {
+            let x2 = quadrature_sample(s + 1, m, mu, lambda);
+            let f2 = f(x2);
+            if x2 > x0 && x1 > x0 && x2 > x1 {
+                for c in 0..3 {
+                    // Newton form in y = x - mu: p = f0 + q1 (x - x0) + q2 (x - x0)(x - x1).
+                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
+                    let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
+                    let (y0, y1) = (x0 - mu, x1 - mu);
+                    let d = [f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2];
+                    out[c] += gaussian_quadratic_integral(x0, x2, mu, lambda, d);
+                }
+            } else if x2 > x0 {
+                add_linear(&mut out, x0, x2, f0, f2, mu, lambda);
+            }
+            x0 = x2;
+            f0 = f2;
+            s += 2;
+            continue;
+        }
+        add_linear(&mut out, x0, x1, f0, f1, mu, lambda);
+        x0 = x1;
+        f0 = f1;
+        s += 1;
+    }
+    out
+}
+
+fn add_linear(out: &mut Rgb32, x0: f32, x1: f32, f0: Rgb32, f1: Rgb32, mu: f32, lambda: f32) {
+    if x1 <= x0 {
+        return;
+    }
+    for c in 0..3 {
+        // f ~ c0 + c1 x on [x0, x1].
+        let c1 = (f1[c] - f0[c]) / (x1 - x0);
+        let c0 = f0[c] - c1 * x0;
+        out[c] += gaussian_linear_integral(x0, x1, mu, lambda, c0, c1);
+    }
+}
+
+/// An SRBF light in the fiber frame: centre angles (theta_j, phi_j) and bandwidth lambda_j.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SrbfInFrame {
+    pub theta: f32,
+    pub phi: f32,
+    pub lambda: f32,
+}
+
+/// lambda' = lambda_j / sqrt(cos theta_i cos theta_j) (Xu Eq. 11), clamped to the table.
+pub fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
+    let c = (theta_i.cos() * theta_j.cos()).max(1e-8);
+    (lambda_j / c.sqrt()).min(LAMBDA_PRIME_MAX)
+}
+
+/// The azimuthal fit of N_TT (lobe 1) or N_TRT (lobe 2) at theta_d, with the averaged eccentric index for TRT.
+pub fn azimuthal_fit(
+    luts: &Luts,
+    p: &FastHairParams,
+    lobe: u32,
+    theta_d: f32,
+    lambda_prime: f32,
+    phi_sum: f32,
+) -> LobeFit {
+    let sigma = p.sigma_a_rgb();
+    if lobe == 1 {
+        let mut fit = LobeFit::default();
+        fit.lobes[0] = tt_lobe(luts, p.eta, sigma, theta_d);
+        fit.count = 1;
+        fit
+    } else {
+        let eta = eta_star_mean(luts, p.eta, p.eccentricity, lambda_prime, phi_sum);
+        trt_lobes(luts, eta, sigma, theta_d, p.caustic_width, p.caustic_fade)
+    }
+}
+
+/// The smooth factor of the outer integral at theta_i: cos^2(theta_i) / cos^2(theta_d) calN_t.
+pub fn outer_integrand(
+    luts: &Luts,
+    p: &FastHairParams,
+    lobe: u32,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+    theta_i: f32,
+) -> Rgb32 {
+    let theta_d = 0.5 * (theta_o - theta_i);
+    let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
+    let ci = theta_i.cos();
+    let w = ci * ci / theta_d.cos().powi(2).max(1e-8);
+    let dphi = phi_o - light.phi;
+    if lobe == 0 {
+        let n = inner_integral_r(luts, p.eta, theta_d, lp, dphi);
+        return [w * n; 3];
+    }
+    let sigma = p.sigma_a_rgb();
+    if lobe == 1 {
+        return inner_integral_blended(1, p.eta, sigma, theta_d, lp, dphi, || {
+            azimuthal_fit(luts, p, 1, theta_d, lp, 0.0)
+        })
+        .map(|n| w * n);
+    }
+    let eta = eta_star_mean(luts, p.eta, p.eccentricity, lp, light.phi + phi_o);
+    inner_integral_blended(2, eta, sigma, theta_d, lp, dphi, || {
+        trt_lobes(luts, eta, sigma, theta_d, p.caustic_width, p.caustic_fade)
+    })
+    .map(|n| w * n)
+}
+
+/// The longitudinal weight w(theta_i) = M_t(theta_h) g^c(theta_i; theta_j, lambda_j) of one lobe, in Laplace
+/// form: its peak theta*, the bandwidth lambda* of the Gaussian with the same curvature there, and ln w(theta*).
+/// M_t(theta_h) is the Gaussian g(theta_i; 2 alpha_t - theta_o, 2 sqrt(2) beta_t) / (sqrt(2 pi) beta_t) (Xu Eq. 7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LongitudinalWeight {
+    pub kappa_j: f32,
+    pub theta_j: f32,
+    pub mu_m: f32,
+    pub lambda_m: f32,
+    pub peak: f32,
+    pub lambda: f32,
+    pub ln_w_peak: f32,
+}
+
+impl LongitudinalWeight {
+    /// ln w(theta) without the 1 / (sqrt(2 pi) beta) factor.
+    pub fn ln_w(&self, theta: f32) -> f32 {
+        let d = (theta - self.mu_m) / self.lambda_m;
+        self.kappa_j * ((theta - self.theta_j).cos() - 1.0) - d * d
+    }
+}
+
+/// Finds theta* by Newton's method on
+/// d ln w / d theta = -kappa_j sin(theta - theta_j) - 2 (theta - mu_M) / lambda_M^2,
+/// started from the product of Gaussians Xu uses (g^c replaced by g). When the curvature
+/// kappa_j cos(theta* - theta_j) + 2 / lambda_M^2 is not clearly positive (a wide light centred more than
+/// 90 degrees away), the light is smooth over the lobe and the weight is M_t alone (lambda* = lambda_M).
+pub fn longitudinal_weight(
+    theta_j: f32,
+    lambda_j: f32,
+    mu_m: f32,
+    lambda_m: f32,
+) -> LongitudinalWeight {
+    let kappa_j = 2.0 / (lambda_j * lambda_j);
+    let k_m = 2.0 / (lambda_m * lambda_m);
+    let (_, t0, _) = gaussian_product(theta_j, lambda_j, mu_m, lambda_m);
+    let mut t = t0;
+    let mut curvature = 0.0;
+    for _ in 0..10 {
+        let (s, c) = (t - theta_j).sin_cos();
+        let grad = -kappa_j * s - k_m * (t - mu_m);
+        curvature = kappa_j * c + k_m;
+        if curvature <= 0.25 * k_m {
+            break;
+        }
+        let step = (grad / curvature).clamp(-0.3, 0.3);
+        t += step;
+        if step.abs() < 1e-6 {
+            break;
+        }
+    }
+    let mut w = LongitudinalWeight {
+        kappa_j,
+        theta_j,
+        mu_m,
+        lambda_m,
+        peak: t,
+        lambda: 0.0,
+        ln_w_peak: 0.0,
+    };
+    if curvature <= 0.25 * k_m || !t.is_finite() {
+        w.peak = mu_m;
+        w.lambda = lambda_m;
+        w.ln_w_peak = 0.0; // the ratio w / g(theta; mu_M, lambda_M) is the light's g^c itself
+        w.kappa_j = kappa_j;
+        return w;
+    }
+    // ln w ~ ln w(theta*) - (curvature / 2) (theta - theta*)^2, i.e. a Gaussian of bandwidth sqrt(2 / curvature).
+    w.lambda = (2.0 / curvature).sqrt();
+    w.ln_w_peak = w.ln_w(t);
+    w
+}
+
+/// M_t for lobe t (0 = R, 1 = TT, 2 = TRT), RGB (Xu Eq. 11 by Sec. 4.2.2).
+///
+/// Xu replaces the light's g^c(theta_i; theta_j, lambda_j) by the Gaussian g(theta_i; theta_j, lambda_j) and
+/// integrates the smooth factor against the product Gaussian g M_t. That is exact for narrow lights but
+/// off by large factors for wide ones far from the lobe (g^c / g = exp((2 (cos D - 1) + D^2) / lambda_j^2)
+/// reaches 20 at D = 2.6, lambda_j = 1). Here the weight w = g^c M_t is kept exact: the quadrature runs
+/// against the Gaussian with w's peak and curvature ([`longitudinal_weight`]) and the ratio of w to that
+/// Gaussian (1 at the peak, smooth around it) joins the interpolated factor.
+pub fn srbf_response_lobe(
+    luts: &Luts,
+    p: &FastHairParams,
+    lobe: u32,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+) -> Rgb32 {
+    let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
+    let (mu_m, lambda_m) = (2.0 * alpha - theta_o, 2.0 * std::f32::consts::SQRT_2 * beta);
+    let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
+    let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * beta);
+    if scale < 1e-30 {
+        return [0.0; 3];
+    }
+    linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
+        let d = (ti - w.peak) / w.lambda;
+        let ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0).exp();
+        outer_integrand(luts, p, lobe, light, theta_o, phi_o, ti).map(|v| ratio * v)
+    })
+    // The parabolas may dip below zero where f vanishes; the response cannot.
+    .map(|v| (scale * v).max(0.0))
+}
+
+/// M_R, M_TT, M_TRT (RGB each).
+pub fn srbf_response(
+    luts: &Luts,
+    p: &FastHairParams,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+) -> [Rgb32; 3] {
+    std::array::from_fn(|t| srbf_response_lobe(luts, p, t as u32, light, theta_o, phi_o))
+}
