@@ -8,3 +8,4 @@ pub mod envmap;
 pub mod gpu;
 pub mod hair;
 pub mod scattering;
+pub mod shadow;

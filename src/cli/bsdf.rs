@@ -1,7 +1,7 @@
 //! `strandlight bsdf`: evaluate the exact Marschner model for given directions.
 
-use super::params_args::{ParamArgs, ParamsReport};
-use anyhow::{Context, bail};
+use super::params_args::{ParamArgs, ParamsReport, check_angles};
+use anyhow::Context;
 use clap::Args;
 use serde::{Deserialize, Serialize};
 use std::io::Read;
@@ -68,21 +68,15 @@ pub struct Answer {
 }
 
 pub fn evaluate(q: &Query, defaults: &ParamArgs) -> anyhow::Result<Answer> {
-    for (name, v) in [
-        ("theta_i", q.theta_i),
-        ("phi_i", q.phi_i),
-        ("theta_o", q.theta_o),
-        ("phi_o", q.phi_o),
-    ] {
-        if !v.is_finite() {
-            bail!("{name} must be finite");
-        }
-    }
-    for (name, v) in [("theta_i", q.theta_i), ("theta_o", q.theta_o)] {
-        if v.abs() > 90.0 {
-            bail!("{name} must lie in [-90, 90] degrees, got {v}");
-        }
-    }
+    check_angles(
+        &[
+            ("theta_i", q.theta_i),
+            ("phi_i", q.phi_i),
+            ("theta_o", q.theta_o),
+            ("phi_o", q.phi_o),
+        ],
+        &[("theta_i", q.theta_i), ("theta_o", q.theta_o)],
+    )?;
     let args = q.params.overlay(defaults);
     let params = args.resolve()?;
     let variant = args.variant.unwrap_or_default();

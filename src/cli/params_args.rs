@@ -195,3 +195,18 @@ impl ParamsReport {
         }
     }
 }
+
+/// Rejects non-finite angles and inclinations outside [-90, 90] degrees, naming the field.
+pub fn check_angles(all: &[(&str, f64)], inclinations: &[(&str, f64)]) -> anyhow::Result<()> {
+    for (name, v) in all {
+        if !v.is_finite() {
+            bail!("{name} must be finite");
+        }
+    }
+    for (name, v) in inclinations {
+        if v.abs() > 90.0 {
+            bail!("{name} must lie in [-90, 90] degrees, got {v}");
+        }
+    }
+    Ok(())
+}

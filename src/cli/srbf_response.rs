@@ -1,7 +1,8 @@
 //! `strandlight srbf-response`: the fast per-SRBF response (Xu 2011 Sec. 4.2) for given parameters, light
 //! and view, optionally with the brute-force integral of the exact model and the relative error.
 
-use super::params_args::{ParamArgs, ParamsReport, VariantArg};
+use super::bsdf::LobeReport;
+use super::params_args::{ParamArgs, ParamsReport, VariantArg, check_angles};
 use anyhow::{Context, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
@@ -10,7 +11,9 @@ use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHair
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::srbf_reference::{SrbfLight64, srbf_response_reference};
-use strandlight::scattering::{CausticModel, FiberAngles, FresnelModel, Lobe, ModelVariant, Rgb};
+use strandlight::scattering::{
+    CausticModel, FiberAngles, FresnelModel, Lobe, LobeValues, ModelVariant, Rgb,
+};
 
 #[derive(Args, Debug)]
 pub struct SrbfResponseArgs {
@@ -58,25 +61,16 @@ pub struct Query {
     pub params: ParamArgs,
 }
 
-#[derive(Serialize)]
-pub struct Lobes {
-    #[serde(rename = "R")]
-    pub r: Rgb,
-    #[serde(rename = "TT")]
-    pub tt: Rgb,
-    #[serde(rename = "TRT")]
-    pub trt: Rgb,
-    pub total: Rgb,
-}
-
-impl Lobes {
-    fn new(v: [Rgb; 3]) -> Self {
-        Self {
-            r: v[0],
-            tt: v[1],
-            trt: v[2],
-            total: std::array::from_fn(|c| v[0][c] + v[1][c] + v[2][c]),
-        }
+/// Per lobe and channel, with the total (the `bsdf` report's shape).
+fn lobes(v: [Rgb; 3]) -> LobeReport {
+    let lobes = LobeValues {
+        r: v[0],
+        tt: v[1],
+        trt: v[2],
+    };
+    LobeReport {
+        total: lobes.total(),
+        lobes,
     }
 }
 
@@ -90,9 +84,9 @@ pub struct Answer {
     pub segments: u32,
     pub params: ParamsReport,
     /// integral of G S cos(theta_i) d omega_i, per lobe and channel (fast form).
-    pub fast: Lobes,
+    pub fast: LobeReport,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub reference: Option<Lobes>,
+    pub reference: Option<LobeReport>,
     /// |fast - reference| / reference of the total, per channel.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relative_error: Option<Rgb>,
@@ -105,22 +99,16 @@ fn evaluate(
     segments: u32,
     reference: bool,
 ) -> anyhow::Result<Answer> {
-    for (name, v) in [
-        ("theta_j", q.theta_j),
-        ("phi_j", q.phi_j),
-        ("lambda", q.lambda),
-        ("theta_o", q.theta_o),
-        ("phi_o", q.phi_o),
-    ] {
-        if !v.is_finite() {
-            bail!("{name} must be finite");
-        }
-    }
-    for (name, v) in [("theta_j", q.theta_j), ("theta_o", q.theta_o)] {
-        if v.abs() > 90.0 {
-            bail!("{name} must lie in [-90, 90] degrees, got {v}");
-        }
-    }
+    check_angles(
+        &[
+            ("theta_j", q.theta_j),
+            ("phi_j", q.phi_j),
+            ("lambda", q.lambda),
+            ("theta_o", q.theta_o),
+            ("phi_o", q.phi_o),
+        ],
+        &[("theta_j", q.theta_j), ("theta_o", q.theta_o)],
+    )?;
     if !(0.001..=10.0).contains(&q.lambda) {
         bail!("lambda must lie in [0.001, 10] radians, got {}", q.lambda);
     }
@@ -148,7 +136,7 @@ fn evaluate(
         q.phi_o.to_radians() as f32,
     )
     .map(|l| l.map(|v| v as f64));
-    let fast = Lobes::new(fast);
+    let fast = lobes(fast);
     let (reference, relative_error) = if reference {
         let variant = ModelVariant {
             fresnel: FresnelModel::XuSchlick,
@@ -163,7 +151,7 @@ fn evaluate(
         let r = Lobe::ALL.map(|lobe| {
             std::array::from_fn(|c| srbf_response_reference(&params, variant, lobe, l64, wo, c))
         });
-        let r = Lobes::new(r);
+        let r = lobes(r);
         let err = std::array::from_fn(|c| {
             (fast.total[c] - r.total[c]).abs() / r.total[c].max(f64::MIN_POSITIVE)
         });

@@ -1,5 +1,7 @@
 //! GPU access through wgpu: headless device creation shared by the CLI, tests and (later) the editor.
 
 pub mod context;
+pub mod fast_eval;
+pub mod shaders;
 
 pub use context::{GpuContext, GpuError, GpuOptions};

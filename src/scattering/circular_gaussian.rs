@@ -12,6 +12,26 @@ pub fn circular_gaussian(x: f32, mu: f32, lambda: f32) -> f32 {
     (2.0 * ((x - mu).cos() - 1.0) / (lambda * lambda)).exp()
 }
 
+/// asin to f32 precision by the same rational form as the WGSL twin (Cephes asinf), so CPU and GPU round
+/// alike: Vulkan lets a built-in asin be off by thousands of ULP, which narrow lights amplify.
+#[allow(clippy::excessive_precision)] // the published coefficients, verbatim
+pub fn asin_precise(x: f32) -> f32 {
+    let a = x.abs();
+    let p = |z: f32| {
+        (((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z
+            + 1.6666752422e-1
+    };
+    let r = if a < 0.5 {
+        let z = a * a;
+        a + a * z * p(z)
+    } else {
+        let z = 0.5 * (1.0 - a.min(1.0));
+        let s = z.sqrt();
+        std::f32::consts::FRAC_PI_2 - 2.0 * (s + s * z * p(z))
+    };
+    r.copysign(x)
+}
+
 /// I0(x) e^-x, the exponentially scaled modified Bessel function of the first kind, order 0
 /// (Abramowitz & Stegun 9.8.1 for x <= 3.75, 9.8.2 for x > 3.75; relative error < 2e-7).
 /// Scaled so large kappa does not overflow.

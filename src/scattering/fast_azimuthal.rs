@@ -19,7 +19,7 @@
 //! - N_TRT(0) for b_2 (Eq. 21) is the full root sum: for sqrt(2) < eta' < 2 phi(2, h) = 0 has the roots
 //!   +-h_2 beside h = 0, found by bisection.
 
-use super::circular_gaussian::bessel_i0_scaled;
+use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
 use super::lut::{Luts, lut_sample_c, lut_sample_h, wrap_angle_f32};
 use std::f32::consts::{PI, SQRT_2, TAU};
 
@@ -265,7 +265,7 @@ pub fn trt_value_at_zero(eta: f32, cos_d: f32, eta_p: f32, sigma_p: Rgb32) -> Rg
     let mut n = trt_root_term(eta, cos_d, eta_p, sigma_p, 0.0);
     if eta_p > SQRT_2 && eta_p < 2.0 {
         // g(h) = 2 asin(h/eta') - asin(h): positive at the caustic h_c, negative at h = 1.
-        let g = |h: f32| 2.0 * (h / eta_p).asin() - h.asin();
+        let g = |h: f32| 2.0 * asin_precise(h / eta_p) - asin_precise(h);
         let (mut lo, mut hi) = (((4.0 - eta_p * eta_p) / 3.0).sqrt(), 1.0f32);
         for _ in 0..24 {
             let mid = 0.5 * (lo + hi);
@@ -314,7 +314,8 @@ pub fn trt_lobes(
     let mut fit = LobeFit::default();
     if eta_p < 2.0 {
         let hc = ((4.0 - eta_p * eta_p) / 3.0).sqrt();
-        let phi_star = wrap_angle_f32(4.0 * (hc / eta_p).asin() - 2.0 * hc.asin() + TAU).abs();
+        let phi_star =
+            wrap_angle_f32(4.0 * asin_precise(hc / eta_p) - 2.0 * asin_precise(hc) + TAU).abs();
         let damp = 1.0 - (kappa_w * ((phi_star).cos() - 1.0)).exp();
         let kappa_star = 2.0 / (phi_star * phi_star).max(1e-12);
         let e_star = circular_gaussian_energy(kappa_star);

@@ -13,6 +13,7 @@
 //! are found by safeguarded Newton and it is integrated by 8-point Gauss-Legendre on two panels.
 //! f32, as the WGSL twin.
 
+use super::circular_gaussian::asin_precise;
 use super::fast_azimuthal::{
     LobeFit, Rgb32, attenuation_exact, bravais_eta_prime, fresnel_schlick, inner_integral_lobes,
     sigma_a_prime, smoothstep,
@@ -43,7 +44,7 @@ const GAUSS_LEGENDRE_8: [(f32, f32); 8] = [
 /// Phi(p, t) = 2 p asin(sin t / eta') - 2 t + p pi (Xu Eq. 8 with h = sin t), unwrapped.
 pub fn exit_azimuth(p: u32, t: f32, eta_p: f32) -> f32 {
     let pf = p as f32;
-    2.0 * pf * (t.sin() / eta_p).asin() - 2.0 * t + pf * PI
+    2.0 * pf * asin_precise(t.sin() / eta_p) - 2.0 * t + pf * PI
 }
 
 /// dPhi/dt = 2 p cos t / sqrt(eta'^2 - sin^2 t) - 2.
@@ -134,7 +135,7 @@ pub fn azimuthal_window_integral(
     let mut ends = [-FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, FRAC_PI_2];
     let mut pieces = 1;
     if p == 2 && eta_p < 2.0 {
-        let tc = ((4.0 - eta_p * eta_p) / 3.0).sqrt().asin();
+        let tc = asin_precise(((4.0 - eta_p * eta_p) / 3.0).sqrt());
         ends = [-FRAC_PI_2, -tc, tc, FRAC_PI_2];
         pieces = 3;
     }
@@ -161,7 +162,9 @@ pub fn azimuthal_window_integral(
                 for (x, wt) in GAUSS_LEGENDRE_8 {
                     let t = mid + half * x;
                     let g = if kappa > 0.0 {
-                        (kappa * ((exit_azimuth(p, t, eta_p) - c).cos() - 1.0)).exp()
+                        // cos x - 1 = -2 sin^2(x/2), without the cancellation that kappa ~ 1e3 amplifies.
+                        let s = (0.5 * (exit_azimuth(p, t, eta_p) - c)).sin();
+                        (-2.0 * kappa * s * s).exp()
                     } else {
                         1.0
                     };

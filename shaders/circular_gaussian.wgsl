@@ -1,0 +1,131 @@
+// Circular-Gaussian primitives of Xu et al. 2011's fast model.
+// Twin of src/scattering/circular_gaussian.rs and the Bessel / kappa helpers of fast_azimuthal.rs:
+// same names, same formulas, f32.
+
+const PI: f32 = 3.14159265358979;
+const TAU: f32 = 6.28318530717959;
+const FRAC_PI_2: f32 = 1.57079632679490;
+const SQRT_2: f32 = 1.41421356237310;
+const SQRT_PI: f32 = 1.77245385090552;
+
+// Wraps an angle to [-pi, pi].
+fn wrap_angle(x: f32) -> f32 {
+    return x - TAU * floor((x + PI) / TAU);
+}
+
+// asin to f32 precision (Cephes asinf). Vulkan lets the built-in asin be off by thousands of ULP, and
+// exp(kappa (cos(Phi) - 1)) with kappa = 2 / lambda'^2 up to ~1000 amplifies that into percent errors.
+fn asin_precise(x: f32) -> f32 {
+    let a = abs(x);
+    var r: f32;
+    if (a < 0.5) {
+        let z = a * a;
+        r = a + a * z * ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z + 1.6666752422e-1);
+    } else {
+        let z = 0.5 * (1.0 - min(a, 1.0));
+        let s = sqrt(z);
+        r = FRAC_PI_2 - 2.0 * (s + s * z * ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z + 1.6666752422e-1));
+    }
+    return sign(x) * r;
+}
+
+// I0(x) e^-x (Abramowitz & Stegun 9.8.1, 9.8.2).
+fn bessel_i0_scaled(x: f32) -> f32 {
+    let ax = abs(x);
+    if (ax <= 3.75) {
+        let t = (ax / 3.75) * (ax / 3.75);
+        let i0 = 1.0 + t * (3.5156229 + t * (3.0899424 + t * (1.2067492 + t * (0.2659732 + t * (0.0360768 + t * 0.0045813)))));
+        return i0 * exp(-ax);
+    }
+    let t = 3.75 / ax;
+    let p = 0.39894228 + t * (0.01328592 + t * (0.00225319 + t * (-0.00157565 + t * (0.00916281
+        + t * (-0.02057706 + t * (0.02635537 + t * (-0.01647633 + t * 0.00392377)))))));
+    return p / sqrt(ax);
+}
+
+// I1(x) e^-x (A&S 9.8.3, 9.8.4), x >= 0.
+fn bessel_i1_scaled(x: f32) -> f32 {
+    let ax = abs(x);
+    if (ax <= 3.75) {
+        let t = (ax / 3.75) * (ax / 3.75);
+        let i1 = ax * (0.5 + t * (0.87890594 + t * (0.51498869 + t * (0.15084934 + t * (0.02658733 + t * (0.00301532 + t * 0.00032411))))));
+        return i1 * exp(-ax);
+    }
+    let t = 3.75 / ax;
+    let p = 0.39894228 + t * (-0.03988024 + t * (-0.00362018 + t * (0.00163801 + t * (-0.01031555
+        + t * (0.02282967 + t * (-0.02895312 + t * (0.01787654 + t * -0.00420059)))))));
+    return p / sqrt(ax);
+}
+
+// erf by A&S 7.1.26 (WGSL has no erf).
+fn erf_approx(x: f32) -> f32 {
+    let a = abs(x);
+    let t = 1.0 / (1.0 + 0.3275911 * a);
+    let poly = t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+    return sign(x) * (1.0 - poly * exp(-a * a));
+}
+
+// integral_a^b (c0 + c1 x) g(x; mu, lambda) dx, g = exp(-(x - mu)^2 / lambda^2).
+fn gaussian_linear_integral(a: f32, b: f32, mu: f32, lambda: f32, c0: f32, c1: f32) -> f32 {
+    let ua = (a - mu) / lambda;
+    let ub = (b - mu) / lambda;
+    let i0 = 0.5 * SQRT_PI * lambda * (erf_approx(ub) - erf_approx(ua));
+    let i1 = 0.5 * lambda * lambda * (exp(-ua * ua) - exp(-ub * ub));
+    return (c0 + c1 * mu) * i0 + c1 * i1;
+}
+
+// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx, y = x - mu.
+fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32>) -> f32 {
+    let ua = (a - mu) / lambda;
+    let ub = (b - mu) / lambda;
+    let ea = exp(-ua * ua);
+    let eb = exp(-ub * ub);
+    let m0 = 0.5 * SQRT_PI * (erf_approx(ub) - erf_approx(ua));
+    let m1 = 0.5 * (ea - eb);
+    let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
+    return lambda * (d.x * m0 + d.y * lambda * m1 + d.z * lambda * lambda * m2);
+}
+
+// 2 pi e^-kappa I0(kappa): the period integral of exp(kappa (cos x - 1)).
+fn circular_gaussian_energy(kappa: f32) -> f32 {
+    return TAU * bessel_i0_scaled(kappa);
+}
+
+// kappa whose period integral is `ratio` (Newton on ln(2 pi I0s) in ln kappa).
+fn circular_gaussian_kappa_for_ratio(ratio: f32) -> f32 {
+    let kappa_min = 1e-4;
+    let kappa_max = 1e8;
+    if (!(ratio < TAU * 0.9999)) {
+        return kappa_min;
+    }
+    if (ratio <= 0.0) {
+        return kappa_max;
+    }
+    let goal = log(ratio);
+    var s = log(clamp(TAU / (ratio * ratio), kappa_min, kappa_max));
+    for (var it = 0; it < 8; it++) {
+        let k = exp(s);
+        let i0 = bessel_i0_scaled(k);
+        let i1 = bessel_i1_scaled(k);
+        let f = log(TAU * i0) - goal;
+        let df = k * (i1 / i0 - 1.0);
+        if (abs(df) < 1e-12) {
+            break;
+        }
+        s = clamp(s - clamp(f / df, -3.0, 3.0), log(kappa_min), log(kappa_max));
+    }
+    return exp(s);
+}
+
+// b integral g^c(x; 0, lambda') g^c(dphi - x; mu, lambda) dx / b, with dphi - mu passed as `dphi`.
+fn circular_gaussian_convolution(kappa_prime: f32, dphi: f32, kappa: f32) -> f32 {
+    let re = kappa_prime + kappa * cos(dphi);
+    let im = kappa * sin(dphi);
+    let km = sqrt(re * re + im * im);
+    return TAU * exp(km - kappa_prime - kappa) * bessel_i0_scaled(km);
+}
+
+fn smoothstep_f(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}

@@ -1,0 +1,199 @@
+// Xu 2011 Sec. 4.2: the single-scattering response of one SRBF light per lobe.
+// Twin of src/scattering/fast_response.rs (and the FastHairParams layout of fast_params.rs).
+
+struct FastHairParams {
+    sigma_a: vec4<f32>,
+    alpha: vec4<f32>,
+    beta: vec4<f32>,
+    eta: f32,
+    eccentricity: f32,
+    caustic_width: f32,
+    caustic_fade: f32,
+    quadrature_segments: u32,
+    d_f: f32,
+    d_b: f32,
+    _pad: f32,
+}
+
+struct SrbfInFrame {
+    theta: f32,
+    phi: f32,
+    lambda: f32,
+}
+
+const LAMBDA_PRIME_MAX: f32 = 10.0;
+
+// g(x; mu1, l1) g(x; mu2, l2) = scale g(x; mu, l): returns (scale, mu, l).
+fn gaussian_product(mu1: f32, l1: f32, mu2: f32, l2: f32) -> vec3<f32> {
+    let a = l1 * l1;
+    let b = l2 * l2;
+    let s = a + b;
+    let d = mu1 - mu2;
+    return vec3<f32>(exp(-d * d / s), (mu1 * b + mu2 * a) / s, sqrt(a * b / s));
+}
+
+// Sample s (0..=m) of the quadrature over [-pi/2, pi/2] for a Gaussian (mu, lambda).
+fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
+    if (s == 0u) {
+        return -FRAC_PI_2;
+    }
+    if (s >= m) {
+        return FRAC_PI_2;
+    }
+    let half = 0.5 * (f32(m) - 2.0) * lambda;
+    let lo_raw = mu - half;
+    let hi_raw = mu + half;
+    let lo_clipped = lo_raw <= -FRAC_PI_2;
+    let hi_clipped = hi_raw >= FRAC_PI_2;
+    let lo = clamp(lo_raw, -FRAC_PI_2, FRAC_PI_2);
+    let hi = clamp(hi_raw, -FRAC_PI_2, FRAC_PI_2);
+    let inner = m - 1u;
+    let denom = (inner - 1u) + select(0u, 1u, lo_clipped) + select(0u, 1u, hi_clipped);
+    if (denom == 0u) {
+        return clamp(mu, -FRAC_PI_2, FRAC_PI_2);
+    }
+    let k = (s - 1u) + select(0u, 1u, lo_clipped);
+    return lo + (hi - lo) * f32(k) / f32(denom);
+}
+
+fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
+    let c = max(cos(theta_i) * cos(theta_j), 1e-8);
+    return min(lambda_j / sqrt(c), LAMBDA_PRIME_MAX);
+}
+
+// cos^2(theta_i) / cos^2(theta_d) calN_t at theta_i.
+fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, theta_i: f32) -> vec3<f32> {
+    let theta_d = 0.5 * (theta_o - theta_i);
+    let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
+    let ci = cos(theta_i);
+    let cd = cos(theta_d);
+    let w = ci * ci / max(cd * cd, 1e-8);
+    let dphi = phi_o - light.phi;
+    let sigma = params.sigma_a.xyz;
+    if (lobe == 0u) {
+        return vec3<f32>(w * inner_integral_r(params.eta, theta_d, lp, dphi));
+    }
+    if (lobe == 1u) {
+        return w * inner_integral_blended(1u, params.eta, sigma, theta_d, lp, dphi, params.caustic_width, params.caustic_fade);
+    }
+    let eta = eta_star_mean(params.eta, params.eccentricity, lp, light.phi + phi_o);
+    return w * inner_integral_blended(2u, eta, sigma, theta_d, lp, dphi, params.caustic_width, params.caustic_fade);
+}
+
+// The weight M_t g^c(theta_i; theta_j, lambda_j) in Laplace form.
+struct LongitudinalWeight {
+    kappa_j: f32,
+    theta_j: f32,
+    mu_m: f32,
+    lambda_m: f32,
+    peak: f32,
+    lambda: f32,
+    ln_w_peak: f32,
+}
+
+fn longitudinal_ln_w(w: LongitudinalWeight, theta: f32) -> f32 {
+    let d = (theta - w.mu_m) / w.lambda_m;
+    return w.kappa_j * (cos(theta - w.theta_j) - 1.0) - d * d;
+}
+
+fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) -> LongitudinalWeight {
+    let kappa_j = 2.0 / (lambda_j * lambda_j);
+    let k_m = 2.0 / (lambda_m * lambda_m);
+    var t = gaussian_product(theta_j, lambda_j, mu_m, lambda_m).y;
+    var curvature = 0.0;
+    for (var it = 0; it < 10; it++) {
+        let s = sin(t - theta_j);
+        let c = cos(t - theta_j);
+        let grad = -kappa_j * s - k_m * (t - mu_m);
+        curvature = kappa_j * c + k_m;
+        if (curvature <= 0.25 * k_m) {
+            break;
+        }
+        let step = clamp(grad / curvature, -0.3, 0.3);
+        t = t + step;
+        if (abs(step) < 1e-6) {
+            break;
+        }
+    }
+    var w = LongitudinalWeight(kappa_j, theta_j, mu_m, lambda_m, t, 0.0, 0.0);
+    if (curvature <= 0.25 * k_m) {
+        w.peak = mu_m;
+        w.lambda = lambda_m;
+        w.ln_w_peak = 0.0;
+        return w;
+    }
+    w.lambda = sqrt(2.0 / curvature);
+    w.ln_w_peak = longitudinal_ln_w(w, t);
+    return w;
+}
+
+fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+    let d = (ti - w.peak) / w.lambda;
+    let ratio = exp(clamp(longitudinal_ln_w(w, ti) - w.ln_w_peak + d * d, -80.0, 20.0));
+    return ratio * outer_integrand(params, lobe, light, theta_o, phi_o, ti);
+}
+
+fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f32, lambda: f32) -> vec3<f32> {
+    var out = vec3<f32>(0.0);
+    if (x1 <= x0) {
+        return out;
+    }
+    for (var c = 0u; c < 3u; c++) {
+        let c1 = (f1[c] - f0[c]) / (x1 - x0);
+        let c0 = f0[c] - c1 * x0;
+        out[c] = gaussian_linear_integral(x0, x1, mu, lambda, c0, c1);
+    }
+    return out;
+}
+
+// M_t for lobe t (0 = R, 1 = TT, 2 = TRT), RGB (Xu Eq. 11 by Sec. 4.2.2, parabolas on paired segments).
+fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
+    let alpha = params.alpha[lobe];
+    let beta = params.beta[lobe];
+    let mu_m = 2.0 * alpha - theta_o;
+    let lambda_m = 2.0 * SQRT_2 * beta;
+    let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
+    let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * beta);
+    if (scale < 1e-30) {
+        return vec3<f32>(0.0);
+    }
+    let m = params.quadrature_segments;
+    let mu = w.peak;
+    let l = w.lambda;
+    var out = vec3<f32>(0.0);
+    var x0 = quadrature_sample(0u, m, mu, l);
+    var f0 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x0);
+    var s = 1u;
+    loop {
+        if (s > m) {
+            break;
+        }
+        let x1 = quadrature_sample(s, m, mu, l);
+        let f1 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x1);
+        if (s < m) {
+            let x2 = quadrature_sample(s + 1u, m, mu, l);
+            let f2 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x2);
+            if (x2 > x0 && x1 > x0 && x2 > x1) {
+                for (var c = 0u; c < 3u; c++) {
+                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
+                    let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
+                    let y0 = x0 - mu;
+                    let y1 = x1 - mu;
+                    let d = vec3<f32>(f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2);
+                    out[c] = out[c] + gaussian_quadratic_integral(x0, x2, mu, l, d);
+                }
+            } else if (x2 > x0) {
+                out = out + quadrature_linear_piece(x0, x2, f0, f2, mu, l);
+            }
+            x0 = x2;
+            f0 = f2;
+            s = s + 2u;
+            continue;
+        }
+        out = out + quadrature_linear_piece(x0, x1, f0, f1, mu, l);
+        x0 = x1;
+        f0 = f1;
+        s = s + 1u;
+    }
+    return max(scale * out, vec3<f32>(0.0));
+}

@@ -1,0 +1,30 @@
+//! WGSL sources, embedded at build time and concatenated in dependency order (WGSL has no includes).
+//! Each file in `shaders/` mirrors a Rust file of the same name in `src/scattering/`.
+
+pub const CIRCULAR_GAUSSIAN: &str = include_str!("../../shaders/circular_gaussian.wgsl");
+pub const LUT: &str = include_str!("../../shaders/lut.wgsl");
+pub const FAST_AZIMUTHAL: &str = include_str!("../../shaders/fast_azimuthal.wgsl");
+pub const FAST_EXACT_AZIMUTHAL: &str = include_str!("../../shaders/fast_exact_azimuthal.wgsl");
+pub const FAST_RESPONSE: &str = include_str!("../../shaders/fast_response.wgsl");
+pub const FAST_EVAL: &str = include_str!("../../shaders/fast_eval.wgsl");
+
+/// The fast-model library (no bindings, no entry points): the including module declares the
+/// storage buffers `lut_c`, `lut_h_tt` and `lut_h_trt`.
+pub fn fast_model_library() -> String {
+    [
+        CIRCULAR_GAUSSIAN,
+        LUT,
+        FAST_AZIMUTHAL,
+        FAST_EXACT_AZIMUTHAL,
+        FAST_RESPONSE,
+    ]
+    .join("\n")
+}
+
+/// Every complete shader module strandlight builds, by name (validated by naga in the tests).
+pub fn modules() -> Vec<(&'static str, String)> {
+    vec![(
+        "fast_eval",
+        format!("{}\n{}", fast_model_library(), FAST_EVAL),
+    )]
+}

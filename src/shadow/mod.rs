@@ -1,0 +1,5 @@
+//! Self-shadowing of hair by hair: the fiber-density volume and the transmittance it gives each light.
+
+pub mod fiber_density;
+
+pub use fiber_density::FiberDensity;
