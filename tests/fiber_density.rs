@@ -198,3 +198,65 @@ fn a_fiber_deep_in_a_clump_receives_less_light_than_one_on_its_lit_side() {
     assert!(surface > 0.5 && far_side < 0.1);
     assert!(along < 1e-3);
 }
+
+/// Directions from the SRBF G(omega) = exp(2 (omega . c - 1) / lambda^2) (von Mises-Fisher, kappa = 2 / lambda^2).
+fn sample_srbf(r: &mut Rng01, c: Vec3, lambda: f32) -> Vec3 {
+    let kappa = 2.0 / (lambda * lambda);
+    let u = r.u().max(1e-7);
+    let w = 1.0 + (u + (1.0 - u) * (-2.0 * kappa).exp()).ln() / kappa;
+    let phi = std::f32::consts::TAU * r.u();
+    let e1 = if c.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+    let e1 = (e1 - c * c.dot(e1)).normalize();
+    let e2 = c.cross(e1);
+    let s = (1.0 - w * w).max(0.0).sqrt();
+    (c * w + (e1 * phi.cos() + e2 * phi.sin()) * s).normalize()
+}
+
+#[test]
+fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
+    use strandlight::shadow::DensityPyramid;
+    // The clump of the previous test, lit from +x by SRBFs of growing width.
+    let mut r = Rng01::new(11);
+    let fibers: Vec<(Vec3, Vec3)> = (0..3000)
+        .map(|_| {
+            let (rad, a) = (r.u().sqrt(), std::f32::consts::TAU * r.u());
+            let c = Vec3::new(rad * a.cos(), 0.0, rad * a.sin());
+            (c - Vec3::Y * 2.0, c + Vec3::Y * 2.0)
+        })
+        .collect();
+    let hair = hair_of(&fibers, 0.007);
+    let sigma = vec![[0.3f32; 3]; hair.point_count()];
+    let v = FiberDensity::build(&hair, &sigma, 0.1);
+    let pyramid = DensityPyramid::build(&v);
+    let mut worst: f32 = 0.0;
+    for p in [
+        Vec3::new(0.9, 0.0, 0.0),
+        Vec3::new(0.5, 0.3, 0.2),
+        Vec3::new(0.0, 0.5, 0.0),
+    ] {
+        // A narrow light: the cone degenerates to the ray.
+        let narrow = pyramid.srbf_transmittance(p, Vec3::X, 0.01, 0.0);
+        let ray = v.transmittance(p, Vec3::X, 0.0);
+        assert!(
+            (narrow - ray).abs() < 0.01 + 0.02 * ray,
+            "{narrow} vs {ray}"
+        );
+        for lambda in [0.2f32, 0.5, 1.0] {
+            let cone = pyramid.srbf_transmittance(p, Vec3::X, lambda, 0.0);
+            let n = 4000;
+            let mc: f32 = (0..n)
+                .map(|_| v.transmittance(p, sample_srbf(&mut r, Vec3::X, lambda), 0.0))
+                .sum::<f32>()
+                / n as f32;
+            let err = cone - mc;
+            worst = worst.max(err.abs());
+            println!(
+                "p {p:?} lambda {lambda}: cone {cone:.4}, Monte Carlo over G {mc:.4} ({err:+.4}); ray {ray:.4}"
+            );
+        }
+    }
+    println!("worst absolute difference {worst:.4}");
+    // Measured: 0.023 (deep inside a clump under the widest light, where the seven cones see less
+    // of the back hemisphere than G does; one averaged cone was off by 0.085).
+    assert!(worst < 0.04, "{worst}");
+}

@@ -2,6 +2,7 @@
 
 pub mod context;
 pub mod fast_eval;
+pub mod fiber_density;
 pub mod shaders;
 
 pub use context::{GpuContext, GpuError, GpuOptions};

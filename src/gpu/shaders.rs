@@ -23,8 +23,14 @@ pub fn fast_model_library() -> String {
 
 /// Every complete shader module strandlight builds, by name (validated by naga in the tests).
 pub fn modules() -> Vec<(&'static str, String)> {
-    vec![(
-        "fast_eval",
-        format!("{}\n{}", fast_model_library(), FAST_EVAL),
-    )]
+    vec![
+        (
+            "fast_eval",
+            format!("{}\n{}", fast_model_library(), FAST_EVAL),
+        ),
+        (
+            "fiber_density",
+            super::fiber_density::FIBER_DENSITY_WGSL.to_string(),
+        ),
+    ]
 }

@@ -9,6 +9,7 @@
 //! of light arriving without crossing any fiber is exp(-tau) (Poisson). sqrt(<sin^2>) stands in for
 //! <|sin|>: exact for aligned fibers, 4% high for isotropic ones. No opacity constant is involved.
 
+use super::cone::{crossings, trilinear};
 use crate::hair::Hair;
 use glam::Vec3;
 
@@ -31,11 +32,17 @@ pub struct FiberDensity {
 /// Largest number of voxels along one axis.
 pub const MAX_DIM: usize = 256;
 
-impl FiberDensity {
-    /// Deposits every segment's length into the voxels it passes through (sub-sampled at a quarter
-    /// voxel), with its direction tensor, absorption (mean of its two points) and diameter.
-    /// `sigma_a` holds one RGB absorption per point of `hair`.
-    pub fn build(hair: &Hair, sigma_a: &[[f32; 3]], voxel: f32) -> Self {
+/// Where the volume lies: one voxel of margin around the hair's bounds, the voxel grown if an axis
+/// would need more than MAX_DIM voxels. Shared by the CPU builder and the GPU pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeGrid {
+    pub origin: Vec3,
+    pub voxel: f32,
+    pub dims: [usize; 3],
+}
+
+impl VolumeGrid {
+    pub fn around(hair: &Hair, voxel: f32) -> Self {
         let (lo, hi) = hair.bounds();
         let mut voxel = voxel.max(1e-4);
         let extent = (hi - lo).max(Vec3::splat(voxel));
@@ -45,6 +52,25 @@ impl FiberDensity {
         }
         let origin = lo - Vec3::splat(voxel);
         let dims = [0, 1, 2].map(|a| ((extent[a] / voxel).ceil() as usize + 2).min(MAX_DIM));
+        Self {
+            origin,
+            voxel,
+            dims,
+        }
+    }
+
+    pub fn voxel_count(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+}
+
+impl FiberDensity {
+    /// Deposits every segment's length into the voxels it passes through (sub-sampled at a quarter
+    /// voxel), with its direction tensor, absorption (mean of its two points) and diameter.
+    /// `sigma_a` holds one RGB absorption per point of `hair`.
+    pub fn build(hair: &Hair, sigma_a: &[[f32; 3]], voxel: f32) -> Self {
+        let grid = VolumeGrid::around(hair, voxel);
+        let (origin, voxel, dims) = (grid.origin, grid.voxel, grid.dims);
         let n = dims[0] * dims[1] * dims[2];
         let mut length = vec![0f64; n];
         let mut tensor = vec![[0f64; 6]; n];
@@ -121,40 +147,18 @@ impl FiberDensity {
         out
     }
 
-    /// Trilinear reading of (a, M) at p (voxel centres at origin + voxel (i + 1/2)); zero outside.
-    fn sample(&self, p: Vec3) -> (f32, [f32; 6]) {
-        let q = (p - self.origin) / self.voxel - Vec3::splat(0.5);
-        let base = q.floor();
-        let f = q - base;
-        let (mut a, mut m) = (0.0, [0.0; 6]);
-        for corner in 0..8 {
-            let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
-            let idx = [0, 1, 2].map(|ax| base[ax] as i64 + o[ax] as i64);
-            if (0..3).any(|ax| idx[ax] < 0 || idx[ax] >= self.dims[ax] as i64) {
-                continue;
-            }
-            let w = (0..3)
-                .map(|ax| if o[ax] == 1 { f[ax] } else { 1.0 - f[ax] })
-                .product::<f32>();
-            let v =
-                (idx[2] as usize * self.dims[1] + idx[1] as usize) * self.dims[0] + idx[0] as usize;
-            a += w * self.extinction[v];
-            for c in 0..6 {
-                m[c] += w * self.extinction_tensor[v][c];
-            }
-        }
-        (a, m)
-    }
-
-    /// Expected fiber crossings per cm along omega (unit) at p: sqrt(a^2 - a omega^T M omega).
+    /// Expected fiber crossings per cm along omega (unit) at p: sqrt(a^2 - a omega^T M omega), with
+    /// (a, M) read trilinearly.
     pub fn crossings_per_length(&self, p: Vec3, omega: Vec3) -> f32 {
-        let (a, m) = self.sample(p);
-        let w = omega;
-        let q = m[0] * w.x * w.x
-            + m[1] * w.y * w.y
-            + m[2] * w.z * w.z
-            + 2.0 * (m[3] * w.x * w.y + m[4] * w.x * w.z + m[5] * w.y * w.z);
-        (a * a - a * q).max(0.0).sqrt()
+        let (a, m) = trilinear(
+            self.dims,
+            self.voxel,
+            self.origin,
+            &self.extinction,
+            &self.extinction_tensor,
+            p,
+        );
+        crossings(a, m, omega)
     }
 
     /// Expected crossings tau from p towards the light along omega (unit), by the midpoint rule with

@@ -1,5 +1,7 @@
 //! Self-shadowing of hair by hair: the fiber-density volume and the transmittance it gives each light.
 
+pub mod cone;
 pub mod fiber_density;
 
+pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;

@@ -1,5 +1,6 @@
-//! The WGSL fast-form functions (shaders/) against their Rust twins (src/scattering/fast_*.rs) on the
-//! adapter (lavapipe in CI), and every WGSL module validated by naga with its struct layouts checked.
+//! WGSL against its Rust twins on the adapter (lavapipe in CI): the fast-form functions (shaders/ vs
+//! src/scattering/fast_*.rs) and the fiber-density pass (vs src/shadow/); every WGSL module validated by
+//! naga with its struct layouts checked.
 
 use rand_core::Rng;
 use std::f64::consts::PI;
@@ -135,4 +136,75 @@ fn wgsl_fast_response_equals_the_rust_twin() {
         "p99 relative difference"
     );
     assert!(worst <= 5e-3, "max relative difference {worst}");
+}
+
+/// The GPU fiber-density pass equals the CPU builder (its twin) voxel by voxel.
+#[test]
+fn gpu_fiber_density_equals_the_cpu_volume() {
+    use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
+    use strandlight::hair::procedural::{Style, StyleParams, generate};
+    use strandlight::shadow::FiberDensity;
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env())
+        .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
+    let hair = generate(&StyleParams::new(Style::Wavy, 2000, 24, 3)).expect("generate");
+    // Painted absorption: a root-to-tip gradient and a per-strand variation.
+    let t = hair.root_to_tip();
+    let sigma: Vec<[f32; 3]> = t
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| [0.2 + x, 0.5 + 0.1 * (i % 7) as f32, 1.5 - x])
+        .collect();
+    let voxel = 0.5;
+    let cpu = FiberDensity::build(&hair, &sigma, voxel);
+    let grid = VolumeGrid::around(&hair, voxel);
+    let gpu_hair = GpuHair::new(&ctx.device, &hair, &sigma);
+    let target = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
+    let pass = FiberDensityPass::new(&ctx.device);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    pass.encode(&ctx.device, &mut enc, &gpu_hair, &target);
+    ctx.queue.submit([enc.finish()]);
+    let gpu = target.read(&ctx).expect("read the volume");
+    assert_eq!(gpu.len(), cpu.extinction.len());
+    let amax = cpu.extinction.iter().fold(0f32, |a, b| a.max(*b));
+    let (mut worst, mut total_cpu, mut total_gpu, mut filled) = (0f32, 0f64, 0f64, 0usize);
+    for (v, g) in gpu.iter().enumerate() {
+        total_cpu += cpu.length_density[v] as f64;
+        total_gpu += g[7] as f64;
+        if cpu.extinction[v] < 1e-3 * amax {
+            continue;
+        }
+        filled += 1;
+        let m = cpu.extinction_tensor[v];
+        let s = cpu.absorption[v];
+        let pairs = [
+            (cpu.extinction[v], g[0]),
+            (m[0], g[1]),
+            (m[1], g[2]),
+            (m[2], g[3]),
+            (m[3], g[4]),
+            (m[4], g[5]),
+            (m[5], g[6]),
+            (cpu.length_density[v], g[7]),
+            (s[0], g[8]),
+            (s[1], g[9]),
+            (s[2], g[10]),
+        ];
+        for (k, (a, b)) in pairs.iter().enumerate() {
+            // Tensor entries are compared against the voxel's extinction (they can be ~0).
+            let scale = if (1..7).contains(&k) {
+                cpu.extinction[v]
+            } else {
+                a.abs()
+            };
+            worst = worst.max((a - b).abs() / scale.max(1e-20));
+        }
+    }
+    println!(
+        "{filled} filled voxels of {}: worst relative difference {worst:.2e}; total rho_L cpu {total_cpu:.6e} gpu {total_gpu:.6e}",
+        gpu.len()
+    );
+    assert!(filled > 100);
+    assert!((total_gpu / total_cpu - 1.0).abs() < 1e-4);
+    assert!(worst < 2e-3, "{worst}");
 }

@@ -1,0 +1,107 @@
+// The fiber-density volume on the GPU. Twin of FiberDensity::build (src/shadow/fiber_density.rs):
+// `deposit` runs one invocation per segment and adds its sub-sampled length, orientation tensor,
+// absorption and diameter into the voxels in fixed point (portable u32 atomics); `resolve` runs one
+// invocation per voxel and turns the sums into the extinction a = rho_L D, the tensor M = rho_L D <u u^T>,
+// the mean absorption and rho_L.
+
+struct VolumeInfo {
+    origin: vec3<f32>,
+    voxel: f32,
+    dims: vec3<u32>,
+    segment_count: u32,
+}
+
+// Fixed-point scale of the sums: 2^20 units per cm (a voxel may hold up to 4096 cm of fiber).
+const FIXED_SCALE: f32 = 1048576.0;
+const CHANNELS: u32 = 11u; // length, 6 tensor, 3 absorption, diameter (each x length)
+
+@group(0) @binding(0) var<uniform> info: VolumeInfo;
+// Point positions (xyz) and diameter (w), cm.
+@group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
+// Per-point sigma_a (xyz).
+@group(0) @binding(2) var<storage, read> absorption: array<vec4<f32>>;
+// First point of each segment (the segment joins it to the next point).
+@group(0) @binding(3) var<storage, read> segments: array<u32>;
+@group(0) @binding(4) var<storage, read_write> sums: array<atomic<u32>>;
+// Three vec4 per voxel: (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, rho_L), (sigma_a.rgb, 0).
+@group(0) @binding(5) var<storage, read_write> volume: array<vec4<f32>>;
+
+fn voxel_index(p: vec3<f32>) -> i32 {
+    let q = floor((p - info.origin) / info.voxel);
+    if (any(q < vec3<f32>(0.0)) || any(q >= vec3<f32>(info.dims))) {
+        return -1;
+    }
+    let i = vec3<u32>(q);
+    return i32((i.z * info.dims.y + i.y) * info.dims.x + i.x);
+}
+
+fn add_fixed(v: u32, c: u32, x: f32) {
+    atomicAdd(&sums[v * CHANNELS + c], u32(round(max(x, 0.0) * FIXED_SCALE)));
+}
+
+@compute @workgroup_size(64)
+fn deposit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Flat index over a 2D dispatch (a dimension holds at most 65535 workgroups).
+    let s = id.x + id.y * groups.x * 64u;
+    if (s >= info.segment_count) {
+        return;
+    }
+    let i = segments[s];
+    let a = points[i].xyz;
+    let b = points[i + 1u].xyz;
+    let l = distance(a, b);
+    if (l <= 0.0) {
+        return;
+    }
+    let u = (b - a) / l;
+    let sig = 0.5 * (absorption[i].xyz + absorption[i + 1u].xyz);
+    let d = 0.5 * (points[i].w + points[i + 1u].w);
+    let steps = max(u32(ceil(l / (0.25 * info.voxel))), 1u);
+    let dl = l / f32(steps);
+    // The tensor's off-diagonal terms can be negative: store u u^T + 1 (all >= 0) and remove the
+    // offset in `resolve` (the sum of dl is the length channel).
+    for (var k = 0u; k < steps; k++) {
+        let x = a + (b - a) * ((f32(k) + 0.5) / f32(steps));
+        let v = voxel_index(x);
+        if (v < 0) {
+            continue;
+        }
+        let vi = u32(v);
+        add_fixed(vi, 0u, dl);
+        add_fixed(vi, 1u, dl * u.x * u.x);
+        add_fixed(vi, 2u, dl * u.y * u.y);
+        add_fixed(vi, 3u, dl * u.z * u.z);
+        add_fixed(vi, 4u, dl * (u.x * u.y + 1.0));
+        add_fixed(vi, 5u, dl * (u.x * u.z + 1.0));
+        add_fixed(vi, 6u, dl * (u.y * u.z + 1.0));
+        add_fixed(vi, 7u, dl * sig.x);
+        add_fixed(vi, 8u, dl * sig.y);
+        add_fixed(vi, 9u, dl * sig.z);
+        add_fixed(vi, 10u, dl * d);
+    }
+}
+
+@compute @workgroup_size(64)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let v = id.x + id.y * groups.x * 64u;
+    if (v >= info.dims.x * info.dims.y * info.dims.z) {
+        return;
+    }
+    var s: array<f32, 11>;
+    for (var c = 0u; c < CHANNELS; c++) {
+        s[c] = f32(atomicLoad(&sums[v * CHANNELS + c])) / FIXED_SCALE;
+    }
+    let len = s[0];
+    if (len <= 0.0) {
+        volume[3u * v] = vec4<f32>(0.0);
+        volume[3u * v + 1u] = vec4<f32>(0.0);
+        volume[3u * v + 2u] = vec4<f32>(0.0);
+        return;
+    }
+    let rho = len / (info.voxel * info.voxel * info.voxel);
+    let d = s[10] / len;
+    let k = rho * d / len;
+    volume[3u * v] = vec4<f32>(rho * d, k * s[1], k * s[2], k * s[3]);
+    volume[3u * v + 1u] = vec4<f32>(k * (s[4] - len), k * (s[5] - len), k * (s[6] - len), rho);
+    volume[3u * v + 2u] = vec4<f32>(s[7] / len, s[8] / len, s[9] / len, 0.0);
+}

@@ -1,0 +1,231 @@
+//! The fiber-density volume built on the GPU (`shaders/fiber_density.wgsl`), the twin of
+//! [`crate::shadow::FiberDensity::build`]; run whenever geometry changes.
+
+use super::context::GpuContext;
+use crate::hair::Hair;
+use crate::shadow::fiber_density::VolumeGrid;
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+pub const FIBER_DENSITY_WGSL: &str = include_str!("../../shaders/fiber_density.wgsl");
+
+/// The volume's placement as the shader reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct VolumeInfo {
+    pub origin: [f32; 3],
+    pub voxel: f32,
+    pub dims: [u32; 3],
+    pub segment_count: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<VolumeInfo>() == 32);
+
+/// Fixed-point channels per voxel in the deposit buffer (see the shader).
+const CHANNELS: u64 = 11;
+
+/// Strand geometry on the GPU: points (xyz, diameter), per-point absorption (the buffer the brush
+/// paints), and the first point of every segment.
+pub struct GpuHair {
+    pub points: wgpu::Buffer,
+    pub absorption: wgpu::Buffer,
+    pub segments: wgpu::Buffer,
+    pub segment_count: u32,
+}
+
+impl GpuHair {
+    pub fn new(device: &wgpu::Device, hair: &Hair, sigma_a: &[[f32; 3]]) -> Self {
+        let mut points = Vec::with_capacity(hair.point_count());
+        let mut segments = Vec::new();
+        for s in 0..hair.strand_count() {
+            let r = hair.strand_range(s);
+            for p in r.clone() {
+                let x = hair.positions[p];
+                points.push([x.x, x.y, x.z, hair.thickness_at(s, p)]);
+            }
+            segments.extend((r.start as u32)..(r.end as u32 - 1));
+        }
+        let absorption: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
+        let init = |label: &str, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        // An empty buffer cannot be bound: keep at least one element.
+        if segments.is_empty() {
+            segments.push(0);
+        }
+        Self {
+            points: init("hair points", bytemuck::cast_slice(&points)),
+            absorption: init("hair absorption", bytemuck::cast_slice(&absorption)),
+            segment_count: if hair.point_count() > 1 {
+                segments.len() as u32
+            } else {
+                0
+            },
+            segments: init("hair segments", bytemuck::cast_slice(&segments)),
+        }
+    }
+}
+
+/// The volume on the GPU: three vec4 per voxel, (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, rho_L),
+/// (sigma_a, 0), as in [`crate::shadow::FiberDensity`].
+pub struct GpuFiberDensity {
+    pub grid: VolumeGrid,
+    pub info: wgpu::Buffer,
+    pub sums: wgpu::Buffer,
+    pub volume: wgpu::Buffer,
+}
+
+impl GpuFiberDensity {
+    pub fn new(device: &wgpu::Device, grid: VolumeGrid, segment_count: u32) -> Self {
+        let n = grid.voxel_count() as u64;
+        let info = VolumeInfo {
+            origin: grid.origin.to_array(),
+            voxel: grid.voxel,
+            dims: grid.dims.map(|d| d as u32),
+            segment_count,
+        };
+        Self {
+            grid,
+            info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("volume info"),
+                contents: bytemuck::bytes_of(&info),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            sums: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("volume sums"),
+                size: n * CHANNELS * 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            volume: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("volume"),
+                size: n * 48,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+        }
+    }
+
+    /// Reads the volume back (tests, debugging): 12 floats per voxel.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<[f32; 12]>, String> {
+        let size = self.volume.size();
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.volume, 0, &readback, 0, size);
+        ctx.queue.submit([enc.finish()]);
+        let slice = readback.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| format!("waiting for the GPU: {e}"))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| format!("reading the volume back: {e}"))?;
+        Ok(bytemuck::cast_slice::<u8, [f32; 12]>(&data).to_vec())
+    }
+}
+
+/// The two compute pipelines (deposit per segment, resolve per voxel).
+pub struct FiberDensityPass {
+    deposit: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+impl FiberDensityPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("fiber_density"),
+            source: wgpu::ShaderSource::Wgsl(FIBER_DENSITY_WGSL.into()),
+        });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self {
+            deposit: pipeline("deposit"),
+            resolve: pipeline("resolve"),
+        }
+    }
+
+    /// Clears the sums, deposits every segment, resolves every voxel.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        hair: &GpuHair,
+        target: &GpuFiberDensity,
+    ) {
+        encoder.clear_buffer(&target.sums, 0, None);
+        let bind = |pipeline: &wgpu::ComputePipeline, with_inputs: bool| {
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: target.info.as_entire_binding(),
+            }];
+            if with_inputs {
+                entries.extend([
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: hair.points.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: hair.absorption.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: hair.segments.as_entire_binding(),
+                    },
+                ]);
+            } else {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: target.volume.as_entire_binding(),
+                });
+            }
+            entries.push(wgpu::BindGroupEntry {
+                binding: 4,
+                resource: target.sums.as_entire_binding(),
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fiber_density"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            })
+        };
+        let (deposit_bind, resolve_bind) = (bind(&self.deposit, true), bind(&self.resolve, false));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fiber density"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.deposit);
+        pass.set_bind_group(0, &deposit_bind, &[]);
+        let (x, y) = dispatch_2d(hair.segment_count);
+        pass.dispatch_workgroups(x, y, 1);
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &resolve_bind, &[]);
+        let (x, y) = dispatch_2d(target.grid.voxel_count() as u32);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+/// Workgroups of 64 covering `n` invocations, as (x, y) with x <= 65535 (the shader flattens them).
+pub fn dispatch_2d(n: u32) -> (u32, u32) {
+    let groups = n.div_ceil(64).max(1);
+    let x = groups.min(65535);
+    (x, groups.div_ceil(x))
+}
