@@ -13,6 +13,7 @@ use strandlight::scattering::lut::Luts;
 
 #[test]
 fn every_wgsl_module_validates_and_struct_layouts_match() {
+    let mut layouts = 0;
     for (name, source) in shaders::modules() {
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
@@ -28,8 +29,21 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
             let expected = match ty.name.as_deref() {
                 Some("FastHairParams") => std::mem::size_of::<FastHairParams>(),
                 Some("FastQuery") => std::mem::size_of::<FastQuery>(),
+                Some("VolumeInfo") => {
+                    std::mem::size_of::<strandlight::gpu::fiber_density::VolumeInfo>()
+                }
+                Some("PyramidInfo") => {
+                    std::mem::size_of::<strandlight::gpu::density_pyramid::PyramidInfo>()
+                }
+                Some("PyramidLevel") => {
+                    std::mem::size_of::<strandlight::gpu::density_pyramid::PyramidLevel>()
+                }
+                Some("TransmittanceQuery") => {
+                    std::mem::size_of::<strandlight::gpu::density_pyramid::TransmittanceQuery>()
+                }
                 _ => continue,
             };
+            layouts += 1;
             assert_eq!(
                 layouter[handle].size as usize, expected,
                 "{name}: WGSL {:?} vs Rust",
@@ -38,6 +52,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         }
         println!("{name}: {} lines valid", source.lines().count());
     }
+    assert_eq!(layouts, 6, "every shared struct was found and compared");
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {
@@ -206,5 +221,69 @@ fn gpu_fiber_density_equals_the_cpu_volume() {
     );
     assert!(filled > 100);
     assert!((total_gpu / total_cpu - 1.0).abs() < 1e-4);
+    assert!(worst < 2e-3, "{worst}");
+}
+
+/// The GPU pyramid and cone-marched SRBF transmittance equal the CPU twins (src/shadow/cone.rs).
+#[test]
+fn gpu_srbf_transmittance_equals_the_cpu_cone_march() {
+    use glam::Vec3;
+    use strandlight::gpu::density_pyramid::{
+        DensityPyramidPass, GpuDensityPyramid, TransmittanceQuery, evaluate_transmittance,
+    };
+    use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
+    use strandlight::hair::procedural::{Style, StyleParams, generate};
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::{DensityPyramid, FiberDensity};
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env())
+        .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
+    let hair = generate(&StyleParams::new(Style::Bob, 3000, 16, 4)).expect("generate");
+    let sigma = vec![[0.4f32; 3]; hair.point_count()];
+    let voxel = 0.4;
+    let cpu = DensityPyramid::build(&FiberDensity::build(&hair, &sigma, voxel));
+    let grid = VolumeGrid::around(&hair, voxel);
+    let gpu_hair = GpuHair::new(&ctx.device, &hair, &sigma);
+    let volume = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
+    let pyramid = GpuDensityPyramid::new(&ctx.device, &volume);
+    assert_eq!(pyramid.info.count as usize, cpu.levels.len());
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume);
+    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid);
+    ctx.queue.submit([enc.finish()]);
+    // Queries: points on strands, lights all round, narrow to wide.
+    let mut rng = rand_pcg::Pcg64::new(8, 0x0a02_bdbf_7bb3_c0a7);
+    let mut u = move || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    let queries: Vec<TransmittanceQuery> = (0..512)
+        .map(|k| {
+            let p = hair.positions[(k * 97) % hair.point_count()];
+            let z = 2.0 * u() - 1.0;
+            let a = std::f32::consts::TAU * u();
+            let r = (1.0 - z * z).sqrt();
+            TransmittanceQuery {
+                p: p.to_array(),
+                lambda: 0.03 * 40f32.powf(u()),
+                centre: [r * a.cos(), z, r * a.sin()],
+                skip: 0.01,
+            }
+        })
+        .collect();
+    let gpu = evaluate_transmittance(&ctx, &pyramid, &queries).expect("GPU transmittance");
+    let mut worst: f32 = 0.0;
+    let mut spread = (1f32, 0f32);
+    for (q, g) in queries.iter().zip(&gpu) {
+        let c = cpu.srbf_transmittance(Vec3::from(q.p), Vec3::from(q.centre), q.lambda, q.skip);
+        worst = worst.max((c - g).abs());
+        spread = (spread.0.min(c), spread.1.max(c));
+    }
+    println!(
+        "{} queries: transmittance from {:.4} to {:.4}; worst |GPU - CPU| {worst:.2e}",
+        queries.len(),
+        spread.0,
+        spread.1
+    );
+    assert!(
+        spread.0 < 0.2 && spread.1 > 0.8,
+        "the queries span shadow and light"
+    );
     assert!(worst < 2e-3, "{worst}");
 }

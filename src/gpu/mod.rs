@@ -1,6 +1,7 @@
 //! GPU access through wgpu: headless device creation shared by the CLI, tests and (later) the editor.
 
 pub mod context;
+pub mod density_pyramid;
 pub mod fast_eval;
 pub mod fiber_density;
 pub mod shaders;

@@ -7,6 +7,15 @@ pub const FAST_AZIMUTHAL: &str = include_str!("../../shaders/fast_azimuthal.wgsl
 pub const FAST_EXACT_AZIMUTHAL: &str = include_str!("../../shaders/fast_exact_azimuthal.wgsl");
 pub const FAST_RESPONSE: &str = include_str!("../../shaders/fast_response.wgsl");
 pub const FAST_EVAL: &str = include_str!("../../shaders/fast_eval.wgsl");
+pub const DENSITY_PYRAMID: &str = include_str!("../../shaders/density_pyramid.wgsl");
+pub const DENSITY_DOWNSAMPLE: &str = include_str!("../../shaders/density_downsample.wgsl");
+pub const TRANSMITTANCE_EVAL: &str = include_str!("../../shaders/transmittance_eval.wgsl");
+
+/// The transmittance test harness: constants, cone marching, bindings and entry point. The
+/// including module declares `pyramid_info` and `pyramid`.
+pub fn transmittance_eval_module() -> String {
+    [CIRCULAR_GAUSSIAN, DENSITY_PYRAMID, TRANSMITTANCE_EVAL].join("\n")
+}
 
 /// The fast-model library (no bindings, no entry points): the including module declares the
 /// storage buffers `lut_c`, `lut_h_tt` and `lut_h_trt`.
@@ -32,5 +41,7 @@ pub fn modules() -> Vec<(&'static str, String)> {
             "fiber_density",
             super::fiber_density::FIBER_DENSITY_WGSL.to_string(),
         ),
+        ("density_downsample", DENSITY_DOWNSAMPLE.to_string()),
+        ("transmittance_eval", transmittance_eval_module()),
     ]
 }
