@@ -147,6 +147,17 @@ impl FiberDensity {
         out
     }
 
+    /// The voxel containing p.
+    pub fn voxel_at(&self, p: Vec3) -> Option<usize> {
+        let q = ((p - self.origin) / self.voxel).floor();
+        if q.min_element() < 0.0 {
+            return None;
+        }
+        let (i, j, k) = (q.x as usize, q.y as usize, q.z as usize);
+        (i < self.dims[0] && j < self.dims[1] && k < self.dims[2])
+            .then(|| (k * self.dims[1] + j) * self.dims[0] + i)
+    }
+
     /// Expected fiber crossings per cm along omega (unit) at p: sqrt(a^2 - a omega^T M omega), with
     /// (a, M) read trilinearly.
     pub fn crossings_per_length(&self, p: Vec3, omega: Vec3) -> f32 {

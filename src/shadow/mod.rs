@@ -2,6 +2,7 @@
 
 pub mod cone;
 pub mod fiber_density;
+pub mod forward;
 
 pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;
