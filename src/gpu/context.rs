@@ -100,4 +100,45 @@ impl GpuContext {
             summary,
         })
     }
+
+    /// Copies `buffer` (which needs COPY_SRC) into a mappable buffer after the work already submitted,
+    /// waits for the GPU, and returns its contents as `T`s (tests, read-backs of results).
+    pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>, String> {
+        let size = buffer.size();
+        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
+        self.queue.submit([enc.finish()]);
+        let slice = readback.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| format!("waiting for the GPU: {e}"))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| format!("reading a buffer back: {e}"))?;
+        // Copied out, so the result is aligned for T whatever the mapping's alignment.
+        Ok(bytemuck::pod_collect_to_vec(&data[..]))
+    }
+}
+
+/// A compute pipeline for one entry point of `module`, with the layout derived from the shader.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: None,
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
 }

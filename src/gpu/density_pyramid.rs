@@ -1,7 +1,7 @@
 //! The fiber-density mip pyramid on the GPU (`shaders/density_downsample.wgsl`) and the SRBF
 //! transmittance read from it (`shaders/density_pyramid.wgsl`); twins of [`crate::shadow::cone`].
 
-use super::context::GpuContext;
+use super::context::{GpuContext, compute_pipeline};
 use super::fiber_density::{GpuFiberDensity, dispatch_2d};
 use super::shaders;
 use bytemuck::{Pod, Zeroable};
@@ -129,19 +129,9 @@ impl DensityPyramidPass {
             label: Some("density_downsample"),
             source: wgpu::ShaderSource::Wgsl(shaders::DENSITY_DOWNSAMPLE.into()),
         });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
         Self {
-            copy: pipeline("copy_level0"),
-            downsample: pipeline("downsample"),
+            copy: compute_pipeline(device, &module, "copy_level0"),
+            downsample: compute_pipeline(device, &module, "downsample"),
         }
     }
 
@@ -200,14 +190,7 @@ pub fn evaluate_transmittance(
         label: Some("transmittance_eval"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("transmittance_eval"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let pipeline = compute_pipeline(device, &module, "main");
     let q = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("transmittance queries"),
         contents: bytemuck::cast_slice(queries),
@@ -218,12 +201,6 @@ pub fn evaluate_transmittance(
         label: Some("transmittance results"),
         size,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("transmittance readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -255,15 +232,8 @@ pub fn evaluate_transmittance(
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
     }
-    enc.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
     ctx.queue.submit([enc.finish()]);
-    let slice = readback.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| format!("waiting for the GPU: {e}"))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| format!("reading back: {e}"))?;
-    Ok(bytemuck::cast_slice::<u8, f32>(&data)[..queries.len()].to_vec())
+    let mut v: Vec<f32> = ctx.read_buffer(&results)?;
+    v.truncate(queries.len());
+    Ok(v)
 }

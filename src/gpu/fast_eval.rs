@@ -2,7 +2,7 @@
 //! that checks the WGSL fast-form functions against their Rust twins, and the LUTs as storage buffers
 //! (the renderer binds the same buffers).
 
-use super::context::GpuContext;
+use super::context::{GpuContext, compute_pipeline};
 use super::shaders;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::lut::{LutTexture, Luts};
@@ -59,15 +59,9 @@ impl FastEvalPipeline {
             label: Some("fast_eval"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("fast_eval"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        Self { pipeline }
+        Self {
+            pipeline: compute_pipeline(device, &module, "main"),
+        }
     }
 
     /// M_R, M_TT, M_TRT (RGB) per query.
@@ -91,12 +85,6 @@ impl FastEvalPipeline {
             label: Some("fast_eval results"),
             size,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fast_eval readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -132,17 +120,8 @@ impl FastEvalPipeline {
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
         }
-        enc.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
         ctx.queue.submit([enc.finish()]);
-        let slice = readback.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("waiting for the GPU: {e}"))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| format!("reading back results: {e}"))?;
-        let v: &[[f32; 4]] = bytemuck::cast_slice(&data);
+        let v: Vec<[f32; 4]> = ctx.read_buffer(&results)?;
         Ok((0..queries.len())
             .map(|i| std::array::from_fn(|t| [v[3 * i + t][0], v[3 * i + t][1], v[3 * i + t][2]]))
             .collect())

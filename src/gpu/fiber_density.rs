@@ -1,7 +1,7 @@
 //! The fiber-density volume built on the GPU (`shaders/fiber_density.wgsl`), the twin of
 //! [`crate::shadow::FiberDensity::build`]; run whenever geometry changes.
 
-use super::context::GpuContext;
+use super::context::{GpuContext, compute_pipeline};
 use crate::hair::Hair;
 use crate::shadow::fiber_density::VolumeGrid;
 use bytemuck::{Pod, Zeroable};
@@ -112,25 +112,7 @@ impl GpuFiberDensity {
 
     /// Reads the volume back (tests, debugging): 12 floats per voxel.
     pub fn read(&self, ctx: &GpuContext) -> Result<Vec<[f32; 12]>, String> {
-        let size = self.volume.size();
-        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("volume readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&self.volume, 0, &readback, 0, size);
-        ctx.queue.submit([enc.finish()]);
-        let slice = readback.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("waiting for the GPU: {e}"))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| format!("reading the volume back: {e}"))?;
-        Ok(bytemuck::cast_slice::<u8, [f32; 12]>(&data).to_vec())
+        ctx.read_buffer(&self.volume)
     }
 }
 
@@ -146,19 +128,9 @@ impl FiberDensityPass {
             label: Some("fiber_density"),
             source: wgpu::ShaderSource::Wgsl(FIBER_DENSITY_WGSL.into()),
         });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
         Self {
-            deposit: pipeline("deposit"),
-            resolve: pipeline("resolve"),
+            deposit: compute_pipeline(device, &module, "deposit"),
+            resolve: compute_pipeline(device, &module, "resolve"),
         }
     }
 

@@ -8,7 +8,7 @@
 //! tau) underestimates it (Jensen) and misses the tails of wide SRBFs, so wide lights are split into
 //! seven cones ([`DensityPyramid::srbf_transmittance`]); the test measures the rest against Monte Carlo.
 
-use super::fiber_density::FiberDensity;
+use super::fiber_density::{FiberDensity, box_exit};
 use glam::Vec3;
 
 /// One mip level: (a, M) per voxel, dims halved (rounded up) from the level below.
@@ -155,20 +155,7 @@ impl DensityPyramid {
     /// volume; `skip` cm left out at the start. Steps grow with the cone (half the level's voxel).
     pub fn cone_optical_depth(&self, p: Vec3, omega: Vec3, half_angle: f32, skip: f32) -> f32 {
         let base = self.levels[0].voxel;
-        let dims = self.levels[0].dims;
-        let hi = self.origin + base * Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
-        let mut exit = f32::INFINITY;
-        for ax in 0..3 {
-            let w = omega[ax];
-            if w.abs() > 1e-12 {
-                let t = if w > 0.0 {
-                    (hi[ax] - p[ax]) / w
-                } else {
-                    (self.origin[ax] - p[ax]) / w
-                };
-                exit = exit.min(t);
-            }
-        }
+        let exit = box_exit(self.origin, base, self.levels[0].dims, p, omega);
         let tan = half_angle.min(1.5).tan();
         let mut s = skip;
         let mut tau = 0.0;

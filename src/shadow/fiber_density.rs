@@ -29,6 +29,25 @@ pub struct FiberDensity {
     pub length_density: Vec<f32>,
 }
 
+/// Distance from p along omega (unit) to where the ray leaves the box origin + voxel * [0, dims];
+/// infinite for a zero direction.
+pub fn box_exit(origin: Vec3, voxel: f32, dims: [usize; 3], p: Vec3, omega: Vec3) -> f32 {
+    let hi = origin + voxel * Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
+    let mut exit = f32::INFINITY;
+    for ax in 0..3 {
+        let w = omega[ax];
+        if w.abs() > 1e-12 {
+            let t = if w > 0.0 {
+                (hi[ax] - p[ax]) / w
+            } else {
+                (origin[ax] - p[ax]) / w
+            };
+            exit = exit.min(t);
+        }
+    }
+    exit
+}
+
 /// Largest number of voxels along one axis.
 pub const MAX_DIM: usize = 256;
 
@@ -177,26 +196,7 @@ impl FiberDensity {
     /// shaded fiber itself).
     pub fn optical_depth(&self, p: Vec3, omega: Vec3, skip: f32) -> f32 {
         let h = 0.5 * self.voxel;
-        let hi = self.origin
-            + self.voxel
-                * Vec3::new(
-                    self.dims[0] as f32,
-                    self.dims[1] as f32,
-                    self.dims[2] as f32,
-                );
-        // Distance to leave the box along omega.
-        let mut exit = f32::INFINITY;
-        for ax in 0..3 {
-            let w = omega[ax];
-            if w.abs() > 1e-12 {
-                let t = if w > 0.0 {
-                    (hi[ax] - p[ax]) / w
-                } else {
-                    (self.origin[ax] - p[ax]) / w
-                };
-                exit = exit.min(t);
-            }
-        }
+        let exit = box_exit(self.origin, self.voxel, self.dims, p, omega);
         if !exit.is_finite() || exit <= skip {
             return 0.0;
         }

@@ -12,7 +12,7 @@
 //! Each voxel holds the sign-free orientation tensor only, so a_f and beta_f^2 are averaged over
 //! theta = +-asin(sqrt(omega^T <u u^T> omega)) (the fiber's inclination to the light, either way along it).
 
-use super::fiber_density::FiberDensity;
+use super::fiber_density::{FiberDensity, box_exit};
 use crate::scattering::dual_terms::dual_sample;
 use crate::scattering::{HairParams, ModelVariant};
 use glam::Vec3;
@@ -110,25 +110,7 @@ pub fn forward_scattering(
     skip: f32,
 ) -> ForwardScattering {
     let h0 = 0.5 * volume.voxel;
-    let hi = volume.origin
-        + volume.voxel
-            * Vec3::new(
-                volume.dims[0] as f32,
-                volume.dims[1] as f32,
-                volume.dims[2] as f32,
-            );
-    let mut exit = f32::INFINITY;
-    for ax in 0..3 {
-        let w = omega[ax];
-        if w.abs() > 1e-12 {
-            let t = if w > 0.0 {
-                (hi[ax] - p[ax]) / w
-            } else {
-                (volume.origin[ax] - p[ax]) / w
-            };
-            exit = exit.min(t);
-        }
-    }
+    let exit = box_exit(volume.origin, volume.voxel, volume.dims, p, omega);
     let (mut tau, mut loss, mut spread) = (0f32, [0f32; 3], [0f32; 3]);
     if exit.is_finite() && exit > skip {
         let steps = ((exit - skip) / h0).ceil() as usize;
