@@ -171,9 +171,8 @@ fn doubling_the_diameter_doubles_the_optical_depth() {
     assert!(((-t2).exp() - (-t1).exp().powi(2)).abs() < 1e-5);
 }
 
-#[test]
-fn a_fiber_deep_in_a_clump_receives_less_light_than_one_on_its_lit_side() {
-    // A clump: 3000 fibers along y within a cylinder of radius 1 cm about the y axis.
+/// A clump: 3000 fibers along y within a cylinder of radius 1 cm about the y axis, in 1 mm voxels.
+fn clump_volume() -> FiberDensity {
     let mut r = Rng01::new(11);
     let fibers: Vec<(Vec3, Vec3)> = (0..3000)
         .map(|_| {
@@ -184,7 +183,12 @@ fn a_fiber_deep_in_a_clump_receives_less_light_than_one_on_its_lit_side() {
         .collect();
     let hair = hair_of(&fibers, 0.007);
     let sigma = vec![[0.3f32; 3]; hair.point_count()];
-    let v = FiberDensity::build(&hair, &sigma, 0.1);
+    FiberDensity::build(&hair, &sigma, 0.1)
+}
+
+#[test]
+fn a_fiber_deep_in_a_clump_receives_less_light_than_one_on_its_lit_side() {
+    let v = clump_volume();
     let light = Vec3::X;
     let centre = v.transmittance(Vec3::ZERO, light, 0.0);
     let surface = v.transmittance(Vec3::new(0.95, 0.0, 0.0), light, 0.0);
@@ -215,18 +219,9 @@ fn sample_srbf(r: &mut Rng01, c: Vec3, lambda: f32) -> Vec3 {
 #[test]
 fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
     use strandlight::shadow::DensityPyramid;
-    // The clump of the previous test, lit from +x by SRBFs of growing width.
-    let mut r = Rng01::new(11);
-    let fibers: Vec<(Vec3, Vec3)> = (0..3000)
-        .map(|_| {
-            let (rad, a) = (r.u().sqrt(), std::f32::consts::TAU * r.u());
-            let c = Vec3::new(rad * a.cos(), 0.0, rad * a.sin());
-            (c - Vec3::Y * 2.0, c + Vec3::Y * 2.0)
-        })
-        .collect();
-    let hair = hair_of(&fibers, 0.007);
-    let sigma = vec![[0.3f32; 3]; hair.point_count()];
-    let v = FiberDensity::build(&hair, &sigma, 0.1);
+    // The clump, lit from +x by SRBFs of growing width.
+    let v = clump_volume();
+    let mut r = Rng01::new(12);
     let pyramid = DensityPyramid::build(&v);
     let mut worst: f32 = 0.0;
     for p in [

@@ -1,10 +1,9 @@
 //! `strandlight bsdf`: evaluate the exact Marschner model for given directions.
 
-use super::params_args::{ParamArgs, ParamsReport, check_angles};
+use super::params_args::{ParamArgs, ParamsReport, check_angles, read_stdin_queries};
 use anyhow::Context;
 use clap::Args;
 use serde::{Deserialize, Serialize};
-use std::io::Read;
 use strandlight::scattering::{FiberAngles, HalfAngles, LobeValues, Rgb, scattering_s};
 
 #[derive(Args, Debug)]
@@ -103,12 +102,7 @@ pub fn evaluate(q: &Query, defaults: &ParamArgs) -> anyhow::Result<Answer> {
 
 pub fn run(args: BsdfArgs) -> anyhow::Result<()> {
     if args.stdin {
-        let mut text = String::new();
-        std::io::stdin()
-            .read_to_string(&mut text)
-            .context("reading queries from standard input")?;
-        let queries: Vec<Query> = serde_json::from_str(&text)
-            .context("standard input is not a JSON array of bsdf queries")?;
+        let queries: Vec<Query> = read_stdin_queries("bsdf")?;
         let answers = queries
             .iter()
             .enumerate()

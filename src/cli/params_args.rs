@@ -210,3 +210,14 @@ pub fn check_angles(all: &[(&str, f64)], inclinations: &[(&str, f64)]) -> anyhow
     }
     Ok(())
 }
+
+/// Reads a JSON array of queries from standard input; errors say which command's queries they were.
+pub fn read_stdin_queries<T: serde::de::DeserializeOwned>(command: &str) -> anyhow::Result<Vec<T>> {
+    use std::io::Read;
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .context("reading queries from standard input")?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("standard input is not a JSON array of {command} queries"))
+}

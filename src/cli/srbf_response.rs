@@ -2,11 +2,10 @@
 //! and view, optionally with the brute-force integral of the exact model and the relative error.
 
 use super::bsdf::LobeReport;
-use super::params_args::{ParamArgs, ParamsReport, VariantArg, check_angles};
+use super::params_args::{ParamArgs, ParamsReport, VariantArg, check_angles, read_stdin_queries};
 use anyhow::{Context, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
-use std::io::Read;
 use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
@@ -176,12 +175,7 @@ fn evaluate(
 pub fn run(args: SrbfResponseArgs) -> anyhow::Result<()> {
     let luts = Luts::default_tables();
     if args.stdin {
-        let mut text = String::new();
-        std::io::stdin()
-            .read_to_string(&mut text)
-            .context("reading queries from standard input")?;
-        let queries: Vec<Query> = serde_json::from_str(&text)
-            .context("standard input is not a JSON array of srbf-response queries")?;
+        let queries: Vec<Query> = read_stdin_queries("srbf-response")?;
         use rayon::prelude::*;
         let answers = queries
             .par_iter()
