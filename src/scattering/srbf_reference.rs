@@ -84,26 +84,19 @@ fn moving_feature(
     phi_o: f64,
     h_of: impl Fn(&AzimuthalLobe) -> Option<f64>,
 ) -> Option<f64> {
-    let mut phi = 0.0;
     for start in [0.0, 1.5, -1.5, 3.0] {
-        phi = start;
-        let mut converged = false;
+        let mut phi = start;
         for _ in 0..100 {
             let az = AzimuthalLobe::new(params, variant, Lobe::TRT, theta_d, phi_o - 0.5 * phi);
             let h = h_of(&az)?;
             let next = wrap_angle(phi_p(2, h, az.eta_perp));
             if (next - phi).abs() < 1e-13 {
-                converged = true;
-                phi = next;
-                break;
+                return Some(next);
             }
             phi = next;
         }
-        if converged {
-            return Some(phi);
-        }
     }
-    let _ = phi;
+    // Not a contraction from any start: the integral runs without this break.
     None
 }
 
