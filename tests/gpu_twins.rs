@@ -38,6 +38,12 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 Some("PyramidLevel") => {
                     std::mem::size_of::<strandlight::gpu::density_pyramid::PyramidLevel>()
                 }
+                Some("ForwardQuery") => {
+                    std::mem::size_of::<strandlight::gpu::forward::ForwardQuery>()
+                }
+                Some("VolumeInfoF") => {
+                    std::mem::size_of::<strandlight::gpu::fiber_density::VolumeInfo>()
+                }
                 Some("TransmittanceQuery") => {
                     std::mem::size_of::<strandlight::gpu::density_pyramid::TransmittanceQuery>()
                 }
@@ -52,7 +58,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         }
         println!("{name}: {} lines valid", source.lines().count());
     }
-    assert_eq!(layouts, 6, "every shared struct was found and compared");
+    assert_eq!(layouts, 10, "every shared struct was found and compared");
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {
@@ -286,4 +292,85 @@ fn gpu_srbf_transmittance_equals_the_cpu_cone_march() {
         "the queries span shadow and light"
     );
     assert!(worst < 2e-3, "{worst}");
+}
+
+/// The GPU forward-scattering march (direct fraction, T_f, sigma_f^2) equals the CPU twin on painted hair.
+#[test]
+fn gpu_forward_scattering_equals_the_cpu_march() {
+    use glam::Vec3;
+    use strandlight::gpu::density_pyramid::{DensityPyramidPass, GpuDensityPyramid};
+    use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
+    use strandlight::gpu::forward::{ForwardQuery, evaluate_forward, upload_forward_table};
+    use strandlight::hair::procedural::{Style, StyleParams, generate};
+    use strandlight::scattering::{CausticModel, FresnelModel, ModelVariant};
+    use strandlight::shadow::FiberDensity;
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::forward::{ForwardTable, forward_scattering};
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env())
+        .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
+    let hair = generate(&StyleParams::new(Style::StraightLong, 3000, 20, 6)).expect("generate");
+    // Dyed tips: absorption grows from root to tip in green and blue.
+    let sigma: Vec<[f32; 3]> = hair
+        .root_to_tip()
+        .iter()
+        .map(|&t| [0.2, 0.3 + 1.5 * t, 0.5 + 2.0 * t])
+        .collect();
+    let variant = ModelVariant {
+        fresnel: FresnelModel::XuSchlick,
+        caustic: CausticModel::None,
+    };
+    let table = ForwardTable::build(&HairParams::default(), variant);
+    let voxel = 0.4;
+    let cpu_volume = FiberDensity::build(&hair, &sigma, voxel);
+    let grid = VolumeGrid::around(&hair, voxel);
+    let gpu_hair = GpuHair::new(&ctx.device, &hair, &sigma);
+    let volume = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
+    let pyramid = GpuDensityPyramid::new(&ctx.device, &volume);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume);
+    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid);
+    ctx.queue.submit([enc.finish()]);
+    let table_buffer = upload_forward_table(&ctx.device, &table);
+    let mut rng = rand_pcg::Pcg64::new(13, 0x0a02_bdbf_7bb3_c0a7);
+    let mut u = move || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    let queries: Vec<ForwardQuery> = (0..512)
+        .map(|k| {
+            let p = hair.positions[(k * 131) % hair.point_count()];
+            let z = 2.0 * u() - 1.0;
+            let a = std::f32::consts::TAU * u();
+            let r = (1.0 - z * z).sqrt();
+            ForwardQuery {
+                p: p.to_array(),
+                skip: 0.01,
+                omega: [r * a.cos(), z, r * a.sin()],
+                _pad: 0.0,
+            }
+        })
+        .collect();
+    let gpu = evaluate_forward(&ctx, &pyramid, &volume, &table_buffer, &queries).expect("GPU");
+    let (mut worst_t, mut worst_s, mut lo) = (0f32, 0f32, 1f32);
+    for (q, g) in queries.iter().zip(&gpu) {
+        let c = forward_scattering(
+            &cpu_volume,
+            &table,
+            Vec3::from(q.p),
+            Vec3::from(q.omega),
+            q.skip,
+        );
+        worst_t = worst_t.max((c.direct_fraction - g.direct_fraction).abs());
+        lo = lo.min(c.transmittance_f[2]);
+        for ch in 0..3 {
+            worst_t = worst_t.max((c.transmittance_f[ch] - g.transmittance_f[ch]).abs());
+            if c.direct_fraction < 0.99 {
+                worst_s =
+                    worst_s.max((c.sigma_f2[ch] - g.sigma_f2[ch]).abs() / c.sigma_f2[ch].max(1e-6));
+            }
+        }
+    }
+    println!(
+        "{} queries (T_f blue down to {lo:.3}): worst |GPU - CPU| of T_f and direct fraction {worst_t:.2e}, sigma_f^2 relative {worst_s:.2e}",
+        queries.len()
+    );
+    assert!(lo < 0.3, "the queries include shadowed paths");
+    assert!(worst_t < 2e-3 && worst_s < 5e-3, "{worst_t} {worst_s}");
 }

@@ -4,6 +4,7 @@ pub mod context;
 pub mod density_pyramid;
 pub mod fast_eval;
 pub mod fiber_density;
+pub mod forward;
 pub mod shaders;
 
 pub use context::{GpuContext, GpuError, GpuOptions};

@@ -10,6 +10,19 @@ pub const FAST_EVAL: &str = include_str!("../../shaders/fast_eval.wgsl");
 pub const DENSITY_PYRAMID: &str = include_str!("../../shaders/density_pyramid.wgsl");
 pub const DENSITY_DOWNSAMPLE: &str = include_str!("../../shaders/density_downsample.wgsl");
 pub const TRANSMITTANCE_EVAL: &str = include_str!("../../shaders/transmittance_eval.wgsl");
+pub const FORWARD_SCATTERING: &str = include_str!("../../shaders/forward_scattering.wgsl");
+pub const FORWARD_EVAL: &str = include_str!("../../shaders/forward_eval.wgsl");
+
+/// The forward-scattering test harness (constants, cone marching for the crossings, the march).
+pub fn forward_eval_module() -> String {
+    [
+        CIRCULAR_GAUSSIAN,
+        DENSITY_PYRAMID,
+        FORWARD_SCATTERING,
+        FORWARD_EVAL,
+    ]
+    .join("\n")
+}
 
 /// The transmittance test harness: constants, cone marching, bindings and entry point. The
 /// including module declares `pyramid_info` and `pyramid`.
@@ -43,5 +56,6 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ),
         ("density_downsample", DENSITY_DOWNSAMPLE.to_string()),
         ("transmittance_eval", transmittance_eval_module()),
+        ("forward_eval", forward_eval_module()),
     ]
 }

@@ -1,0 +1,98 @@
+// Forward scattering along a shadow path from the fiber-density volume: the direct fraction,
+// T_f = E[prod a_f] and sigma_f^2, with the crossed fibers' own absorption. Twin of
+// src/shadow/forward.rs. Reads the pyramid (level 0, for the trilinear crossings), the volume
+// (nearest voxel's tensor and absorption) and the (theta, sigma_a) table of a_f and beta_f^2.
+// Bindings declared by the including module: pyramid_info, pyramid, volume_info, volume, forward_table.
+
+const FWD_THETA_SAMPLES: u32 = 64u;
+const FWD_SIGMA_SAMPLES: u32 = 33u;
+const FWD_SIGMA_MIN: f32 = 0.005;
+const FWD_SIGMA_MAX: f32 = 50.0;
+
+struct ForwardScattering {
+    direct_fraction: f32,
+    transmittance_f: vec3<f32>,
+    sigma_f2: vec3<f32>,
+}
+
+fn forward_sigma_pos(s: f32) -> f32 {
+    if (s <= FWD_SIGMA_MIN) {
+        return max(s / FWD_SIGMA_MIN, 0.0);
+    }
+    return 1.0 + log(s / FWD_SIGMA_MIN) / log(FWD_SIGMA_MAX / FWD_SIGMA_MIN) * f32(FWD_SIGMA_SAMPLES - 2u);
+}
+
+// (a_f, beta_f^2) at (theta, sigma_a), bilinear; the table holds (a_f, beta_f^2) pairs, theta fastest.
+fn forward_lookup(theta: f32, sigma_a: f32) -> vec2<f32> {
+    let x = clamp((theta + FRAC_PI_2) / PI, 0.0, 1.0) * f32(FWD_THETA_SAMPLES - 1u);
+    let y = clamp(forward_sigma_pos(sigma_a), 0.0, f32(FWD_SIGMA_SAMPLES - 1u));
+    let i = min(u32(x), FWD_THETA_SAMPLES - 2u);
+    let j = min(u32(y), FWD_SIGMA_SAMPLES - 2u);
+    let wx = x - f32(i);
+    let wy = y - f32(j);
+    let v00 = forward_table[j * FWD_THETA_SAMPLES + i];
+    let v10 = forward_table[j * FWD_THETA_SAMPLES + i + 1u];
+    let v01 = forward_table[(j + 1u) * FWD_THETA_SAMPLES + i];
+    let v11 = forward_table[(j + 1u) * FWD_THETA_SAMPLES + i + 1u];
+    return mix(mix(v00, v10, wx), mix(v01, v11, wx), wy);
+}
+
+fn forward_voxel_at(p: vec3<f32>) -> i32 {
+    let q = floor((p - volume_info.origin) / volume_info.voxel);
+    if (any(q < vec3<f32>(0.0)) || any(q >= vec3<f32>(volume_info.dims))) {
+        return -1;
+    }
+    let i = vec3<u32>(q);
+    return i32((i.z * volume_info.dims.y + i.y) * volume_info.dims.x + i.x);
+}
+
+fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, skip: f32) -> ForwardScattering {
+    let h0 = 0.5 * volume_info.voxel;
+    let hi = volume_info.origin + volume_info.voxel * vec3<f32>(volume_info.dims);
+    var exit = 3.0e38;
+    for (var ax = 0; ax < 3; ax++) {
+        let w = omega[ax];
+        if (abs(w) > 1e-12) {
+            exit = min(exit, select((volume_info.origin[ax] - p[ax]) / w, (hi[ax] - p[ax]) / w, w > 0.0));
+        }
+    }
+    var tau = 0.0;
+    var loss = vec3<f32>(0.0);
+    var spread = vec3<f32>(0.0);
+    if (exit < 1.0e38 && exit > skip) {
+        let steps = u32(ceil((exit - skip) / h0));
+        let h = (exit - skip) / f32(steps);
+        for (var k = 0u; k < steps; k++) {
+            let x = p + omega * (skip + (f32(k) + 0.5) * h);
+            let v = forward_voxel_at(x);
+            if (v < 0) {
+                continue;
+            }
+            let c = crossings_at(x, omega, 0.0);
+            if (c <= 0.0) {
+                continue;
+            }
+            let x0 = volume[3 * v];
+            let x1 = volume[3 * v + 1];
+            let sig = volume[3 * v + 2].xyz;
+            let a = max(x0.x, 1e-30);
+            let w = omega;
+            let q = (dot(x0.yzw, w * w) + 2.0 * (x1.x * w.x * w.y + x1.y * w.x * w.z + x1.z * w.y * w.z)) / a;
+            let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
+            tau = tau + c * h;
+            for (var ch = 0u; ch < 3u; ch++) {
+                let f1 = forward_lookup(theta, sig[ch]);
+                let f2 = forward_lookup(-theta, sig[ch]);
+                loss[ch] = loss[ch] + c * h * (1.0 - 0.5 * (f1.x + f2.x));
+                spread[ch] = spread[ch] + c * h * 0.5 * (f1.y + f2.y);
+            }
+        }
+    }
+    let direct = exp(-tau);
+    let scattered = max(1.0 - direct, 1e-12);
+    var out: ForwardScattering;
+    out.direct_fraction = direct;
+    out.transmittance_f = exp(-loss);
+    out.sigma_f2 = select(vec3<f32>(0.0), spread / scattered, tau > 0.0);
+    return out;
+}

@@ -1,0 +1,103 @@
+//! Forward scattering along shadow paths on the GPU (`shaders/forward_scattering.wgsl`), the twin of
+//! [`crate::shadow::forward`]: the (theta, sigma_a) table as a storage buffer and a batch evaluator for
+//! the tests.
+
+use super::context::{GpuContext, compute_pipeline};
+use super::density_pyramid::GpuDensityPyramid;
+use super::fiber_density::GpuFiberDensity;
+use super::shaders;
+use crate::shadow::forward::{ForwardScattering, ForwardTable};
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// One query: point, skipped distance, direction towards the light.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ForwardQuery {
+    pub p: [f32; 3],
+    pub skip: f32,
+    pub omega: [f32; 3],
+    pub _pad: f32,
+}
+
+const _: () = assert!(std::mem::size_of::<ForwardQuery>() == 32);
+
+/// The table as (a_f, beta_f^2) pairs, theta fastest (rebuilt when eta, alpha or beta change).
+pub fn upload_forward_table(device: &wgpu::Device, table: &ForwardTable) -> wgpu::Buffer {
+    let pairs: Vec<[f32; 2]> = table
+        .a_f
+        .iter()
+        .zip(&table.beta_f2)
+        .map(|(a, b)| [*a, *b])
+        .collect();
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("forward table"),
+        contents: bytemuck::cast_slice(&pairs),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+/// Evaluates `forward_scattering` for a batch of queries (tests).
+pub fn evaluate_forward(
+    ctx: &GpuContext,
+    pyramid: &GpuDensityPyramid,
+    volume: &GpuFiberDensity,
+    table: &wgpu::Buffer,
+    queries: &[ForwardQuery],
+) -> Result<Vec<ForwardScattering>, String> {
+    let device = &ctx.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("forward_eval"),
+        source: wgpu::ShaderSource::Wgsl(shaders::forward_eval_module().into()),
+    });
+    let pipeline = compute_pipeline(device, &module, "main");
+    let q = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("forward queries"),
+        contents: bytemuck::cast_slice(queries),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let results = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("forward results"),
+        size: (queries.len().max(1) * 32) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let entries = [
+        &pyramid.info_buffer,
+        &pyramid.pyramid,
+        &volume.info,
+        &volume.volume,
+        table,
+        &q,
+        &results,
+    ];
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("forward_eval"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
+    }
+    ctx.queue.submit([enc.finish()]);
+    let v: Vec<[f32; 4]> = ctx.read_buffer(&results)?;
+    Ok((0..queries.len())
+        .map(|i| ForwardScattering {
+            direct_fraction: v[2 * i][3],
+            transmittance_f: [v[2 * i][0], v[2 * i][1], v[2 * i][2]],
+            sigma_f2: [v[2 * i + 1][0], v[2 * i + 1][1], v[2 * i + 1][2]],
+        })
+        .collect())
+}
