@@ -127,6 +127,61 @@ impl GpuContext {
     }
 }
 
+impl GpuContext {
+    /// Runs a batch kernel: `inputs` bound at bindings 0.. of group 0, then the `queries` (a storage
+    /// buffer), then a results buffer of `per_query` values of R for each query; one invocation per
+    /// query in workgroups of 64; returns the results read back.
+    pub fn run_batch<Q: bytemuck::Pod, R: bytemuck::Pod>(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        inputs: &[&wgpu::Buffer],
+        queries: &[Q],
+        per_query: usize,
+    ) -> Result<Vec<R>, String> {
+        use wgpu::util::DeviceExt;
+        if queries.is_empty() {
+            return Ok(Vec::new());
+        }
+        let q = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("batch queries"),
+                contents: bytemuck::cast_slice(queries),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let size = (queries.len() * per_query * std::mem::size_of::<R>()) as u64;
+        let results = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("batch results"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let buffers: Vec<&wgpu::Buffer> = inputs.iter().copied().chain([&q, &results]).collect();
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("batch"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
+        }
+        self.queue.submit([enc.finish()]);
+        self.read_buffer(&results)
+    }
+}
+
 /// A compute pipeline for one entry point of `module`, with the layout derived from the shader.
 pub fn compute_pipeline(
     device: &wgpu::Device,

@@ -191,49 +191,10 @@ pub fn evaluate_transmittance(
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let pipeline = compute_pipeline(device, &module, "main");
-    let q = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("transmittance queries"),
-        contents: bytemuck::cast_slice(queries),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (queries.len() * 4).max(4) as u64;
-    let results = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("transmittance results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("transmittance_eval"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: pyramid.info_buffer.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: pyramid.pyramid.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: q.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: results.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
-    }
-    ctx.queue.submit([enc.finish()]);
-    let mut v: Vec<f32> = ctx.read_buffer(&results)?;
-    v.truncate(queries.len());
-    Ok(v)
+    ctx.run_batch(
+        &pipeline,
+        &[&pyramid.info_buffer, &pyramid.pyramid],
+        queries,
+        1,
+    )
 }

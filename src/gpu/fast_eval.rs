@@ -71,57 +71,12 @@ impl FastEvalPipeline {
         luts: &GpuLuts,
         queries: &[FastQuery],
     ) -> Result<Vec<[[f32; 3]; 3]>, String> {
-        if queries.is_empty() {
-            return Ok(Vec::new());
-        }
-        let device = &ctx.device;
-        let q = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fast_eval queries"),
-            contents: bytemuck::cast_slice(queries),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let size = (queries.len() * 3 * 16) as u64;
-        let results = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fast_eval results"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fast_eval"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: luts.c.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: luts.h_tt.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: luts.h_trt.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: q.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: results.as_entire_binding(),
-                },
-            ],
-        });
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
-        }
-        ctx.queue.submit([enc.finish()]);
-        let v: Vec<[f32; 4]> = ctx.read_buffer(&results)?;
+        let v: Vec<[f32; 4]> = ctx.run_batch(
+            &self.pipeline,
+            &[&luts.c, &luts.h_tt, &luts.h_trt],
+            queries,
+            3,
+        )?;
         Ok((0..queries.len())
             .map(|i| std::array::from_fn(|t| [v[3 * i + t][0], v[3 * i + t][1], v[3 * i + t][2]]))
             .collect())

@@ -51,48 +51,18 @@ pub fn evaluate_forward(
         source: wgpu::ShaderSource::Wgsl(shaders::forward_eval_module().into()),
     });
     let pipeline = compute_pipeline(device, &module, "main");
-    let q = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("forward queries"),
-        contents: bytemuck::cast_slice(queries),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let results = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("forward results"),
-        size: (queries.len().max(1) * 32) as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let entries = [
-        &pyramid.info_buffer,
-        &pyramid.pyramid,
-        &volume.info,
-        &volume.volume,
-        table,
-        &q,
-        &results,
-    ];
-    let entries: Vec<wgpu::BindGroupEntry> = entries
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("forward_eval"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(queries.len().div_ceil(64) as u32, 1, 1);
-    }
-    ctx.queue.submit([enc.finish()]);
-    let v: Vec<[f32; 4]> = ctx.read_buffer(&results)?;
+    let v: Vec<[f32; 4]> = ctx.run_batch(
+        &pipeline,
+        &[
+            &pyramid.info_buffer,
+            &pyramid.pyramid,
+            &volume.info,
+            &volume.volume,
+            table,
+        ],
+        queries,
+        2,
+    )?;
     Ok((0..queries.len())
         .map(|i| ForwardScattering {
             direct_fraction: v[2 * i][3],
