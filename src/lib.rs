@@ -7,5 +7,6 @@
 pub mod envmap;
 pub mod gpu;
 pub mod hair;
+pub mod render;
 pub mod scattering;
 pub mod shadow;

@@ -13,7 +13,7 @@ use strandlight::scattering::lut::Luts;
 
 #[test]
 fn every_wgsl_module_validates_and_struct_layouts_match() {
-    let mut layouts = 0;
+    let mut seen = std::collections::BTreeSet::new();
     for (name, source) in shaders::modules() {
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
@@ -47,9 +47,17 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 Some("TransmittanceQuery") => {
                     std::mem::size_of::<strandlight::gpu::density_pyramid::TransmittanceQuery>()
                 }
+                Some("Camera") => std::mem::size_of::<strandlight::render::camera::CameraUniform>(),
+                Some("GpuLight") => std::mem::size_of::<strandlight::render::shading::GpuLight>(),
+                Some("ShadeBatch") => {
+                    std::mem::size_of::<strandlight::render::shading::ShadeBatch>()
+                }
+                Some("ResolveInfo") => {
+                    std::mem::size_of::<strandlight::render::resolve::ResolveInfo>()
+                }
                 _ => continue,
             };
-            layouts += 1;
+            seen.insert(ty.name.clone().unwrap_or_default());
             assert_eq!(
                 layouter[handle].size as usize, expected,
                 "{name}: WGSL {:?} vs Rust",
@@ -58,7 +66,8 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         }
         println!("{name}: {} lines valid", source.lines().count());
     }
-    assert_eq!(layouts, 10, "every shared struct was found and compared");
+    println!("struct layouts compared: {seen:?}");
+    assert_eq!(seen.len(), 12, "every shared struct was found and compared");
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {
@@ -183,7 +192,7 @@ fn gpu_fiber_density_equals_the_cpu_volume() {
     let target = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
     let pass = FiberDensityPass::new(&ctx.device);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
-    pass.encode(&ctx.device, &mut enc, &gpu_hair, &target);
+    pass.encode(&ctx.device, &mut enc, &gpu_hair, &target, None);
     ctx.queue.submit([enc.finish()]);
     let gpu = target.read(&ctx).expect("read the volume");
     assert_eq!(gpu.len(), cpu.extinction.len());
@@ -253,8 +262,8 @@ fn gpu_srbf_transmittance_equals_the_cpu_cone_march() {
     let pyramid = GpuDensityPyramid::new(&ctx.device, &volume);
     assert_eq!(pyramid.info.count as usize, cpu.levels.len());
     let mut enc = ctx.device.create_command_encoder(&Default::default());
-    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume);
-    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid);
+    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume, None);
+    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid, None);
     ctx.queue.submit([enc.finish()]);
     // Queries: points on strands, lights all round, narrow to wide.
     let mut rng = rand_pcg::Pcg64::new(8, 0x0a02_bdbf_7bb3_c0a7);
@@ -327,8 +336,8 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
     let volume = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
     let pyramid = GpuDensityPyramid::new(&ctx.device, &volume);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
-    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume);
-    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid);
+    FiberDensityPass::new(&ctx.device).encode(&ctx.device, &mut enc, &gpu_hair, &volume, None);
+    DensityPyramidPass::new(&ctx.device).encode(&ctx.device, &mut enc, &volume, &pyramid, None);
     ctx.queue.submit([enc.finish()]);
     let table_buffer = upload_forward_table(&ctx.device, &table);
     let mut rng = rand_pcg::Pcg64::new(13, 0x0a02_bdbf_7bb3_c0a7);

@@ -1,5 +1,6 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
+pub mod bench;
 pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;
@@ -10,6 +11,7 @@ pub mod make_env;
 pub mod make_hair;
 pub mod params_args;
 pub mod precompute;
+pub mod render;
 pub mod srbf_response;
 
 use clap::{Parser, Subcommand};
@@ -42,6 +44,10 @@ pub enum Command {
     SrbfResponse(Box<srbf_response::SrbfResponseArgs>),
     /// Benchmark the LUT build, the dual-scattering tables and the 40-light fast response (CPU, JSON).
     BenchFast(bench_fast::BenchFastArgs),
+    /// Render a still (linear EXR, PNG preview) of a hairstyle under an environment on the GPU.
+    Render(Box<render::RenderArgs>),
+    /// Benchmark the renderer on the standard scenes S1-S3: GPU time per pass (JSON).
+    Bench(bench::BenchArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -61,6 +67,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Precompute(args)) => precompute::run(args),
         Some(Command::SrbfResponse(args)) => srbf_response::run(*args),
         Some(Command::BenchFast(args)) => bench_fast::run(args),
+        Some(Command::Render(args)) => render::run(*args),
+        Some(Command::Bench(args)) => bench::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => {
             // The editor will open here once it exists; until then, say what there is.

@@ -141,10 +141,11 @@ impl DensityPyramidPass {
         encoder: &mut wgpu::CommandEncoder,
         volume: &GpuFiberDensity,
         target: &GpuDensityPyramid,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("density pyramid"),
-            timestamp_writes: None,
+            timestamp_writes: timestamps,
         });
         for l in 0..target.info.count as usize {
             let pipeline = if l == 0 { &self.copy } else { &self.downsample };

@@ -141,6 +141,7 @@ impl FiberDensityPass {
         encoder: &mut wgpu::CommandEncoder,
         hair: &GpuHair,
         target: &GpuFiberDensity,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         encoder.clear_buffer(&target.sums, 0, None);
         let bind = |pipeline: &wgpu::ComputePipeline, with_inputs: bool| {
@@ -182,7 +183,7 @@ impl FiberDensityPass {
         let (deposit_bind, resolve_bind) = (bind(&self.deposit, true), bind(&self.resolve, false));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("fiber density"),
-            timestamp_writes: None,
+            timestamp_writes: timestamps,
         });
         pass.set_pipeline(&self.deposit);
         pass.set_bind_group(0, &deposit_bind, &[]);

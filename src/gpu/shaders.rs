@@ -12,6 +12,31 @@ pub const DENSITY_DOWNSAMPLE: &str = include_str!("../../shaders/density_downsam
 pub const TRANSMITTANCE_EVAL: &str = include_str!("../../shaders/transmittance_eval.wgsl");
 pub const FORWARD_SCATTERING: &str = include_str!("../../shaders/forward_scattering.wgsl");
 pub const FORWARD_EVAL: &str = include_str!("../../shaders/forward_eval.wgsl");
+pub const CAMERA: &str = include_str!("../../shaders/camera.wgsl");
+pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
+pub const SHADING: &str = include_str!("../../shaders/shading.wgsl");
+pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
+
+/// The visibility pass (ribbons into the multisampled id target).
+pub fn visibility_module() -> String {
+    [CIRCULAR_GAUSSIAN, CAMERA, VISIBILITY].join("\n")
+}
+
+/// The shading pass: the fast model, cone-marched transmittance, camera, and the kernel.
+pub fn shading_module() -> String {
+    [
+        fast_model_library().as_str(),
+        DENSITY_PYRAMID,
+        CAMERA,
+        SHADING,
+    ]
+    .join("\n")
+}
+
+/// The resolve pass.
+pub fn resolve_module() -> String {
+    [CIRCULAR_GAUSSIAN, CAMERA, RESOLVE].join("\n")
+}
 
 /// The forward-scattering test harness (constants, cone marching for the crossings, the march).
 pub fn forward_eval_module() -> String {
@@ -57,5 +82,8 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ("density_downsample", DENSITY_DOWNSAMPLE.to_string()),
         ("transmittance_eval", transmittance_eval_module()),
         ("forward_eval", forward_eval_module()),
+        ("visibility", visibility_module()),
+        ("shading", shading_module()),
+        ("resolve", resolve_module()),
     ]
 }

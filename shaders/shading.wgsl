@@ -1,0 +1,122 @@
+// Shading pass (Xu 2011 Sec. 5): for every pixel, the distinct hair segments among its visibility
+// samples are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
+// each light scaled by its transmittance through the fiber-density pyramid, and accumulated per lobe
+// weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
+// Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response,
+// density_pyramid, camera.
+
+const FLAG_SHADOWS: u32 = 1u;
+
+struct GpuLight {
+    direction: vec3<f32>,
+    lambda: f32,
+    rgb: vec3<f32>,
+    _pad: f32,
+}
+
+struct ShadeBatch {
+    first: u32,
+    count: u32,
+    flags: u32,
+    samples: u32,
+    skip: f32,
+    slot: u32,
+    _p1: f32,
+    _p2: f32,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var<uniform> params: FastHairParams;
+@group(0) @binding(2) var<uniform> batch: ShadeBatch;
+@group(0) @binding(3) var<uniform> pyramid_info: PyramidInfo;
+@group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> segments: array<u32>;
+@group(0) @binding(6) var<storage, read> absorption: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> lights: array<GpuLight>;
+@group(0) @binding(8) var<storage, read> lut_c: array<f32>;
+@group(0) @binding(9) var<storage, read> lut_h_tt: array<f32>;
+@group(0) @binding(10) var<storage, read> lut_h_trt: array<f32>;
+@group(0) @binding(11) var<storage, read> pyramid: array<vec4<f32>>;
+@group(0) @binding(12) var visibility: texture_multisampled_2d<f32>;
+@group(0) @binding(13) var<storage, read_write> aov_r: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> aov_tt: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read_write> aov_trt: array<vec4<f32>>;
+
+struct ShadingPoint {
+    position: vec3<f32>,
+    tangent: vec3<f32>,
+    sigma_a: vec3<f32>,
+}
+
+// The point of segment `seg` seen along the ray, its tangent and its absorption (linear along the segment).
+fn shading_point(seg: u32, ray: Ray) -> ShadingPoint {
+    let i0 = segments[seg];
+    let a = points[i0].xyz;
+    let b = points[i0 + 1u].xyz;
+    let t = closest_on_segment(ray.origin, ray.dir, a, b);
+    let s = mix(absorption[i0].xyz, absorption[i0 + 1u].xyz, t);
+    return ShadingPoint(mix(a, b, t), b - a, s);
+}
+
+struct LobeRadiance {
+    r: vec3<f32>,
+    tt: vec3<f32>,
+    trt: vec3<f32>,
+}
+
+// Radiance towards omega_o from lights [first, first + count) at one shading point, per lobe.
+fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool, skip: f32) -> LobeRadiance {
+    var p = params;
+    p.sigma_a = vec4<f32>(sp.sigma_a, 0.0);
+    let frame = fiber_frame(sp.tangent);
+    let o = fiber_angles(frame, omega_o);
+    var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var j = first; j < first + count; j++) {
+        let l = lights[j];
+        let ang = fiber_angles(frame, l.direction);
+        var vis = 1.0;
+        if (shadows) {
+            vis = srbf_transmittance(sp.position, l.direction, l.lambda, skip);
+        }
+        let light = SrbfInFrame(ang.x, ang.y, l.lambda);
+        let k = vis * l.rgb;
+        out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
+        out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
+        out.trt = out.trt + k * srbf_response_lobe(p, 2u, light, o.x, o.y);
+    }
+    return out;
+}
+
+@compute @workgroup_size(8, 8)
+fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= camera.size.x || id.y >= camera.size.y) {
+        return;
+    }
+    let pixel = id.y * camera.size.x + id.x;
+    // This dispatch handles visibility sample `batch.slot` of every pixel: its segment is shaded if no
+    // earlier sample of the pixel holds the same segment, weighted by the fraction of samples it
+    // covers. (One shading call per invocation: looping over a pixel's segments inside one invocation
+    // gave wrong sums on lavapipe.)
+    let v = u32(textureLoad(visibility, vec2<i32>(id.xy), i32(batch.slot)).x);
+    if (v == 0u) {
+        return;
+    }
+    var count = 0u;
+    for (var s = 0u; s < batch.samples; s++) {
+        let other = u32(textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x);
+        if (other == v) {
+            if (s < batch.slot) {
+                return;
+            }
+            count = count + 1u;
+        }
+    }
+    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
+    let sp = shading_point(v - 1u, ray);
+    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, batch.skip);
+    let w = f32(count) / f32(batch.samples);
+    let acc = LobeRadiance(w * l.r, w * l.tt, w * l.trt);
+    aov_r[pixel] = aov_r[pixel] + vec4<f32>(acc.r, 0.0);
+    aov_tt[pixel] = aov_tt[pixel] + vec4<f32>(acc.tt, 0.0);
+    aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(acc.trt, 0.0);
+}

@@ -1,0 +1,215 @@
+//! `strandlight render`: a still of a hairstyle under an environment, as linear EXR (and a PNG preview).
+
+use super::params_args::ParamArgs;
+use anyhow::{Context, bail};
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+use strandlight::gpu::{GpuContext, GpuOptions};
+use strandlight::hair::load::{LoadOptions, load_hair};
+use strandlight::hair::procedural::Style;
+use strandlight::render::camera::CAMERA_PRESETS;
+use strandlight::render::scene::{
+    Environment, default_environment, generated_hair, load_environment,
+};
+use strandlight::render::{Camera, RenderSettings, Renderer};
+use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
+use strandlight::scattering::lut::Luts;
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Hair file (.hair, .tfx, .gltf, .glb); default: a generated wavy hairstyle (10k strands).
+    #[arg(long)]
+    pub hair: Option<PathBuf>,
+    /// Style of the generated hair (when no --hair is given).
+    #[arg(long, value_enum, conflicts_with = "hair")]
+    pub style: Option<Style>,
+    /// Strands of the generated style.
+    #[arg(long, default_value_t = 10_000)]
+    pub strands: usize,
+    /// Points per generated strand.
+    #[arg(long, default_value_t = 27)]
+    pub points: usize,
+    /// Environment: .srbf.json, or .hdr / .exr (fitted, cached); default: the built-in sunny sky.
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// SRBF lights fitted to an .hdr / .exr environment.
+    #[arg(long, default_value_t = 40)]
+    pub lights: usize,
+    /// Turn the environment about +Y (degrees).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub env_yaw: f64,
+    #[command(flatten)]
+    pub params: ParamArgs,
+    /// Camera preset: front, three-quarter, side, back, back-three-quarter, top.
+    #[arg(long, default_value = "three-quarter")]
+    pub camera: String,
+    /// Orbit yaw in degrees (overrides the preset's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub yaw: Option<f32>,
+    /// Orbit pitch in degrees (overrides the preset's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub pitch: Option<f32>,
+    /// Camera distance to the hair's centre in cm (default: frame the hair).
+    #[arg(long)]
+    pub distance: Option<f32>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 30.0)]
+    pub fov: f32,
+    #[arg(long, default_value_t = 720)]
+    pub width: u32,
+    #[arg(long, default_value_t = 480)]
+    pub height: u32,
+    /// Visibility samples per pixel (MSAA: 2 or 4).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// No self-shadowing.
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// SRBF lights per shading pass (1..=16).
+    #[arg(long, default_value_t = 16)]
+    pub lights_per_pass: u32,
+    /// Voxels along the hair's longest side (fiber-density volume).
+    #[arg(long, default_value_t = 128)]
+    pub volume_resolution: u32,
+    /// Linear float EXR (RGBA, alpha = coverage).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Add AOV layers to the EXR: Z and the components R, TT, TRT, MS.global, MS.local.
+    #[arg(long)]
+    pub aovs: bool,
+    /// Tonemapped PNG preview.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Use a software adapter (lavapipe).
+    #[arg(long)]
+    pub software: bool,
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    if args.output.is_none() && args.png.is_none() {
+        bail!("nothing to write: give -o still.exr and/or --png preview.png");
+    }
+    let params = args.params.resolve()?;
+    let (hair, hair_name) = match &args.hair {
+        Some(path) => {
+            let loaded = load_hair(path, &LoadOptions::default())?;
+            (loaded.file.hair, path.display().to_string())
+        }
+        None => {
+            let style = args.style.unwrap_or(Style::Wavy);
+            (
+                generated_hair(style, args.strands, args.points, 1),
+                format!("generated {style:?} {}x{}", args.strands, args.points),
+            )
+        }
+    };
+    if hair.strand_count() == 0 {
+        bail!("{hair_name}: no strands to render");
+    }
+    let mut env: Environment = match &args.env {
+        Some(p) => load_environment(p, args.lights)
+            .with_context(|| format!("loading the environment {}", p.display()))?,
+        None => default_environment(),
+    };
+    if args.env_yaw != 0.0 {
+        env.lights = env.lights.rotated(args.env_yaw.to_radians());
+    }
+    let (preset_yaw, preset_pitch) = Camera::preset(&args.camera).with_context(|| {
+        let names: Vec<&str> = CAMERA_PRESETS.iter().map(|p| p.0).collect();
+        format!(
+            "unknown camera preset '{}' (one of {})",
+            args.camera,
+            names.join(", ")
+        )
+    })?;
+    let (lo, hi) = hair.bounds();
+    let aspect = args.width as f32 / args.height.max(1) as f32;
+    let mut camera = Camera::framing(
+        lo,
+        hi,
+        args.yaw.unwrap_or(preset_yaw),
+        args.pitch.unwrap_or(preset_pitch),
+        aspect,
+        0.9,
+    );
+    if !(args.fov > 1.0 && args.fov < 170.0) {
+        bail!("--fov must lie in (1, 170) degrees");
+    }
+    camera.fov_y = args.fov;
+    if let Some(d) = args.distance {
+        if !(d > 0.0 && d.is_finite()) {
+            bail!("--distance must be positive");
+        }
+        camera.distance = d;
+    }
+    let settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        samples: args.samples,
+        exposure: args.exposure,
+        shadows: !args.no_shadows,
+        lights_per_pass: args.lights_per_pass,
+        volume_resolution: args.volume_resolution,
+        ..Default::default()
+    };
+    let mut options = GpuOptions::from_env();
+    options.force_software |= args.software;
+    let ctx = GpuContext::new_headless(&options)?;
+    eprintln!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
+    let luts = Luts::default_tables();
+    let fast = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS);
+    let sigma_a = vec![fast.sigma_a_rgb(); hair.point_count()];
+    let t = Instant::now();
+    let mut renderer = Renderer::new(
+        &ctx,
+        settings.clone(),
+        &luts,
+        &hair,
+        &sigma_a,
+        &fast,
+        &env.lights.lights,
+        &camera,
+    )?;
+    renderer.render_frame(&ctx);
+    let frame = renderer.read_frame(&ctx)?;
+    if let Some(times) = renderer.pass_times(&ctx)? {
+        let list: Vec<String> = times
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.2} ms"))
+            .collect();
+        eprintln!("GPU time per pass: {}", list.join(", "));
+    }
+    eprintln!(
+        "rendered {}x{} ({} strands, {} lights) in {:.2} s",
+        args.width,
+        args.height,
+        hair.strand_count(),
+        env.lights.lights.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let attributes = vec![
+        ("hair".to_string(), hair_name),
+        ("environment".to_string(), env.name.clone()),
+        ("lights".to_string(), env.lights.lights.len().to_string()),
+        ("params".to_string(), serde_json::to_string(&params)?),
+        ("camera".to_string(), serde_json::to_string(&camera)?),
+        ("exposure_ev".to_string(), args.exposure.to_string()),
+        ("samples".to_string(), args.samples.to_string()),
+        ("shadows".to_string(), (!args.no_shadows).to_string()),
+        ("adapter".to_string(), ctx.summary.name.clone()),
+        ("mode".to_string(), "srbf".to_string()),
+    ];
+    if let Some(o) = &args.output {
+        frame.write_exr(o, &attributes, args.aovs)?;
+        eprintln!("wrote {}", o.display());
+    }
+    if let Some(p) = &args.png {
+        frame.write_png(p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}

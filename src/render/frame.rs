@@ -1,0 +1,165 @@
+//! A rendered frame read back from the GPU, and its files: linear float EXR (RGBA, alpha = coverage,
+//! optionally with AOV layers R, TT, TRT, MS.global, MS.local and depth Z), with the render's
+//! parameters as header attributes; a tonemapped PNG preview (ACES filmic, sRGB), never used for the EXR.
+
+use super::targets::COMPONENTS;
+use std::path::Path;
+
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    /// Linear RGB times 2^EV, premultiplied by coverage; alpha = covered samples / samples.
+    pub beauty: Vec<[f32; 4]>,
+    /// Distance along the view axis of the nearest hair sample (1e10 where there is none).
+    pub depth: Vec<f32>,
+    /// Segment index + 1 per visibility sample (0 = no hair); only the first four samples.
+    pub sample_ids: Vec<[u32; 4]>,
+    /// R, TT, TRT, MS.global, MS.local, with the same exposure as the beauty; they add up to it.
+    pub components: Vec<Vec<[f32; 3]>>,
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct OutputError {
+    pub path: String,
+    pub message: String,
+}
+
+fn out_err(path: &Path, message: impl std::fmt::Display) -> OutputError {
+    OutputError {
+        path: path.display().to_string(),
+        message: message.to_string(),
+    }
+}
+
+/// Attributes written into the EXR header (name, value); non-Latin-1 characters become '?'.
+pub type Attributes = Vec<(String, String)>;
+
+fn exr_text(s: &str) -> exr::prelude::Text {
+    let latin: String = s
+        .chars()
+        .map(|c| if (c as u32) < 256 { c } else { '?' })
+        .collect();
+    exr::prelude::Text::new_or_none(&latin).unwrap_or_else(|| exr::prelude::Text::from("?"))
+}
+
+impl Frame {
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Pixels with any coverage.
+    pub fn covered(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.pixel_count()).filter(|&i| self.beauty[i][3] > 0.0)
+    }
+
+    /// The same coverage and depth with other shading: `radiance[k]` (R, TT, TRT, before exposure) for
+    /// pixel `pixels[k]`, every other pixel and the multiple-scattering components zero.
+    pub fn with_lobes(
+        &self,
+        pixels: &[usize],
+        radiance: &[[[f32; 3]; 3]],
+        exposure_scale: f32,
+    ) -> Frame {
+        let n = self.pixel_count();
+        let mut out = self.clone();
+        out.components = vec![vec![[0.0; 3]; n]; COMPONENTS.len()];
+        for px in out.beauty.iter_mut() {
+            px[0] = 0.0;
+            px[1] = 0.0;
+            px[2] = 0.0;
+        }
+        for (&i, l) in pixels.iter().zip(radiance) {
+            for t in 0..3 {
+                let v = l[t].map(|x| x * exposure_scale);
+                out.components[t][i] = v;
+                for c in 0..3 {
+                    out.beauty[i][c] += v[c];
+                }
+            }
+        }
+        out
+    }
+
+    /// Writes float32 EXR: R, G, B, A; with `aovs`, also Z and <component>.R/G/B for every component.
+    pub fn write_exr(
+        &self,
+        path: &Path,
+        attributes: &Attributes,
+        aovs: bool,
+    ) -> Result<(), OutputError> {
+        use exr::prelude::*;
+        let n = self.pixel_count();
+        let channel = |name: &str, f: &dyn Fn(usize) -> f32| {
+            AnyChannel::new(name, FlatSamples::F32((0..n).map(f).collect()))
+        };
+        let mut channels: Vec<AnyChannel<FlatSamples>> = vec![
+            channel("R", &|i| self.beauty[i][0]),
+            channel("G", &|i| self.beauty[i][1]),
+            channel("B", &|i| self.beauty[i][2]),
+            channel("A", &|i| self.beauty[i][3]),
+        ];
+        if aovs {
+            channels.push(channel("Z", &|i| self.depth[i]));
+            for (name, data) in COMPONENTS.iter().zip(&self.components) {
+                for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
+                    channels.push(channel(&format!("{name}.{suffix}"), &|i| data[i][c]));
+                }
+            }
+        }
+        let mut attrs = LayerAttributes::named("strandlight");
+        attrs.software_name = Some(Text::from("strandlight"));
+        for (k, v) in attributes {
+            attrs.other.insert(
+                exr_text(&format!("strandlight.{k}")),
+                AttributeValue::Text(exr_text(v)),
+            );
+        }
+        let mut layer = Layer::new(
+            (self.width as usize, self.height as usize),
+            attrs,
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(channels.into()),
+        );
+        layer.encoding.compression = Compression::ZIP16;
+        Image::from_layer(layer)
+            .write()
+            .to_file(path)
+            .map_err(|e| out_err(path, format!("writing EXR: {e}")))
+    }
+
+    /// The preview: ACES filmic (Narkowicz's fit) on the exposed linear colour, sRGB encoded, straight
+    /// alpha.
+    pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
+        let mut img = image::RgbaImage::new(self.width, self.height);
+        for (i, px) in img.pixels_mut().enumerate() {
+            let [r, g, b, a] = self.beauty[i];
+            let un = if a > 0.0 { 1.0 / a } else { 0.0 };
+            let enc = |x: f32| (255.0 * srgb_encode(aces_filmic(x * un)) + 0.5) as u8;
+            *px = image::Rgba([
+                enc(r),
+                enc(g),
+                enc(b),
+                (255.0 * a.clamp(0.0, 1.0) + 0.5) as u8,
+            ]);
+        }
+        img.save(path)
+            .map_err(|e| out_err(path, format!("writing PNG: {e}")))
+    }
+}
+
+/// Narkowicz 2015's fit of the ACES filmic curve (linear in, display-linear [0, 1] out).
+pub fn aces_filmic(x: f32) -> f32 {
+    let x = x.max(0.0) * 0.6;
+    ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+}
+
+pub fn srgb_encode(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}

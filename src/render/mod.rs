@@ -1,0 +1,18 @@
+//! The hair renderer (Xu et al. 2011 Sec. 5 on wgpu): visibility, per-SRBF shading batches with
+//! self-shadowing, resolve; shared by `strandlight render`, `bench` and the editor.
+
+pub mod camera;
+pub mod frame;
+pub mod reference;
+pub mod renderer;
+pub mod resolve;
+pub mod scene;
+pub mod shade;
+pub mod shading;
+pub mod targets;
+pub mod timing;
+pub mod visibility;
+
+pub use camera::Camera;
+pub use frame::Frame;
+pub use renderer::{RenderError, RenderSettings, Renderer};

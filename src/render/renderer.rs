@@ -1,0 +1,419 @@
+//! The renderer the CLI, the benchmarks and (later) the editor drive: GPU resources for one hairstyle,
+//! updated in place when parameters, absorption, lights or the camera change, and `render_frame`,
+//! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
+//! visibility, shading batches, resolve).
+
+use super::camera::Camera;
+use super::frame::Frame;
+use super::resolve::{ResolveInfo, ResolvePass};
+use super::shading::{FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass};
+use super::targets::{FrameTargets, MAX_SEGMENTS};
+use super::timing::PassTimer;
+use super::visibility::VisibilityPass;
+use crate::envmap::SrbfLight;
+use crate::gpu::GpuContext;
+use crate::gpu::density_pyramid::{DensityPyramidPass, GpuDensityPyramid};
+use crate::gpu::fast_eval::GpuLuts;
+use crate::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
+use crate::hair::Hair;
+use crate::scattering::fast_params::FastHairParams;
+use crate::scattering::lut::Luts;
+use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
+use wgpu::util::DeviceExt;
+
+/// The passes, in the order `render_frame` runs them (timestamp names).
+pub const PASSES: [&str; 5] = [
+    "fiber_density",
+    "density_pyramid",
+    "visibility",
+    "shading",
+    "resolve",
+];
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("image size {0}x{1} is out of range (1..={2} per side)")]
+    Size(u32, u32, u32),
+    #[error("{0} samples per pixel are not supported (use 2 or 4)")]
+    Samples(u32),
+    #[error("{points} points in the hair but {absorption} absorption values")]
+    AbsorptionCount { points: usize, absorption: usize },
+    #[error("{0} hair segments; the visibility pass names at most 2^24")]
+    TooManySegments(usize),
+    #[error("the GPU: {0}")]
+    Gpu(String),
+}
+
+/// What does not change from frame to frame without rebuilding targets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Multisampling of the visibility pass (2 or 4).
+    pub samples: u32,
+    /// Exposure in stops applied by the resolve pass.
+    pub exposure: f32,
+    pub shadows: bool,
+    /// Ribbons are at least this many pixels wide.
+    pub min_width_px: f32,
+    /// SRBF lights per shading pass (at most 16).
+    pub lights_per_pass: u32,
+    /// Voxels along the hair's longest side for the fiber-density volume.
+    pub volume_resolution: u32,
+    /// Shadow marches skip this many voxels at the shaded point (its own fiber's density).
+    pub shadow_skip_voxels: f32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 720,
+            height: 480,
+            samples: 4,
+            exposure: 0.0,
+            shadows: true,
+            min_width_px: 1.0,
+            lights_per_pass: 16,
+            volume_resolution: 128,
+            shadow_skip_voxels: 0.5,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// The fiber-density grid this renderer builds for `hair` (the CPU twin uses the same).
+    pub fn volume_grid(&self, hair: &Hair) -> VolumeGrid {
+        VolumeGrid::around(hair, self.voxel_size(hair))
+    }
+
+    pub fn voxel_size(&self, hair: &Hair) -> f32 {
+        let (lo, hi) = hair.bounds();
+        let n = self.volume_resolution.clamp(4, MAX_DIM as u32 - 2) as f32;
+        ((hi - lo).max_element() / n).max(1e-3)
+    }
+
+    pub fn shadow_skip(&self, hair: &Hair) -> f32 {
+        self.shadow_skip_voxels.max(0.0) * self.volume_grid(hair).voxel
+    }
+}
+
+pub struct Renderer {
+    pub settings: RenderSettings,
+    hair: GpuHair,
+    point_count: usize,
+    skip: f32,
+    volume: GpuFiberDensity,
+    pyramid: GpuDensityPyramid,
+    luts: GpuLuts,
+    params: wgpu::Buffer,
+    camera: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    light_count: u32,
+    resolve_info: wgpu::Buffer,
+    targets: FrameTargets,
+    density_pass: FiberDensityPass,
+    pyramid_pass: DensityPyramidPass,
+    visibility_pass: VisibilityPass,
+    shading_pass: ShadingPass,
+    resolve_pass: ResolvePass,
+    volume_dirty: bool,
+    timer: Option<PassTimer>,
+    last_ran: Vec<&'static str>,
+}
+
+fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
+    let mut v: Vec<GpuLight> = lights
+        .iter()
+        .map(|l| GpuLight {
+            direction: l.dir().normalize().as_vec3().to_array(),
+            lambda: l.lambda as f32,
+            rgb: l.rgb.map(|c| c as f32),
+            _pad: 0.0,
+        })
+        .collect();
+    if v.is_empty() {
+        // A binding cannot be empty; batches never read this one.
+        v.push(bytemuck::Zeroable::zeroed());
+    }
+    v
+}
+
+impl Renderer {
+    /// Uploads the hair (with one RGB absorption per point), tables and lights, and builds every pass.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &GpuContext,
+        settings: RenderSettings,
+        luts: &Luts,
+        hair: &Hair,
+        sigma_a: &[[f32; 3]],
+        params: &FastHairParams,
+        lights: &[SrbfLight],
+        camera: &Camera,
+    ) -> Result<Self, RenderError> {
+        let device = &ctx.device;
+        let max = device.limits().max_texture_dimension_2d;
+        if settings.width == 0
+            || settings.height == 0
+            || settings.width > max
+            || settings.height > max
+        {
+            return Err(RenderError::Size(settings.width, settings.height, max));
+        }
+        if !matches!(settings.samples, 2 | 4) {
+            return Err(RenderError::Samples(settings.samples));
+        }
+        if sigma_a.len() != hair.point_count() {
+            return Err(RenderError::AbsorptionCount {
+                points: hair.point_count(),
+                absorption: sigma_a.len(),
+            });
+        }
+        let segments = hair.point_count().saturating_sub(hair.strand_count());
+        if segments >= MAX_SEGMENTS as usize {
+            return Err(RenderError::TooManySegments(segments));
+        }
+        let gpu_hair = GpuHair::new(device, hair, sigma_a);
+        let grid = settings.volume_grid(hair);
+        let volume = GpuFiberDensity::new(device, grid, gpu_hair.segment_count);
+        let pyramid = GpuDensityPyramid::new(device, &volume);
+        let uniform = |label: &str, bytes: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let camera_u = camera.uniform(settings.width, settings.height, settings.min_width_px);
+        let resolve_info = ResolveInfo {
+            exposure_scale: settings.exposure.exp2(),
+            samples: settings.samples,
+            _pad: [0; 2],
+        };
+        let mut renderer = Self {
+            hair: gpu_hair,
+            point_count: hair.point_count(),
+            skip: settings.shadow_skip(hair),
+            volume,
+            pyramid,
+            luts: GpuLuts::new(device, luts),
+            params: uniform("hair params", bytemuck::bytes_of(params)),
+            camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
+            lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("lights"),
+                contents: bytemuck::cast_slice(&gpu_lights(lights)),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }),
+            light_count: lights.len() as u32,
+            resolve_info: uniform("resolve", bytemuck::bytes_of(&resolve_info)),
+            targets: FrameTargets::new(device, settings.width, settings.height, settings.samples),
+            density_pass: FiberDensityPass::new(device),
+            pyramid_pass: DensityPyramidPass::new(device),
+            visibility_pass: VisibilityPass::new(device, settings.samples),
+            shading_pass: ShadingPass::new(device),
+            resolve_pass: ResolvePass::new(device),
+            volume_dirty: true,
+            timer: PassTimer::new(ctx, &PASSES),
+            last_ran: Vec::new(),
+            settings,
+        };
+        renderer.update_batches(device);
+        Ok(renderer)
+    }
+
+    fn update_batches(&mut self, device: &wgpu::Device) {
+        let flags = if self.settings.shadows {
+            FLAG_SHADOWS
+        } else {
+            0
+        };
+        let (samples, skip) = (self.settings.samples, self.skip);
+        let batches: Vec<ShadeBatch> =
+            ShadingPass::batches(self.light_count, self.settings.lights_per_pass)
+                .into_iter()
+                .flat_map(|(first, count)| {
+                    (0..samples).map(move |slot| ShadeBatch {
+                        first,
+                        count,
+                        flags,
+                        samples,
+                        skip,
+                        slot,
+                        _pad: [0.0; 2],
+                    })
+                })
+                .collect();
+        self.shading_pass.set_batches(device, &batches);
+    }
+
+    /// Hair parameters changed (no geometry, pipeline or volume rebuild).
+    pub fn set_params(&self, ctx: &GpuContext, params: &FastHairParams) {
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+    }
+
+    pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) {
+        let u = camera.uniform(
+            self.settings.width,
+            self.settings.height,
+            self.settings.min_width_px,
+        );
+        ctx.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// Painted absorption (one RGB per point): rewrites the buffer and marks the volume (which carries
+    /// the absorption along shadow paths) for rebuilding.
+    pub fn set_absorption(
+        &mut self,
+        ctx: &GpuContext,
+        sigma_a: &[[f32; 3]],
+    ) -> Result<(), RenderError> {
+        if sigma_a.len() != self.point_count {
+            return Err(RenderError::AbsorptionCount {
+                points: self.point_count,
+                absorption: sigma_a.len(),
+            });
+        }
+        let v: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
+        ctx.queue
+            .write_buffer(&self.hair.absorption, 0, bytemuck::cast_slice(&v));
+        self.volume_dirty = true;
+        Ok(())
+    }
+
+    pub fn set_lights(&mut self, ctx: &GpuContext, lights: &[SrbfLight]) {
+        let v = gpu_lights(lights);
+        let bytes: &[u8] = bytemuck::cast_slice(&v);
+        if bytes.len() as u64 > self.lights.size() {
+            self.lights = ctx
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("lights"),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                });
+        } else {
+            ctx.queue.write_buffer(&self.lights, 0, bytes);
+        }
+        self.light_count = lights.len() as u32;
+        self.update_batches(&ctx.device);
+    }
+
+    /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
+    pub fn mark_volume_dirty(&mut self) {
+        self.volume_dirty = true;
+    }
+
+    pub fn light_count(&self) -> u32 {
+        self.light_count
+    }
+
+    /// Encodes and submits one frame.
+    pub fn render_frame(&mut self, ctx: &GpuContext) {
+        let device = &ctx.device;
+        let timer = self.timer.as_ref();
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        });
+        self.last_ran.clear();
+        if self.volume_dirty {
+            self.density_pass.encode(
+                device,
+                &mut enc,
+                &self.hair,
+                &self.volume,
+                timer.and_then(|t| t.compute_writes("fiber_density")),
+            );
+            self.pyramid_pass.encode(
+                device,
+                &mut enc,
+                &self.volume,
+                &self.pyramid,
+                timer.and_then(|t| t.compute_writes("density_pyramid")),
+            );
+            self.last_ran.extend(["fiber_density", "density_pyramid"]);
+            self.volume_dirty = false;
+        }
+        self.visibility_pass.encode(
+            device,
+            &mut enc,
+            &self.camera,
+            &self.hair,
+            &self.targets,
+            timer.and_then(|t| t.render_writes("visibility")),
+        );
+        let inputs = ShadingInputs {
+            camera: &self.camera,
+            params: &self.params,
+            pyramid_info: &self.pyramid.info_buffer,
+            points: &self.hair.points,
+            segments: &self.hair.segments,
+            absorption: &self.hair.absorption,
+            lights: &self.lights,
+            luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
+            pyramid: &self.pyramid.pyramid,
+        };
+        self.shading_pass.encode(
+            device,
+            &mut enc,
+            &inputs,
+            &self.targets,
+            timer.and_then(|t| t.compute_writes("shading")),
+        );
+        self.resolve_pass.encode(
+            device,
+            &mut enc,
+            &self.camera,
+            &self.resolve_info,
+            &self.targets,
+            timer.and_then(|t| t.compute_writes("resolve")),
+        );
+        self.last_ran.extend(["visibility", "shading", "resolve"]);
+        if let Some(t) = timer {
+            t.resolve(&mut enc);
+        }
+        ctx.queue.submit([enc.finish()]);
+    }
+
+    /// GPU milliseconds per pass of the last frame (None without timestamp queries).
+    pub fn pass_times(
+        &self,
+        ctx: &GpuContext,
+    ) -> Result<Option<Vec<(&'static str, f64)>>, RenderError> {
+        match &self.timer {
+            None => Ok(None),
+            Some(t) => t
+                .read_ms(ctx, &self.last_ran)
+                .map(Some)
+                .map_err(RenderError::Gpu),
+        }
+    }
+
+    /// Waits for the last frame and reads every output back.
+    pub fn read_frame(&self, ctx: &GpuContext) -> Result<Frame, RenderError> {
+        let t = &self.targets;
+        let scale = self.settings.exposure.exp2();
+        let read4 = |b: &wgpu::Buffer| ctx.read_buffer::<[f32; 4]>(b).map_err(RenderError::Gpu);
+        let components = t
+            .components
+            .iter()
+            .map(|b| {
+                read4(b).map(|v| {
+                    v.into_iter()
+                        .map(|p| [p[0] * scale, p[1] * scale, p[2] * scale])
+                        .collect()
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Frame {
+            width: t.width,
+            height: t.height,
+            samples: t.samples,
+            beauty: read4(&t.beauty)?,
+            depth: ctx.read_buffer(&t.view_depth).map_err(RenderError::Gpu)?,
+            sample_ids: ctx.read_buffer(&t.sample_ids).map_err(RenderError::Gpu)?,
+            components,
+        })
+    }
+}

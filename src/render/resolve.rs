@@ -1,0 +1,85 @@
+//! The resolve pass (`shaders/resolve.wgsl`): coverage, depth, sample ids and the exposed beauty.
+
+use super::targets::FrameTargets;
+use crate::gpu::context::compute_pipeline;
+use crate::gpu::shaders;
+use bytemuck::{Pod, Zeroable};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ResolveInfo {
+    /// 2^EV.
+    pub exposure_scale: f32,
+    pub samples: u32,
+    pub _pad: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<ResolveInfo>() == 16);
+
+pub struct ResolvePass {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl ResolvePass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("resolve"),
+            source: wgpu::ShaderSource::Wgsl(shaders::resolve_module().into()),
+        });
+        Self {
+            pipeline: compute_pipeline(device, &module, "resolve"),
+        }
+    }
+
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &wgpu::Buffer,
+        info: &wgpu::Buffer,
+        targets: &FrameTargets,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let mut entries = vec![
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: info.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&targets.visibility),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&targets.depth),
+            },
+        ];
+        let outputs = targets.components.iter().chain([
+            &targets.beauty,
+            &targets.view_depth,
+            &targets.sample_ids,
+        ]);
+        for (k, b) in outputs.enumerate() {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 4 + k as u32,
+                resource: b.as_entire_binding(),
+            });
+        }
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("resolve"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("resolve"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(targets.width.div_ceil(8), targets.height.div_ceil(8), 1);
+    }
+}

@@ -1,0 +1,164 @@
+//! The shading kernel on the CPU: the twin of `shaders/shading.wgsl` (same shading points, same fast
+//! response, same cone-marched transmittance) used to test the GPU end to end, and the pixel loop the
+//! reference mode shares with it.
+
+use super::camera::{CameraUniform, closest_on_segment, pixel_ray};
+use super::frame::Frame;
+use crate::envmap::SrbfLight;
+use crate::hair::Hair;
+use crate::scattering::fast_params::FastHairParams;
+use crate::scattering::fast_response::{SrbfInFrame, srbf_response};
+use crate::scattering::lut::Luts;
+use crate::shadow::cone::DensityPyramid;
+use glam::Vec3;
+use rayon::prelude::*;
+
+pub type Rgb = [f32; 3];
+
+/// Radiance per lobe (R, TT, TRT).
+pub type LobeRadiance = [Rgb; 3];
+
+/// A visible point on a fiber.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingPoint {
+    pub position: Vec3,
+    pub tangent: Vec3,
+    pub sigma_a: Rgb,
+}
+
+/// The first point of every segment, in the order the GPU numbers segments.
+pub fn segment_starts(hair: &Hair) -> Vec<u32> {
+    (0..hair.strand_count())
+        .flat_map(|s| {
+            let r = hair.strand_range(s);
+            (r.start as u32)..(r.end as u32).saturating_sub(1).max(r.start as u32)
+        })
+        .collect()
+}
+
+/// The hair as the shading kernel reads it.
+pub struct ShadingHair<'a> {
+    pub hair: &'a Hair,
+    pub segments: Vec<u32>,
+    pub sigma_a: &'a [[f32; 3]],
+}
+
+impl<'a> ShadingHair<'a> {
+    pub fn new(hair: &'a Hair, sigma_a: &'a [[f32; 3]]) -> Self {
+        Self {
+            hair,
+            segments: segment_starts(hair),
+            sigma_a,
+        }
+    }
+
+    /// `shading_point` of the WGSL: the point of segment `seg` closest to the ray.
+    pub fn shading_point(&self, seg: u32, origin: Vec3, dir: Vec3) -> ShadingPoint {
+        let i0 = self.segments[seg as usize] as usize;
+        let (a, b) = (self.hair.positions[i0], self.hair.positions[i0 + 1]);
+        let t = closest_on_segment(origin, dir, a, b);
+        let (s0, s1) = (self.sigma_a[i0], self.sigma_a[i0 + 1]);
+        ShadingPoint {
+            position: a + (b - a) * t,
+            tangent: b - a,
+            sigma_a: std::array::from_fn(|c| s0[c] + (s1[c] - s0[c]) * t),
+        }
+    }
+}
+
+/// FiberFrame::from_tangent in f32 (twin of `fiber_frame` in `shaders/camera.wgsl`): (u, v, w).
+pub fn fiber_frame(tangent: Vec3) -> (Vec3, Vec3, Vec3) {
+    let u = tangent.normalize();
+    let helper = if u.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+    let v = (helper - u * helper.dot(u)).normalize();
+    (u, v, u.cross(v))
+}
+
+/// (theta, phi) of a unit direction in the frame (twin of `fiber_angles`).
+pub fn fiber_angles(frame: (Vec3, Vec3, Vec3), omega: Vec3) -> (f32, f32) {
+    let (u, v, w) = frame;
+    (
+        crate::scattering::circular_gaussian::asin_precise(omega.dot(u).clamp(-1.0, 1.0)),
+        omega.dot(w).atan2(omega.dot(v)),
+    )
+}
+
+/// `shade_point` of the WGSL: lights' R, TT, TRT radiance towards omega_o, each light scaled by its
+/// cone-marched transmittance when a pyramid is given.
+pub fn shade_point(
+    luts: &Luts,
+    params: &FastHairParams,
+    sp: &ShadingPoint,
+    omega_o: Vec3,
+    lights: &[SrbfLight],
+    shadows: Option<(&DensityPyramid, f32)>,
+) -> LobeRadiance {
+    let mut p = *params;
+    p.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
+    let frame = fiber_frame(sp.tangent);
+    let (theta_o, phi_o) = fiber_angles(frame, omega_o);
+    let mut out = [[0.0; 3]; 3];
+    for l in lights {
+        let dir = l.dir().normalize().as_vec3();
+        let lambda = l.lambda as f32;
+        let (theta, phi) = fiber_angles(frame, dir);
+        let vis = shadows.map_or(1.0, |(pyr, skip)| {
+            pyr.srbf_transmittance(sp.position, dir, lambda, skip)
+        });
+        let m = srbf_response(luts, &p, SrbfInFrame { theta, phi, lambda }, theta_o, phi_o);
+        for t in 0..3 {
+            for c in 0..3 {
+                out[t][c] += vis * l.rgb[c] as f32 * m[t][c];
+            }
+        }
+    }
+    out
+}
+
+/// The distinct segments among a pixel's sample ids with their counts (ids are segment + 1).
+pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
+    let mut out: Vec<(u32, u32)> = Vec::new();
+    for &v in ids.iter().filter(|&&v| v != 0) {
+        match out.iter_mut().find(|(id, _)| *id == v) {
+            Some(e) => e.1 += 1,
+            None => out.push((v, 1)),
+        }
+    }
+    out
+}
+
+/// The pixel loop of the shading pass on the CPU (rayon over the given pixels): for each pixel, the
+/// coverage-weighted sum of `shade` over the distinct segments of its samples. Returns per pixel of
+/// `pixels` the radiance per lobe (before exposure).
+pub fn shade_pixels(
+    frame: &Frame,
+    camera: &CameraUniform,
+    hair: &ShadingHair,
+    pixels: &[usize],
+    shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
+) -> Vec<LobeRadiance> {
+    pixels
+        .par_iter()
+        .map(|&i| {
+            let samples = frame.samples.min(4) as usize;
+            let ids = &frame.sample_ids[i][..samples];
+            let (x, y) = (
+                (i % frame.width as usize) as f32,
+                (i / frame.width as usize) as f32,
+            );
+            let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
+            let mut acc = [[0.0; 3]; 3];
+            for (id, count) in distinct_samples(ids) {
+                let sp = hair.shading_point(id - 1, origin, dir);
+                let l = shade(&sp, -dir);
+                let w = count as f32 / frame.samples as f32;
+                for t in 0..3 {
+                    for c in 0..3 {
+                        acc[t][c] += w * l[t][c];
+                    }
+                }
+            }
+            acc
+        })
+        .collect()
+}

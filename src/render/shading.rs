@@ -1,0 +1,172 @@
+//! The shading passes (`shaders/shading.wgsl`): one dispatch per batch of at most
+//! [`MAX_LIGHTS_PER_PASS`] SRBF lights (Xu 2011's multi-pass scheme), each adding its lights' R, TT and
+//! TRT radiance to the component buffers.
+
+use super::targets::FrameTargets;
+use crate::gpu::context::compute_pipeline;
+use crate::gpu::shaders;
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+pub const MAX_LIGHTS_PER_PASS: u32 = 16;
+pub const FLAG_SHADOWS: u32 = 1;
+
+/// One SRBF light as the shaders read it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    pub direction: [f32; 3],
+    pub lambda: f32,
+    pub rgb: [f32; 3],
+    pub _pad: f32,
+}
+
+/// One batch's uniform.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ShadeBatch {
+    pub first: u32,
+    pub count: u32,
+    pub flags: u32,
+    pub samples: u32,
+    /// Distance (cm) left out at the start of every shadow march (the shaded fiber's own voxel).
+    pub skip: f32,
+    /// The visibility sample this dispatch shades (one dispatch per sample and batch).
+    pub slot: u32,
+    pub _pad: [f32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
+const _: () = assert!(std::mem::size_of::<ShadeBatch>() == 32);
+
+/// The buffers the shading pass reads that are not frame targets.
+pub struct ShadingInputs<'a> {
+    pub camera: &'a wgpu::Buffer,
+    pub params: &'a wgpu::Buffer,
+    pub pyramid_info: &'a wgpu::Buffer,
+    pub points: &'a wgpu::Buffer,
+    pub segments: &'a wgpu::Buffer,
+    pub absorption: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
+    pub luts: [&'a wgpu::Buffer; 3],
+    pub pyramid: &'a wgpu::Buffer,
+}
+
+pub struct ShadingPass {
+    pipeline: wgpu::ComputePipeline,
+    batches: Vec<wgpu::Buffer>,
+}
+
+impl ShadingPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shading"),
+            source: wgpu::ShaderSource::Wgsl(shaders::shading_module().into()),
+        });
+        Self {
+            pipeline: compute_pipeline(device, &module, "shade"),
+            batches: Vec::new(),
+        }
+    }
+
+    /// The batches for `light_count` lights (at most `per_pass` each).
+    pub fn batches(light_count: u32, per_pass: u32) -> Vec<(u32, u32)> {
+        let per_pass = per_pass.clamp(1, MAX_LIGHTS_PER_PASS);
+        (0..light_count)
+            .step_by(per_pass as usize)
+            .map(|first| (first, per_pass.min(light_count - first)))
+            .collect()
+    }
+
+    /// Rewrites the batch uniforms (lights, flags or sample count changed).
+    pub fn set_batches(&mut self, device: &wgpu::Device, batches: &[ShadeBatch]) {
+        self.batches = batches
+            .iter()
+            .map(|b| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("shade batch"),
+                    contents: bytemuck::bytes_of(b),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
+            })
+            .collect();
+    }
+
+    /// Clears the component buffers and runs every batch.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        for b in &targets.components {
+            encoder.clear_buffer(b, 0, None);
+        }
+        let binds: Vec<wgpu::BindGroup> = self
+            .batches
+            .iter()
+            .map(|batch| {
+                let buffers = [
+                    inputs.camera,
+                    inputs.params,
+                    batch,
+                    inputs.pyramid_info,
+                    inputs.points,
+                    inputs.segments,
+                    inputs.absorption,
+                    inputs.lights,
+                    inputs.luts[0],
+                    inputs.luts[1],
+                    inputs.luts[2],
+                    inputs.pyramid,
+                ];
+                let mut entries: Vec<wgpu::BindGroupEntry> = buffers
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| wgpu::BindGroupEntry {
+                        binding: i as u32,
+                        resource: b.as_entire_binding(),
+                    })
+                    .collect();
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 12,
+                    resource: wgpu::BindingResource::TextureView(&targets.visibility),
+                });
+                for (k, b) in targets.components[..3].iter().enumerate() {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 13 + k as u32,
+                        resource: b.as_entire_binding(),
+                    });
+                }
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shading"),
+                    layout: &self.pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                })
+            })
+            .collect();
+        // One compute pass per batch (Xu's passes); the timestamps bracket them all.
+        let last = binds.len().saturating_sub(1);
+        for (k, bind) in binds.iter().enumerate() {
+            let timestamp_writes = timestamps
+                .as_ref()
+                .filter(|_| k == 0 || k == last)
+                .map(|t| wgpu::ComputePassTimestampWrites {
+                    query_set: t.query_set,
+                    beginning_of_pass_write_index: t
+                        .beginning_of_pass_write_index
+                        .filter(|_| k == 0),
+                    end_of_pass_write_index: t.end_of_pass_write_index.filter(|_| k == last),
+                });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("shading batch"),
+                timestamp_writes,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(targets.width.div_ceil(8), targets.height.div_ceil(8), 1);
+        }
+    }
+}

@@ -1,0 +1,146 @@
+//! `strandlight render` and `strandlight bench` end to end (lavapipe in CI).
+
+use std::process::Command;
+
+fn strandlight() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_strandlight"));
+    c.env(
+        "STRANDLIGHT_CACHE",
+        std::env::temp_dir().join("strandlight-test-cache"),
+    );
+    c
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("strandlight-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d.join(name)
+}
+
+#[test]
+fn render_writes_a_linear_exr_with_attributes_aovs_and_a_png() {
+    let (exr, png) = (tmp("still.exr"), tmp("preview.png"));
+    let out = strandlight()
+        .args([
+            "render",
+            "--strands",
+            "300",
+            "--points",
+            "10",
+            "--width",
+            "48",
+            "--height",
+            "32",
+        ])
+        .args([
+            "--preset",
+            "blond",
+            "--camera",
+            "side",
+            "--aovs",
+            "--no-shadows",
+            "-o",
+        ])
+        .arg(&exr)
+        .arg("--png")
+        .arg(&png)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("{stderr}");
+    assert!(out.status.success(), "{stderr}");
+    use exr::prelude::ReadChannels;
+    use exr::prelude::ReadLayers;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(&exr)
+        .expect("a readable EXR");
+    let layer = &image.layer_data;
+    let names: Vec<String> = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    println!("channels: {names:?}");
+    for want in [
+        "R",
+        "G",
+        "B",
+        "A",
+        "Z",
+        "TT.R",
+        "TRT.B",
+        "MS.global.G",
+        "MS.local.R",
+    ] {
+        assert!(names.iter().any(|n| n == want), "channel {want} missing");
+    }
+    let attrs: Vec<String> = layer
+        .attributes
+        .other
+        .keys()
+        .map(|k| k.to_string())
+        .collect();
+    println!("attributes: {attrs:?}");
+    for want in [
+        "strandlight.params",
+        "strandlight.camera",
+        "strandlight.environment",
+    ] {
+        assert!(attrs.iter().any(|a| a == want), "attribute {want} missing");
+    }
+    // Float samples, alpha = coverage in [0, 1], some hair, and R + TT + TRT = beauty.
+    let get = |name: &str| -> Vec<f32> {
+        let c = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .expect("channel");
+        match &c.sample_data {
+            exr::prelude::FlatSamples::F32(v) => v.clone(),
+            other => panic!("{name} is not float32: {other:?}"),
+        }
+    };
+    let (r, a) = (get("R"), get("A"));
+    let lobes: Vec<Vec<f32>> = ["R.R", "TT.R", "TRT.R", "MS.global.R", "MS.local.R"]
+        .iter()
+        .map(|n| get(n))
+        .collect();
+    assert!(a.iter().all(|&x| (0.0..=1.0).contains(&x)));
+    let covered = a.iter().filter(|&&x| x > 0.0).count();
+    println!("{covered} of {} pixels covered", a.len());
+    assert!(covered > 20);
+    let mut worst = 0.0f32;
+    for i in 0..r.len() {
+        let sum: f32 = lobes.iter().map(|l| l[i]).sum();
+        worst = worst.max((sum - r[i]).abs() / r[i].abs().max(1e-6));
+    }
+    println!("AOV sum vs beauty: worst relative difference {worst:.2e}");
+    assert!(worst < 1e-5);
+    let preview = image::open(&png).expect("a readable PNG").to_rgba8();
+    assert_eq!(preview.dimensions(), (48, 32));
+}
+
+#[test]
+fn render_reports_bad_input_without_panicking() {
+    let cases: [&[&str]; 4] = [
+        &["render", "--width", "0", "-o", "x.exr"],
+        &["render", "--camera", "nowhere", "-o", "x.exr"],
+        &["render", "--samples", "3", "--strands", "10", "-o", "x.exr"],
+        &["render", "--env", "/nonexistent/sky.hdr", "-o", "x.exr"],
+    ];
+    for args in cases {
+        let out = strandlight().args(args).output().expect("runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!("{args:?}: {}", stderr.trim());
+        assert!(!out.status.success());
+        assert!(stderr.contains("error:"));
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}

@@ -1,0 +1,267 @@
+//! The renderer end to end on the GPU (lavapipe in CI): against its CPU twin at visible pixels, and
+//! against the reference mode (exact model under 1024 importance-sampled directions of the full
+//! environment) on the project's and the shared environments, shadows off and on.
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+
+use strandlight::envmap::{EnvMap, SrbfSet, load_env};
+use strandlight::gpu::{GpuContext, GpuOptions};
+use strandlight::hair::Hair;
+use strandlight::hair::procedural::Style;
+use strandlight::render::reference::{importance_sample_env, reference_shade};
+use strandlight::render::scene::generated_hair;
+use strandlight::render::shade::{ShadingHair, shade_pixels, shade_point};
+use strandlight::render::{Camera, Frame, RenderSettings, Renderer};
+use strandlight::scattering::fast_params::FastHairParams;
+use strandlight::scattering::lut::Luts;
+use strandlight::scattering::params::{HairParams, Preset};
+use strandlight::shadow::cone::DensityPyramid;
+use strandlight::shadow::fiber_density::FiberDensity;
+
+fn context() -> GpuContext {
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
+    println!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
+    ctx
+}
+
+struct Scene {
+    hair: Hair,
+    sigma_a: Vec<[f32; 3]>,
+    params: HairParams,
+    fast: FastHairParams,
+    camera: Camera,
+    settings: RenderSettings,
+}
+
+fn scene(strands: usize, width: u32, height: u32, shadows: bool, preset: Preset) -> Scene {
+    let hair = generated_hair(Style::Bob, strands, 12, 3);
+    let params = preset.params();
+    let fast = FastHairParams::new(&params, 4);
+    let (lo, hi) = hair.bounds();
+    let camera = Camera::framing(lo, hi, 35.0, 10.0, width as f32 / height as f32, 0.95);
+    Scene {
+        sigma_a: vec![fast.sigma_a_rgb(); hair.point_count()],
+        hair,
+        params,
+        fast,
+        camera,
+        settings: RenderSettings {
+            width,
+            height,
+            shadows,
+            volume_resolution: 48,
+            ..Default::default()
+        },
+    }
+}
+
+fn render(ctx: &GpuContext, luts: &Luts, s: &Scene, lights: &SrbfSet) -> (Renderer, Frame) {
+    let mut r = Renderer::new(
+        ctx,
+        s.settings.clone(),
+        luts,
+        &s.hair,
+        &s.sigma_a,
+        &s.fast,
+        &lights.lights,
+        &s.camera,
+    )
+    .expect("renderer");
+    r.render_frame(ctx);
+    let f = r.read_frame(ctx).expect("read back");
+    (r, f)
+}
+
+fn envmaps() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps")
+}
+
+#[test]
+fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = SrbfSet::read(&envmaps().join("sunny.srbf.json")).expect("sunny fit");
+    for shadows in [false, true] {
+        let s = scene(400, 64, 48, shadows, Preset::Blond);
+        let (_, frame) = render(&ctx, &luts, &s, &lights);
+        let covered: Vec<usize> = frame.covered().collect();
+        assert!(
+            covered.len() > 200,
+            "the hair covers {} pixels",
+            covered.len()
+        );
+        let pixels: Vec<usize> = covered
+            .iter()
+            .copied()
+            .step_by(covered.len() / 150)
+            .collect();
+        let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
+        let pyramid = DensityPyramid::build(&volume);
+        let skip = s.settings.shadow_skip(&s.hair);
+        let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
+        let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
+        let cpu = shade_pixels(&frame, &cam, &shading_hair, &pixels, |sp, wo| {
+            shade_point(
+                &luts,
+                &s.fast,
+                sp,
+                wo,
+                &lights.lights,
+                shadows.then_some((&pyramid, skip)),
+            )
+        });
+        let mut errors = Vec::new();
+        let scale = pixels
+            .iter()
+            .map(|&i| frame.beauty[i][0] + frame.beauty[i][1] + frame.beauty[i][2])
+            .fold(0.0f32, f32::max);
+        for (k, &i) in pixels.iter().enumerate() {
+            for t in 0..3 {
+                for c in 0..3 {
+                    let (g, r) = (frame.components[t][i][c], cpu[k][t][c]);
+                    // Relative, with a floor of 1e-3 of the brightest pixel (dark TT pixels).
+                    errors.push((g - r).abs() / r.abs().max(1e-3 * scale));
+                }
+            }
+        }
+        errors.sort_by(f32::total_cmp);
+        let (median, p99, max) = (
+            errors[errors.len() / 2],
+            errors[errors.len() * 99 / 100],
+            errors[errors.len() - 1],
+        );
+        println!(
+            "shadows {shadows}: {} pixels x 3 lobes x RGB: median {median:.2e}, p99 {p99:.2e}, max {max:.2e}",
+            pixels.len()
+        );
+        assert!(max <= 0.01, "GPU and CPU twin differ by {max} (> 1%)");
+    }
+}
+
+/// sqrt(sum |a - b|^2 / sum |b|^2) over covered pixels and channels.
+fn relative_rmse(a: &Frame, b: &Frame) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for i in b.covered() {
+        for c in 0..3 {
+            let (x, y) = (a.beauty[i][c] as f64, b.beauty[i][c] as f64);
+            num += (x - y) * (x - y);
+            den += y * y;
+        }
+    }
+    (num / den.max(1e-30)).sqrt()
+}
+
+fn reference_frame(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
+    let lights = importance_sample_env(env, 1024, yaw, 7);
+    let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
+    let skip = s.settings.shadow_skip(&s.hair);
+    let hair = ShadingHair::new(&s.hair, &s.sigma_a);
+    let cam = s
+        .camera
+        .uniform(frame.width, frame.height, s.settings.min_width_px);
+    let pixels: Vec<usize> = frame.covered().collect();
+    let shadows = s.settings.shadows.then_some((&volume, skip));
+    let radiance = shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
+        reference_shade(&s.params, sp, wo, &lights, shadows)
+    });
+    frame.with_lobes(&pixels, &radiance, 1.0)
+}
+
+fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &EnvMap) -> [f64; 2] {
+    [false, true].map(|shadows| {
+        let s = scene(1500, 96, 64, shadows, Preset::Brown);
+        let (_, frame) = render(ctx, luts, &s, lights);
+        let reference = reference_frame(&s, &frame, env, lights.yaw);
+        let e = relative_rmse(&frame, &reference);
+        let mean = |f: &Frame| {
+            let n = f.covered().count().max(1) as f64;
+            f.covered().map(|i| f.beauty[i][1] as f64).sum::<f64>() / n
+        };
+        println!(
+            "{name}, shadows {shadows}: relative RMSE {:.2}% over {} hair pixels (mean G: SRBF {:.4}, reference {:.4})",
+            100.0 * e,
+            frame.covered().count(),
+            mean(&frame),
+            mean(&reference)
+        );
+        e
+    })
+}
+
+#[test]
+fn srbf_render_is_close_to_the_reference_on_the_project_environments() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let mut worst = 0.0f64;
+    for name in ["sunny", "overcast", "studio"] {
+        let lights = SrbfSet::read(&envmaps().join(format!("{name}.srbf.json"))).expect("fit");
+        let (env, _) = load_env(&envmaps().join(format!("{name}.exr"))).expect("env");
+        for e in fidelity(&ctx, &luts, name, &lights, &env) {
+            worst = worst.max(e);
+        }
+    }
+    println!(
+        "worst relative RMSE {:.2}% (limit 10%, goal 5%)",
+        100.0 * worst
+    );
+    assert!(worst <= 0.10);
+}
+
+#[test]
+fn srbf_render_is_close_to_the_reference_on_the_shared_environments() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let mut worst = 0.0f64;
+    for file in [
+        "pmndrs_sky_1k.hdr",
+        "kloofendal_overcast_1k.hdr",
+        "studio_small_03_1k.hdr",
+    ] {
+        let path = data.join("envmaps").join(file);
+        let env = strandlight::render::scene::load_environment(&path, 40).expect("fit");
+        let image = env.image.expect("an image");
+        for e in fidelity(&ctx, &luts, file, &env.lights, &image) {
+            worst = worst.max(e);
+        }
+    }
+    println!(
+        "worst relative RMSE {:.2}% (limit 10%, goal 5%)",
+        100.0 * worst
+    );
+    assert!(worst <= 0.10);
+}
+
+#[test]
+fn importance_sampled_lights_integrate_the_environment() {
+    let (env, _) = load_env(&envmaps().join("sunny.exr")).expect("env");
+    let lights = importance_sample_env(&env, 4096, 0.0, 1);
+    let power = env.power();
+    for c in 0..3 {
+        let sum: f64 = lights.iter().map(|l| l.weight[c]).sum();
+        let rel = (sum - power[c]).abs() / power[c];
+        println!(
+            "channel {c}: sum of weights {sum:.4} vs the map's power {:.4} ({rel:.2e})",
+            power[c]
+        );
+        assert!(rel < 0.02);
+    }
+    // Irradiance on an upward plane (cosine-weighted): the estimate against the texel sum.
+    let exact: f64 = (0..env.height)
+        .flat_map(|y| (0..env.width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            env.pixels[y * env.width + x][1] as f64
+                * env.solid_angle(y)
+                * env.direction(x, y).y.max(0.0)
+        })
+        .sum();
+    let est: f64 = lights
+        .iter()
+        .map(|l| l.weight[1] * l.direction.y.max(0.0))
+        .sum();
+    println!("irradiance (G) on +Y: estimate {est:.4}, exact {exact:.4}");
+    assert!((est - exact).abs() / exact < 0.03);
+}
