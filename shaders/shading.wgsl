@@ -1,9 +1,10 @@
 // Shading pass (Xu 2011 Sec. 5): for every pixel, the distinct hair segments among its visibility
 // samples are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
-// each light scaled by its transmittance through the fiber-density pyramid, and accumulated per lobe
+// each light scaled by its transmittance (cone-marched through the fiber-density pyramid at the points
+// of the shadow grid, read trilinearly), and accumulated per lobe
 // weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
 // Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response,
-// density_pyramid, camera.
+// shadow_grid, camera.
 
 const FLAG_SHADOWS: u32 = 1u;
 
@@ -19,16 +20,16 @@ struct ShadeBatch {
     count: u32,
     flags: u32,
     samples: u32,
-    skip: f32,
     slot: u32,
-    _p1: f32,
-    _p2: f32,
+    _p0: u32,
+    _p1: u32,
+    _p2: u32,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<uniform> params: FastHairParams;
 @group(0) @binding(2) var<uniform> batch: ShadeBatch;
-@group(0) @binding(3) var<uniform> pyramid_info: PyramidInfo;
+@group(0) @binding(3) var<uniform> shadow_grid: ShadowGridInfo;
 @group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> segments: array<u32>;
 @group(0) @binding(6) var<storage, read> absorption: array<vec4<f32>>;
@@ -36,7 +37,7 @@ struct ShadeBatch {
 @group(0) @binding(8) var<storage, read> lut_c: array<f32>;
 @group(0) @binding(9) var<storage, read> lut_h_tt: array<f32>;
 @group(0) @binding(10) var<storage, read> lut_h_trt: array<f32>;
-@group(0) @binding(11) var<storage, read> pyramid: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read> shadow_values: array<f32>;
 @group(0) @binding(12) var visibility: texture_multisampled_2d<f32>;
 @group(0) @binding(13) var<storage, read_write> aov_r: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> aov_tt: array<vec4<f32>>;
@@ -65,7 +66,7 @@ struct LobeRadiance {
 }
 
 // Radiance towards omega_o from lights [first, first + count) at one shading point, per lobe.
-fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool, skip: f32) -> LobeRadiance {
+fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool) -> LobeRadiance {
     var p = params;
     p.sigma_a = vec4<f32>(sp.sigma_a, 0.0);
     let frame = fiber_frame(sp.tangent);
@@ -76,7 +77,7 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
         let ang = fiber_angles(frame, l.direction);
         var vis = 1.0;
         if (shadows) {
-            vis = srbf_transmittance(sp.position, l.direction, l.lambda, skip);
+            vis = grid_transmittance(shadow_grid, sp.position, j);
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
         let k = vis * l.rgb;
@@ -113,7 +114,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
-    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, batch.skip);
+    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u);
     let w = f32(count) / f32(batch.samples);
     let acc = LobeRadiance(w * l.r, w * l.tt, w * l.trt);
     aov_r[pixel] = aov_r[pixel] + vec4<f32>(acc.r, 0.0);

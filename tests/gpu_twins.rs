@@ -48,9 +48,14 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                     std::mem::size_of::<strandlight::gpu::density_pyramid::TransmittanceQuery>()
                 }
                 Some("Camera") => std::mem::size_of::<strandlight::render::camera::CameraUniform>(),
-                Some("GpuLight") => std::mem::size_of::<strandlight::render::shading::GpuLight>(),
                 Some("ShadeBatch") => {
                     std::mem::size_of::<strandlight::render::shading::ShadeBatch>()
+                }
+                Some("GpuLight") | Some("GridLight") => {
+                    std::mem::size_of::<strandlight::render::shading::GpuLight>()
+                }
+                Some("ShadowGridInfo") => {
+                    std::mem::size_of::<strandlight::render::shadow_grid::ShadowGridInfo>()
                 }
                 Some("ResolveInfo") => {
                     std::mem::size_of::<strandlight::render::resolve::ResolveInfo>()
@@ -67,7 +72,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         println!("{name}: {} lines valid", source.lines().count());
     }
     println!("struct layouts compared: {seen:?}");
-    assert_eq!(seen.len(), 12, "every shared struct was found and compared");
+    assert_eq!(seen.len(), 14, "every shared struct was found and compared");
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {

@@ -9,7 +9,7 @@ use strandlight::envmap::{EnvMap, SrbfSet, load_env};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::Style;
-use strandlight::render::reference::{importance_sample_env, reference_shade};
+use strandlight::render::reference::{ReferenceScene, importance_sample_env, reference_frame};
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{ShadingHair, shade_pixels, shade_point};
 use strandlight::render::{Camera, Frame, RenderSettings, Renderer};
@@ -99,6 +99,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
         let pyramid = DensityPyramid::build(&volume);
         let skip = s.settings.shadow_skip(&s.hair);
+        let grid = s.settings.shadow_grid(&s.hair);
         let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
         let cpu = shade_pixels(&frame, &cam, &shading_hair, &pixels, |sp, wo| {
@@ -108,7 +109,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                 sp,
                 wo,
                 &lights.lights,
-                shadows.then_some((&pyramid, skip)),
+                shadows.then_some((&pyramid, &grid, skip)),
             )
         });
         let mut errors = Vec::new();
@@ -152,27 +153,27 @@ fn relative_rmse(a: &Frame, b: &Frame) -> f64 {
     (num / den.max(1e-30)).sqrt()
 }
 
-fn reference_frame(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
-    let lights = importance_sample_env(env, 1024, yaw, 7);
-    let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
-    let skip = s.settings.shadow_skip(&s.hair);
-    let hair = ShadingHair::new(&s.hair, &s.sigma_a);
-    let cam = s
-        .camera
-        .uniform(frame.width, frame.height, s.settings.min_width_px);
-    let pixels: Vec<usize> = frame.covered().collect();
-    let shadows = s.settings.shadows.then_some((&volume, skip));
-    let radiance = shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-        reference_shade(&s.params, sp, wo, &lights, shadows)
-    });
-    frame.with_lobes(&pixels, &radiance, 1.0)
+fn reference(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
+    reference_frame(
+        frame,
+        &ReferenceScene {
+            hair: &s.hair,
+            sigma_a: &s.sigma_a,
+            params: &s.params,
+            env,
+            yaw,
+            directions: 1024,
+            settings: &s.settings,
+            camera: &s.camera,
+        },
+    )
 }
 
 fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &EnvMap) -> [f64; 2] {
     [false, true].map(|shadows| {
         let s = scene(1500, 96, 64, shadows, Preset::Brown);
         let (_, frame) = render(ctx, luts, &s, lights);
-        let reference = reference_frame(&s, &frame, env, lights.yaw);
+        let reference = reference(&s, &frame, env, lights.yaw);
         let e = relative_rmse(&frame, &reference);
         let mean = |f: &Frame| {
             let n = f.covered().count().max(1) as f64;

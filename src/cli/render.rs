@@ -9,6 +9,7 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::load::{LoadOptions, load_hair};
 use strandlight::hair::procedural::Style;
 use strandlight::render::camera::CAMERA_PRESETS;
+use strandlight::render::reference::{ReferenceScene, reference_frame};
 use strandlight::render::scene::{
     Environment, default_environment, generated_hair, load_environment,
 };
@@ -84,6 +85,14 @@ pub struct RenderArgs {
     /// Tonemapped PNG preview.
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// Shade with the exact Marschner model under directions importance-sampled from the environment
+    /// image instead (CPU; same camera, visibility and shadow volume). Needs an .hdr / .exr environment
+    /// or the built-in one.
+    #[arg(long)]
+    pub reference: bool,
+    /// Directions sampled by --reference.
+    #[arg(long, default_value_t = 1024)]
+    pub reference_directions: usize,
     /// Use a software adapter (lavapipe).
     #[arg(long)]
     pub software: bool,
@@ -175,7 +184,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &camera,
     )?;
     renderer.render_frame(&ctx);
-    let frame = renderer.read_frame(&ctx)?;
+    let mut frame = renderer.read_frame(&ctx)?;
     if let Some(times) = renderer.pass_times(&ctx)? {
         let list: Vec<String> = times
             .iter()
@@ -191,6 +200,35 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         env.lights.lights.len(),
         t.elapsed().as_secs_f64()
     );
+    let mut mode = "srbf".to_string();
+    if args.reference {
+        let image = env.image.as_ref().with_context(|| {
+            format!(
+                "--reference needs the environment image; {} holds only SRBF lights",
+                env.name
+            )
+        })?;
+        let t = Instant::now();
+        frame = reference_frame(
+            &frame,
+            &ReferenceScene {
+                hair: &hair,
+                sigma_a: &sigma_a,
+                params: &params,
+                env: image,
+                yaw: env.lights.yaw,
+                directions: args.reference_directions.max(1),
+                settings: &settings,
+                camera: &camera,
+            },
+        );
+        eprintln!(
+            "reference: {} directions, shaded on the CPU in {:.2} s",
+            args.reference_directions,
+            t.elapsed().as_secs_f64()
+        );
+        mode = format!("reference ({} directions)", args.reference_directions);
+    }
     let attributes = vec![
         ("hair".to_string(), hair_name),
         ("environment".to_string(), env.name.clone()),
@@ -201,7 +239,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         ("samples".to_string(), args.samples.to_string()),
         ("shadows".to_string(), (!args.no_shadows).to_string()),
         ("adapter".to_string(), ctx.summary.name.clone()),
-        ("mode".to_string(), "srbf".to_string()),
+        ("mode".to_string(), mode),
     ];
     if let Some(o) = &args.output {
         frame.write_exr(o, &attributes, args.aovs)?;

@@ -16,21 +16,28 @@ pub const CAMERA: &str = include_str!("../../shaders/camera.wgsl");
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const SHADING: &str = include_str!("../../shaders/shading.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
+pub const SHADOW_GRID: &str = include_str!("../../shaders/shadow_grid.wgsl");
+pub const SHADOW_GRID_BUILD: &str = include_str!("../../shaders/shadow_grid_build.wgsl");
+
+/// The shadow-grid build pass: cone marching and the grid.
+pub fn shadow_grid_build_module() -> String {
+    [
+        CIRCULAR_GAUSSIAN,
+        DENSITY_PYRAMID,
+        SHADOW_GRID,
+        SHADOW_GRID_BUILD,
+    ]
+    .join("\n")
+}
 
 /// The visibility pass (ribbons into the multisampled id target).
 pub fn visibility_module() -> String {
     [CIRCULAR_GAUSSIAN, CAMERA, VISIBILITY].join("\n")
 }
 
-/// The shading pass: the fast model, cone-marched transmittance, camera, and the kernel.
+/// The shading pass: the fast model, the shadow-grid lookup, camera, and the kernel.
 pub fn shading_module() -> String {
-    [
-        fast_model_library().as_str(),
-        DENSITY_PYRAMID,
-        CAMERA,
-        SHADING,
-    ]
-    .join("\n")
+    [fast_model_library().as_str(), SHADOW_GRID, CAMERA, SHADING].join("\n")
 }
 
 /// The resolve pass.
@@ -85,5 +92,6 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ("visibility", visibility_module()),
         ("shading", shading_module()),
         ("resolve", resolve_module()),
+        ("shadow_grid_build", shadow_grid_build_module()),
     ]
 }

@@ -9,6 +9,7 @@ pub mod resolve;
 pub mod scene;
 pub mod shade;
 pub mod shading;
+pub mod shadow_grid;
 pub mod targets;
 pub mod timing;
 pub mod visibility;

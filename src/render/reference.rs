@@ -116,3 +116,38 @@ pub fn reference_shade(
     }
     out.map(|l| l.map(|x| x as f32))
 }
+
+/// What the reference needs besides the visibility of a frame.
+pub struct ReferenceScene<'a> {
+    pub hair: &'a crate::hair::Hair,
+    pub sigma_a: &'a [[f32; 3]],
+    pub params: &'a HairParams,
+    pub env: &'a EnvMap,
+    /// Rotation of the environment about +Y (radians), as applied to its SRBF lights.
+    pub yaw: f64,
+    /// Directions sampled from the environment (at least 1024 for the fidelity figures).
+    pub directions: usize,
+    pub settings: &'a super::RenderSettings,
+    pub camera: &'a super::Camera,
+}
+
+/// The reference shading of the points the GPU frame sees (same coverage, depth and ids); its
+/// components R, TT, TRT replace the frame's, multiple scattering is zero, the exposure is applied.
+pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::Frame {
+    let lights = importance_sample_env(scene.env, scene.directions, scene.yaw, 7);
+    let settings = scene.settings;
+    let volume = settings
+        .shadows
+        .then(|| FiberDensity::build(scene.hair, scene.sigma_a, settings.voxel_size(scene.hair)));
+    let skip = settings.shadow_skip(scene.hair);
+    let hair = super::shade::ShadingHair::new(scene.hair, scene.sigma_a);
+    let cam = scene
+        .camera
+        .uniform(frame.width, frame.height, settings.min_width_px);
+    let pixels: Vec<usize> = frame.covered().collect();
+    let shadows = volume.as_ref().map(|v| (v, skip));
+    let radiance = super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
+        reference_shade(scene.params, sp, wo, &lights, shadows)
+    });
+    frame.with_lobes(&pixels, &radiance, settings.exposure.exp2())
+}

@@ -1,12 +1,13 @@
 //! The renderer the CLI, the benchmarks and (later) the editor drive: GPU resources for one hairstyle,
 //! updated in place when parameters, absorption, lights or the camera change, and `render_frame`,
 //! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
-//! visibility, shading batches, resolve).
+//! the per-light shadow grid when they or the lights changed, visibility, shading batches, resolve).
 
 use super::camera::Camera;
 use super::frame::Frame;
 use super::resolve::{ResolveInfo, ResolvePass};
 use super::shading::{FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass};
+use super::shadow_grid::{GpuShadowGrid, ShadowGridPass};
 use super::targets::{FrameTargets, MAX_SEGMENTS};
 use super::timing::PassTimer;
 use super::visibility::VisibilityPass;
@@ -19,12 +20,14 @@ use crate::hair::Hair;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::lut::Luts;
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
+use crate::shadow::grid::ShadowGrid;
 use wgpu::util::DeviceExt;
 
 /// The passes, in the order `render_frame` runs them (timestamp names).
-pub const PASSES: [&str; 5] = [
+pub const PASSES: [&str; 6] = [
     "fiber_density",
     "density_pyramid",
+    "shadow_grid",
     "visibility",
     "shading",
     "resolve",
@@ -62,6 +65,8 @@ pub struct RenderSettings {
     pub volume_resolution: u32,
     /// Shadow marches skip this many voxels at the shaded point (its own fiber's density).
     pub shadow_skip_voxels: f32,
+    /// Points of the per-light transmittance grid along the hair's longest side.
+    pub shadow_grid_resolution: u32,
 }
 
 impl Default for RenderSettings {
@@ -76,6 +81,7 @@ impl Default for RenderSettings {
             lights_per_pass: 16,
             volume_resolution: 128,
             shadow_skip_voxels: 0.5,
+            shadow_grid_resolution: 32,
         }
     }
 }
@@ -95,6 +101,14 @@ impl RenderSettings {
     pub fn shadow_skip(&self, hair: &Hair) -> f32 {
         self.shadow_skip_voxels.max(0.0) * self.volume_grid(hair).voxel
     }
+
+    /// The per-light transmittance grid (the CPU twin reads the same).
+    pub fn shadow_grid(&self, hair: &Hair) -> ShadowGrid {
+        ShadowGrid::around(
+            &self.volume_grid(hair),
+            self.shadow_grid_resolution.clamp(2, 256),
+        )
+    }
 }
 
 pub struct Renderer {
@@ -104,6 +118,7 @@ pub struct Renderer {
     skip: f32,
     volume: GpuFiberDensity,
     pyramid: GpuDensityPyramid,
+    shadow_grid: GpuShadowGrid,
     luts: GpuLuts,
     params: wgpu::Buffer,
     camera: wgpu::Buffer,
@@ -113,10 +128,12 @@ pub struct Renderer {
     targets: FrameTargets,
     density_pass: FiberDensityPass,
     pyramid_pass: DensityPyramidPass,
+    shadow_grid_pass: ShadowGridPass,
     visibility_pass: VisibilityPass,
     shading_pass: ShadingPass,
     resolve_pass: ResolvePass,
     volume_dirty: bool,
+    shadow_grid_dirty: bool,
     timer: Option<PassTimer>,
     last_ran: Vec<&'static str>,
 }
@@ -190,12 +207,20 @@ impl Renderer {
             samples: settings.samples,
             _pad: [0; 2],
         };
+        let skip = settings.shadow_skip(hair);
+        let shadow_grid = GpuShadowGrid::new(
+            device,
+            settings.shadow_grid(hair),
+            lights.len() as u32,
+            skip,
+        );
         let mut renderer = Self {
             hair: gpu_hair,
             point_count: hair.point_count(),
-            skip: settings.shadow_skip(hair),
+            skip,
             volume,
             pyramid,
+            shadow_grid,
             luts: GpuLuts::new(device, luts),
             params: uniform("hair params", bytemuck::bytes_of(params)),
             camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
@@ -209,10 +234,12 @@ impl Renderer {
             targets: FrameTargets::new(device, settings.width, settings.height, settings.samples),
             density_pass: FiberDensityPass::new(device),
             pyramid_pass: DensityPyramidPass::new(device),
+            shadow_grid_pass: ShadowGridPass::new(device),
             visibility_pass: VisibilityPass::new(device, settings.samples),
             shading_pass: ShadingPass::new(device),
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
+            shadow_grid_dirty: true,
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
             settings,
@@ -227,7 +254,7 @@ impl Renderer {
         } else {
             0
         };
-        let (samples, skip) = (self.settings.samples, self.skip);
+        let samples = self.settings.samples;
         let batches: Vec<ShadeBatch> =
             ShadingPass::batches(self.light_count, self.settings.lights_per_pass)
                 .into_iter()
@@ -237,9 +264,8 @@ impl Renderer {
                         count,
                         flags,
                         samples,
-                        skip,
                         slot,
-                        _pad: [0.0; 2],
+                        _pad: [0; 3],
                     })
                 })
                 .collect();
@@ -297,12 +323,26 @@ impl Renderer {
             ctx.queue.write_buffer(&self.lights, 0, bytes);
         }
         self.light_count = lights.len() as u32;
+        if self.light_count != self.shadow_grid.light_count {
+            self.shadow_grid = GpuShadowGrid::new(
+                &ctx.device,
+                self.shadow_grid.grid,
+                self.light_count,
+                self.skip,
+            );
+        }
+        self.shadow_grid_dirty = true;
         self.update_batches(&ctx.device);
     }
 
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
+    }
+
+    /// The next frame rebuilds the per-light transmittance grid (benchmarks time it).
+    pub fn mark_shadow_grid_dirty(&mut self) {
+        self.shadow_grid_dirty = true;
     }
 
     pub fn light_count(&self) -> u32 {
@@ -334,6 +374,19 @@ impl Renderer {
             );
             self.last_ran.extend(["fiber_density", "density_pyramid"]);
             self.volume_dirty = false;
+            self.shadow_grid_dirty = true;
+        }
+        if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
+            self.shadow_grid_pass.encode(
+                device,
+                &mut enc,
+                &self.pyramid,
+                &self.lights,
+                &self.shadow_grid,
+                timer.and_then(|t| t.compute_writes("shadow_grid")),
+            );
+            self.last_ran.push("shadow_grid");
+            self.shadow_grid_dirty = false;
         }
         self.visibility_pass.encode(
             device,
@@ -346,13 +399,13 @@ impl Renderer {
         let inputs = ShadingInputs {
             camera: &self.camera,
             params: &self.params,
-            pyramid_info: &self.pyramid.info_buffer,
+            shadow_grid: &self.shadow_grid.info,
             points: &self.hair.points,
             segments: &self.hair.segments,
             absorption: &self.hair.absorption,
             lights: &self.lights,
             luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
-            pyramid: &self.pyramid.pyramid,
+            shadow_values: &self.shadow_grid.values,
         };
         self.shading_pass.encode(
             device,

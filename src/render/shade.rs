@@ -10,6 +10,7 @@ use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::fast_response::{SrbfInFrame, srbf_response};
 use crate::scattering::lut::Luts;
 use crate::shadow::cone::DensityPyramid;
+use crate::shadow::grid::ShadowGrid;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -83,15 +84,19 @@ pub fn fiber_angles(frame: (Vec3, Vec3, Vec3), omega: Vec3) -> (f32, f32) {
     )
 }
 
+/// Where the shading pass reads shadows from: the pyramid the grid points were marched through, the
+/// grid, and the skipped distance.
+pub type GridShadows<'a> = (&'a DensityPyramid, &'a ShadowGrid, f32);
+
 /// `shade_point` of the WGSL: lights' R, TT, TRT radiance towards omega_o, each light scaled by its
-/// cone-marched transmittance when a pyramid is given.
+/// transmittance read from the shadow grid when shadows are given.
 pub fn shade_point(
     luts: &Luts,
     params: &FastHairParams,
     sp: &ShadingPoint,
     omega_o: Vec3,
     lights: &[SrbfLight],
-    shadows: Option<(&DensityPyramid, f32)>,
+    shadows: Option<GridShadows>,
 ) -> LobeRadiance {
     let mut p = *params;
     p.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
@@ -102,8 +107,8 @@ pub fn shade_point(
         let dir = l.dir().normalize().as_vec3();
         let lambda = l.lambda as f32;
         let (theta, phi) = fiber_angles(frame, dir);
-        let vis = shadows.map_or(1.0, |(pyr, skip)| {
-            pyr.srbf_transmittance(sp.position, dir, lambda, skip)
+        let vis = shadows.map_or(1.0, |(pyr, grid, skip)| {
+            grid.transmittance(pyr, sp.position, dir, lambda, skip)
         });
         let m = srbf_response(luts, &p, SrbfInFrame { theta, phi, lambda }, theta_o, phi_o);
         for t in 0..3 {

@@ -1,6 +1,6 @@
 //! The shading passes (`shaders/shading.wgsl`): one dispatch per batch of at most
 //! [`MAX_LIGHTS_PER_PASS`] SRBF lights (Xu 2011's multi-pass scheme), each adding its lights' R, TT and
-//! TRT radiance to the component buffers.
+//! TRT radiance to the component buffers; one dispatch per visibility sample within a batch.
 
 use super::targets::FrameTargets;
 use crate::gpu::context::compute_pipeline;
@@ -29,11 +29,9 @@ pub struct ShadeBatch {
     pub count: u32,
     pub flags: u32,
     pub samples: u32,
-    /// Distance (cm) left out at the start of every shadow march (the shaded fiber's own voxel).
-    pub skip: f32,
     /// The visibility sample this dispatch shades (one dispatch per sample and batch).
     pub slot: u32,
-    pub _pad: [f32; 2],
+    pub _pad: [u32; 3],
 }
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
@@ -43,13 +41,13 @@ const _: () = assert!(std::mem::size_of::<ShadeBatch>() == 32);
 pub struct ShadingInputs<'a> {
     pub camera: &'a wgpu::Buffer,
     pub params: &'a wgpu::Buffer,
-    pub pyramid_info: &'a wgpu::Buffer,
+    pub shadow_grid: &'a wgpu::Buffer,
     pub points: &'a wgpu::Buffer,
     pub segments: &'a wgpu::Buffer,
     pub absorption: &'a wgpu::Buffer,
     pub lights: &'a wgpu::Buffer,
     pub luts: [&'a wgpu::Buffer; 3],
-    pub pyramid: &'a wgpu::Buffer,
+    pub shadow_values: &'a wgpu::Buffer,
 }
 
 pub struct ShadingPass {
@@ -112,7 +110,7 @@ impl ShadingPass {
                     inputs.camera,
                     inputs.params,
                     batch,
-                    inputs.pyramid_info,
+                    inputs.shadow_grid,
                     inputs.points,
                     inputs.segments,
                     inputs.absorption,
@@ -120,7 +118,7 @@ impl ShadingPass {
                     inputs.luts[0],
                     inputs.luts[1],
                     inputs.luts[2],
-                    inputs.pyramid,
+                    inputs.shadow_values,
                 ];
                 let mut entries: Vec<wgpu::BindGroupEntry> = buffers
                     .iter()

@@ -3,6 +3,7 @@
 pub mod cone;
 pub mod fiber_density;
 pub mod forward;
+pub mod grid;
 
 pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;

@@ -1,0 +1,119 @@
+//! The shadow-grid pass (`shaders/shadow_grid_build.wgsl`): every light's cone-marched transmittance
+//! at every point of a coarse grid, rebuilt when the volume or the lights change
+//! ([`crate::shadow::grid`] is the CPU twin).
+
+use super::shading::GpuLight;
+use crate::gpu::context::compute_pipeline;
+use crate::gpu::density_pyramid::GpuDensityPyramid;
+use crate::gpu::fiber_density::dispatch_2d;
+use crate::gpu::shaders;
+use crate::shadow::grid::ShadowGrid;
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ShadowGridInfo {
+    pub origin: [f32; 3],
+    pub spacing: f32,
+    pub dims: [u32; 3],
+    pub light_count: u32,
+    pub skip: f32,
+    pub _pad: [f32; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<ShadowGridInfo>() == 48);
+
+/// The grid's uniform and its values (one f32 per grid point and light, light-major).
+pub struct GpuShadowGrid {
+    pub grid: ShadowGrid,
+    pub info: wgpu::Buffer,
+    pub values: wgpu::Buffer,
+    pub light_count: u32,
+}
+
+impl GpuShadowGrid {
+    pub fn new(device: &wgpu::Device, grid: ShadowGrid, light_count: u32, skip: f32) -> Self {
+        let info = ShadowGridInfo {
+            origin: grid.origin.to_array(),
+            spacing: grid.spacing,
+            dims: grid.dims,
+            light_count,
+            skip,
+            _pad: [0.0; 3],
+        };
+        Self {
+            grid,
+            info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow grid info"),
+                contents: bytemuck::bytes_of(&info),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            values: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow grid"),
+                size: (grid.point_count() as u64 * light_count.max(1) as u64 * 4).max(4),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            light_count,
+        }
+    }
+}
+
+pub struct ShadowGridPass {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl ShadowGridPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shadow_grid_build"),
+            source: wgpu::ShaderSource::Wgsl(shaders::shadow_grid_build_module().into()),
+        });
+        Self {
+            pipeline: compute_pipeline(device, &module, "build_shadow_grid"),
+        }
+    }
+
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        pyramid: &GpuDensityPyramid,
+        lights: &wgpu::Buffer,
+        target: &GpuShadowGrid,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let buffers = [
+            &pyramid.info_buffer,
+            &pyramid.pyramid,
+            &target.info,
+            lights,
+            &target.values,
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow grid"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shadow grid"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        let (x, y) = dispatch_2d(target.grid.point_count() as u32 * target.light_count);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+/// The lights as the grid pass reads them (same layout as the shading pass's).
+pub type GridLight = GpuLight;
