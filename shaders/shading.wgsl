@@ -3,10 +3,13 @@
 // each light scaled by its transmittance (cone-marched through the fiber-density pyramid at the points
 // of the shadow grid, read trilinearly), and accumulated per lobe
 // weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
+// With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
+// (global M^G and local M^L, from the light's T_f and sigma_f^2 on the grid) to MS.global and MS.local.
 // Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response,
-// shadow_grid, camera.
+// dual_response, shadow_grid, camera.
 
 const FLAG_SHADOWS: u32 = 1u;
+const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 
 struct GpuLight {
     direction: vec3<f32>,
@@ -37,11 +40,14 @@ struct ShadeBatch {
 @group(0) @binding(8) var<storage, read> lut_c: array<f32>;
 @group(0) @binding(9) var<storage, read> lut_h_tt: array<f32>;
 @group(0) @binding(10) var<storage, read> lut_h_trt: array<f32>;
-@group(0) @binding(11) var<storage, read> shadow_values: array<f32>;
+@group(0) @binding(11) var<storage, read> shadow_values: array<vec4<f32>>;
 @group(0) @binding(12) var visibility: texture_multisampled_2d<f32>;
 @group(0) @binding(13) var<storage, read_write> aov_r: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> aov_tt: array<vec4<f32>>;
 @group(0) @binding(15) var<storage, read_write> aov_trt: array<vec4<f32>>;
+@group(0) @binding(16) var<storage, read_write> aov_ms_global: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
+@group(0) @binding(18) var<storage, read> dual_tables: array<vec4<f32>>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -63,27 +69,40 @@ struct LobeRadiance {
     r: vec3<f32>,
     tt: vec3<f32>,
     trt: vec3<f32>,
+    ms_global: vec3<f32>,
+    ms_local: vec3<f32>,
 }
 
-// Radiance towards omega_o from lights [first, first + count) at one shading point, per lobe.
-fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool) -> LobeRadiance {
+// Radiance towards omega_o from lights [first, first + count) at one shading point, per component.
+fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool, multiple: bool) -> LobeRadiance {
     var p = params;
     p.sigma_a = vec4<f32>(sp.sigma_a, 0.0);
     let frame = fiber_frame(sp.tangent);
     let o = fiber_angles(frame, omega_o);
-    var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var j = first; j < first + count; j++) {
         let l = lights[j];
         let ang = fiber_angles(frame, l.direction);
-        var vis = 1.0;
+        var sh = GridShadow(1.0, vec3<f32>(1.0), vec3<f32>(0.0));
         if (shadows) {
-            vis = grid_transmittance(shadow_grid, sp.position, j);
+            sh = grid_shadow(shadow_grid, sp.position, j);
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
-        let k = vis * l.rgb;
+        let k = sh.transmittance * l.rgb;
         out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
         out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
         out.trt = out.trt + k * srbf_response_lobe(p, 2u, light, o.x, o.y);
+        if (multiple) {
+            // One spread for the three channels: their mean sigma_f^2.
+            let s2 = (sh.sigma_f2.x + sh.sigma_f2.y + sh.sigma_f2.z) / 3.0;
+            let global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
+            let local = local_response(p, light, o.x, o.y, s2);
+            let local_direct = local_response(p, light, o.x, o.y, 0.0);
+            let ms = dual_scattering_components(p, sh.transmittance, sh.transmittance_f, local_direct, global, local);
+            let power = srbf_integral(l.lambda) * l.rgb;
+            out.ms_global = out.ms_global + power * ms.ms_global;
+            out.ms_local = out.ms_local + power * ms.ms_local;
+        }
     }
     return out;
 }
@@ -114,10 +133,11 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
-    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u);
+    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
     let w = f32(count) / f32(batch.samples);
-    let acc = LobeRadiance(w * l.r, w * l.tt, w * l.trt);
-    aov_r[pixel] = aov_r[pixel] + vec4<f32>(acc.r, 0.0);
-    aov_tt[pixel] = aov_tt[pixel] + vec4<f32>(acc.tt, 0.0);
-    aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(acc.trt, 0.0);
+    aov_r[pixel] = aov_r[pixel] + vec4<f32>(w * l.r, 0.0);
+    aov_tt[pixel] = aov_tt[pixel] + vec4<f32>(w * l.tt, 0.0);
+    aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(w * l.trt, 0.0);
+    aov_ms_global[pixel] = aov_ms_global[pixel] + vec4<f32>(w * l.ms_global, 0.0);
+    aov_ms_local[pixel] = aov_ms_local[pixel] + vec4<f32>(w * l.ms_local, 0.0);
 }

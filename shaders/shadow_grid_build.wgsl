@@ -1,4 +1,7 @@
-// The shadow-grid build pass: one invocation per (grid point, light).
+// The shadow-grid build pass: one invocation per (grid point, light). Writes the light's cone-marched
+// transmittance (the direct fraction for single scattering) and, when multiple scattering is on, the
+// forward-scattering terms T_f and sigma_f^2 averaged over the same seven cones (srbf_forward).
+// Prepended: circular_gaussian, density_pyramid, forward_scattering, shadow_grid.
 
 struct GridLight {
     direction: vec3<f32>,
@@ -7,11 +10,52 @@ struct GridLight {
     _pad: f32,
 }
 
+struct VolumeInfoF {
+    origin: vec3<f32>,
+    voxel: f32,
+    dims: vec3<u32>,
+    segment_count: u32,
+}
+
 @group(0) @binding(0) var<uniform> pyramid_info: PyramidInfo;
 @group(0) @binding(1) var<storage, read> pyramid: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> shadow_grid: ShadowGridInfo;
 @group(0) @binding(3) var<storage, read> grid_lights: array<GridLight>;
-@group(0) @binding(4) var<storage, read_write> shadow_values: array<f32>;
+@group(0) @binding(4) var<storage, read_write> shadow_values: array<vec4<f32>>;
+@group(0) @binding(5) var<uniform> volume_info: VolumeInfoF;
+@group(0) @binding(6) var<storage, read> volume: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> forward_table: array<vec2<f32>>;
+
+// forward_scattering averaged over the cones of srbf_transmittance (weights 1/2 for the centre, 1/12
+// for each ring cone); sigma_f^2 is averaged over the crossed part (weights w (1 - direct)).
+fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> ForwardScattering {
+    let kappa = 2.0 / (lambda * lambda);
+    let e = exp(-2.0 * kappa);
+    let inner = acos(clamp(1.0 + log(0.5 * (1.0 - e) + e) / kappa, -1.0, 1.0));
+    let c = forward_scattering(p, centre, skip);
+    if (inner < 0.05) {
+        return c;
+    }
+    let ring = acos(clamp(1.0 + log(0.25 * (1.0 - e) + e) / kappa, -1.0, 1.0));
+    var e1 = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(centre.x) < 0.9);
+    e1 = normalize(e1 - centre * dot(centre, e1));
+    let e2 = cross(centre, e1);
+    var direct = 0.5 * c.direct_fraction;
+    var tf = 0.5 * c.transmittance_f;
+    var spread = 0.5 * (1.0 - c.direct_fraction) * c.sigma_f2;
+    var crossed = 0.5 * (1.0 - c.direct_fraction);
+    for (var k = 0; k < 6; k++) {
+        let a = f32(k) * TAU / 6.0;
+        let d = normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring));
+        let f = forward_scattering(p, d, skip);
+        let w = 0.5 / 6.0;
+        direct = direct + w * f.direct_fraction;
+        tf = tf + w * f.transmittance_f;
+        spread = spread + w * (1.0 - f.direct_fraction) * f.sigma_f2;
+        crossed = crossed + w * (1.0 - f.direct_fraction);
+    }
+    return ForwardScattering(direct, tf, spread / max(crossed, 1e-12));
+}
 
 @compute @workgroup_size(64)
 fn build_shadow_grid(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -21,8 +65,17 @@ fn build_shadow_grid(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
     if (k >= n * g.light_count) {
         return;
     }
-    let light = k / n;
-    let i = k % n;
-    let l = grid_lights[light];
-    shadow_values[k] = srbf_transmittance(grid_point(g, i), l.direction, l.lambda, g.skip);
+    let l = grid_lights[k / n];
+    let x = grid_point(g, k % n);
+    // Transmittances are stored as logarithms: attenuation falls off exponentially into the hair, so
+    // interpolating its logarithm follows it between grid points far better.
+    let t = log(max(srbf_transmittance(x, l.direction, l.lambda, g.skip), GRID_MIN_TRANSMITTANCE));
+    if (g.forward == 0u) {
+        shadow_values[2u * k] = vec4<f32>(t, vec3<f32>(t));
+        shadow_values[2u * k + 1u] = vec4<f32>(0.0);
+        return;
+    }
+    let f = srbf_forward(x, l.direction, l.lambda, g.skip);
+    shadow_values[2u * k] = vec4<f32>(t, log(max(f.transmittance_f, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
+    shadow_values[2u * k + 1u] = vec4<f32>(f.sigma_f2, f.direct_fraction);
 }

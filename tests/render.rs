@@ -9,15 +9,18 @@ use strandlight::envmap::{EnvMap, SrbfSet, load_env};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::Style;
+use strandlight::render::reference::REFERENCE_VARIANT;
 use strandlight::render::reference::{ReferenceScene, importance_sample_env, reference_frame};
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{ShadingHair, shade_pixels, shade_point};
-use strandlight::render::{Camera, Frame, RenderSettings, Renderer};
-use strandlight::scattering::fast_params::FastHairParams;
+use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
+use strandlight::scattering::dual_terms::DualTables;
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::{HairParams, Preset};
 use strandlight::shadow::cone::DensityPyramid;
 use strandlight::shadow::fiber_density::FiberDensity;
+use strandlight::shadow::forward::ForwardTable;
+use strandlight::shadow::grid::GridSources;
 
 fn context() -> GpuContext {
     let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
@@ -29,7 +32,7 @@ struct Scene {
     hair: Hair,
     sigma_a: Vec<[f32; 3]>,
     params: HairParams,
-    fast: FastHairParams,
+    look: HairLook,
     camera: Camera,
     settings: RenderSettings,
 }
@@ -37,20 +40,22 @@ struct Scene {
 fn scene(strands: usize, width: u32, height: u32, shadows: bool, preset: Preset) -> Scene {
     let hair = generated_hair(Style::Bob, strands, 12, 3);
     let params = preset.params();
-    let fast = FastHairParams::new(&params, 4);
+    let look = HairLook::new(params);
     let (lo, hi) = hair.bounds();
     let camera = Camera::framing(lo, hi, 35.0, 10.0, width as f32 / height as f32, 0.95);
     Scene {
-        sigma_a: vec![fast.sigma_a_rgb(); hair.point_count()],
+        sigma_a: vec![look.fast.sigma_a_rgb(); hair.point_count()],
         hair,
         params,
-        fast,
+        look,
         camera,
         settings: RenderSettings {
             width,
             height,
             shadows,
+            multiple_scattering: false,
             volume_resolution: 48,
+            shadow_grid_resolution: 32,
             ..Default::default()
         },
     }
@@ -63,7 +68,7 @@ fn render(ctx: &GpuContext, luts: &Luts, s: &Scene, lights: &SrbfSet) -> (Render
         luts,
         &s.hair,
         &s.sigma_a,
-        &s.fast,
+        &s.look,
         &lights.lights,
         &s.camera,
     )
@@ -82,8 +87,10 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
     let ctx = context();
     let luts = Luts::default_tables();
     let lights = SrbfSet::read(&envmaps().join("sunny.srbf.json")).expect("sunny fit");
-    for shadows in [false, true] {
-        let s = scene(400, 64, 48, shadows, Preset::Blond);
+    // Single scattering unshadowed; single and multiple scattering with shadows.
+    for (shadows, multiple) in [(false, false), (true, true)] {
+        let mut s = scene(400, 64, 48, shadows, Preset::Blond);
+        s.settings.multiple_scattering = multiple;
         let (_, frame) = render(&ctx, &luts, &s, &lights);
         let covered: Vec<usize> = frame.covered().collect();
         assert!(
@@ -94,22 +101,32 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         let pixels: Vec<usize> = covered
             .iter()
             .copied()
-            .step_by(covered.len() / 150)
+            // The CPU twin evaluates the grid corners on demand: fewer pixels with multiple scattering.
+            .step_by(covered.len() / if multiple { 40 } else { 100 })
             .collect();
         let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
         let pyramid = DensityPyramid::build(&volume);
-        let skip = s.settings.shadow_skip(&s.hair);
+        let (forward, dual) = (
+            ForwardTable::build(&s.params, REFERENCE_VARIANT),
+            DualTables::build(&s.params, REFERENCE_VARIANT),
+        );
+        let sources = GridSources {
+            pyramid: &pyramid,
+            forward: multiple.then_some((&volume, &forward)),
+            skip: s.settings.shadow_skip(&s.hair),
+        };
         let grid = s.settings.shadow_grid(&s.hair);
         let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
         let cpu = shade_pixels(&frame, &cam, &shading_hair, &pixels, |sp, wo| {
             shade_point(
                 &luts,
-                &s.fast,
+                &s.look.fast,
                 sp,
                 wo,
                 &lights.lights,
-                shadows.then_some((&pyramid, &grid, skip)),
+                shadows.then_some((&grid, &sources)),
+                multiple.then_some(&dual),
             )
         });
         let mut errors = Vec::new();
@@ -117,8 +134,10 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .iter()
             .map(|&i| frame.beauty[i][0] + frame.beauty[i][1] + frame.beauty[i][2])
             .fold(0.0f32, f32::max);
+        let mut ms_share = 0.0f32;
         for (k, &i) in pixels.iter().enumerate() {
-            for t in 0..3 {
+            ms_share += (cpu[k][3][1] + cpu[k][4][1]) / frame.beauty[i][1].max(1e-12);
+            for t in 0..5 {
                 for c in 0..3 {
                     let (g, r) = (frame.components[t][i][c], cpu[k][t][c]);
                     // Relative, with a floor of 1e-3 of the brightest pixel (dark TT pixels).
@@ -133,8 +152,9 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             errors[errors.len() - 1],
         );
         println!(
-            "shadows {shadows}: {} pixels x 3 lobes x RGB: median {median:.2e}, p99 {p99:.2e}, max {max:.2e}",
-            pixels.len()
+            "shadows {shadows}, multiple scattering {multiple}: {} pixels x 5 components x RGB: median {median:.2e}, p99 {p99:.2e}, max {max:.2e}; mean MS share of G {:.3}",
+            pixels.len(),
+            ms_share / pixels.len() as f32
         );
         assert!(max <= 0.01, "GPU and CPU twin differ by {max} (> 1%)");
     }

@@ -10,9 +10,8 @@ use std::time::Instant;
 use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::scene::{StandardScene, default_environment};
-use strandlight::render::{Camera, RenderSettings, Renderer};
+use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
-use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use strandlight::scattering::lut::Luts;
 
 #[derive(Args, Debug)]
@@ -29,9 +28,13 @@ pub struct BenchArgs {
     /// No self-shadowing.
     #[arg(long)]
     pub no_shadows: bool,
-    /// Rebuild the fiber-density volume every frame (as when geometry moves), so it is timed.
-    #[arg(long, default_value_t = true)]
-    pub rebuild_volume: bool,
+    /// Single scattering only.
+    #[arg(long)]
+    pub single_scattering: bool,
+    /// Keep the fiber-density volume and shadow grid between frames (what a parameter or camera
+    /// edit costs); by default they are rebuilt every frame, as when geometry moves, so they are timed.
+    #[arg(long)]
+    pub keep_volume: bool,
     /// Use a software adapter (lavapipe).
     #[arg(long)]
     pub software: bool,
@@ -45,6 +48,7 @@ struct SceneReport {
     scene: StandardScene,
     segments: usize,
     shadows: bool,
+    multiple_scattering: bool,
     frames: usize,
     /// CPU seconds: hairstyle generation, SRBF fit (S2's 41 lights; S1 and S3 use the committed
     /// 40-light fit), LUT build, renderer creation (uploads and pipelines).
@@ -104,7 +108,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let t = Instant::now();
         let luts = Luts::build();
         cpu.insert("lut_build", t.elapsed().as_secs_f64());
-        let params = FastHairParams::new(&Preset::Brown.params(), DEFAULT_QUADRATURE_SEGMENTS);
+        let look = HairLook::new(Preset::Brown.params());
         let (lo, hi) = hair.bounds();
         let aspect = scene.width as f32 / scene.height as f32;
         let camera = Camera::framing(lo, hi, 35.0, 10.0, aspect, 0.9);
@@ -112,18 +116,19 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             width: scene.width,
             height: scene.height,
             shadows: !args.no_shadows,
+            multiple_scattering: !args.single_scattering,
             ..Default::default()
         };
-        let sigma_a = vec![params.sigma_a_rgb(); hair.point_count()];
+        let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
         let t = Instant::now();
         let mut renderer = Renderer::new(
-            &ctx, settings, &luts, &hair, &sigma_a, &params, &lights, &camera,
+            &ctx, settings, &luts, &hair, &sigma_a, &look, &lights, &camera,
         )?;
         cpu.insert("renderer_creation", t.elapsed().as_secs_f64());
         let mut per_pass: BTreeMap<&'static str, Vec<f64>> = BTreeMap::new();
         let (mut totals, mut walls) = (Vec::new(), Vec::new());
         for f in 0..args.warmup + args.frames {
-            if args.rebuild_volume {
+            if !args.keep_volume {
                 renderer.mark_volume_dirty();
             }
             let t = Instant::now();
@@ -151,6 +156,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             scene,
             segments: hair.point_count() - hair.strand_count(),
             shadows: !args.no_shadows,
+            multiple_scattering: !args.single_scattering,
             frames: args.frames,
             cpu_seconds: cpu,
             gpu_ms_median: per_pass.into_iter().map(|(k, v)| (k, median(v))).collect(),

@@ -13,8 +13,7 @@ use strandlight::render::reference::{ReferenceScene, reference_frame};
 use strandlight::render::scene::{
     Environment, default_environment, generated_hair, load_environment,
 };
-use strandlight::render::{Camera, RenderSettings, Renderer};
-use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
+use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::lut::Luts;
 
 #[derive(Args, Debug)]
@@ -70,6 +69,15 @@ pub struct RenderArgs {
     /// No self-shadowing.
     #[arg(long)]
     pub no_shadows: bool,
+    /// Single scattering only (no dual scattering: MS.global and MS.local stay zero).
+    #[arg(long)]
+    pub single_scattering: bool,
+    /// Zinke's forward-scattering density factor d_f.
+    #[arg(long, default_value_t = 0.7)]
+    pub d_f: f32,
+    /// Zinke's backward-scattering density factor d_b.
+    #[arg(long, default_value_t = 0.7)]
+    pub d_b: f32,
     /// SRBF lights per shading pass (1..=16).
     #[arg(long, default_value_t = 16)]
     pub lights_per_pass: u32,
@@ -86,8 +94,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// Shade with the exact Marschner model under directions importance-sampled from the environment
-    /// image instead (CPU; same camera, visibility and shadow volume). Needs an .hdr / .exr environment
-    /// or the built-in one.
+    /// image instead (CPU; same camera, visibility and shadow volume; single scattering only). Needs an
+    /// .hdr / .exr environment or the built-in one.
     #[arg(long)]
     pub reference: bool,
     /// Directions sampled by --reference.
@@ -161,6 +169,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         samples: args.samples,
         exposure: args.exposure,
         shadows: !args.no_shadows,
+        multiple_scattering: !args.single_scattering,
         lights_per_pass: args.lights_per_pass,
         volume_resolution: args.volume_resolution,
         ..Default::default()
@@ -170,8 +179,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new_headless(&options)?;
     eprintln!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
     let luts = Luts::default_tables();
-    let fast = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS);
-    let sigma_a = vec![fast.sigma_a_rgb(); hair.point_count()];
+    if !(0.0..=1.0).contains(&args.d_f) || !(0.0..=1.0).contains(&args.d_b) {
+        bail!("--d-f and --d-b lie in [0, 1]");
+    }
+    let look = HairLook::new(params).with_dual(args.d_f, args.d_b);
+    let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
     let t = Instant::now();
     let mut renderer = Renderer::new(
         &ctx,
@@ -179,7 +191,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &luts,
         &hair,
         &sigma_a,
-        &fast,
+        &look,
         &env.lights.lights,
         &camera,
     )?;
@@ -238,6 +250,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         ("exposure_ev".to_string(), args.exposure.to_string()),
         ("samples".to_string(), args.samples.to_string()),
         ("shadows".to_string(), (!args.no_shadows).to_string()),
+        (
+            "multiple_scattering".to_string(),
+            format!(
+                "{} (d_f {}, d_b {})",
+                !args.single_scattering, args.d_f, args.d_b
+            ),
+        ),
         ("adapter".to_string(), ctx.summary.name.clone()),
         ("mode".to_string(), mode),
     ];

@@ -22,14 +22,19 @@ pub struct ForwardQuery {
 
 const _: () = assert!(std::mem::size_of::<ForwardQuery>() == 32);
 
-/// The table as (a_f, beta_f^2) pairs, theta fastest (rebuilt when eta, alpha or beta change).
-pub fn upload_forward_table(device: &wgpu::Device, table: &ForwardTable) -> wgpu::Buffer {
-    let pairs: Vec<[f32; 2]> = table
+/// The table as (a_f, beta_f^2) pairs, theta fastest, as the shaders read it.
+pub fn forward_table_texels(table: &ForwardTable) -> Vec<[f32; 2]> {
+    table
         .a_f
         .iter()
         .zip(&table.beta_f2)
         .map(|(a, b)| [*a, *b])
-        .collect();
+        .collect()
+}
+
+/// The table as a storage buffer (rebuilt when eta, alpha or beta change).
+pub fn upload_forward_table(device: &wgpu::Device, table: &ForwardTable) -> wgpu::Buffer {
+    let pairs = forward_table_texels(table);
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("forward table"),
         contents: bytemuck::cast_slice(&pairs),

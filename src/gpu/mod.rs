@@ -2,6 +2,7 @@
 
 pub mod context;
 pub mod density_pyramid;
+pub mod dual_eval;
 pub mod fast_eval;
 pub mod fiber_density;
 pub mod forward;

@@ -16,14 +16,23 @@ pub const CAMERA: &str = include_str!("../../shaders/camera.wgsl");
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const SHADING: &str = include_str!("../../shaders/shading.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
+pub const DUAL_RESPONSE: &str = include_str!("../../shaders/dual_response.wgsl");
+pub const DUAL_EVAL: &str = include_str!("../../shaders/dual_eval.wgsl");
+
+/// The dual-scattering test harness: the fast model, the dual responses, bindings and entry point.
+pub fn dual_eval_module() -> String {
+    [fast_model_library().as_str(), DUAL_RESPONSE, DUAL_EVAL].join("\n")
+}
+
 pub const SHADOW_GRID: &str = include_str!("../../shaders/shadow_grid.wgsl");
 pub const SHADOW_GRID_BUILD: &str = include_str!("../../shaders/shadow_grid_build.wgsl");
 
-/// The shadow-grid build pass: cone marching and the grid.
+/// The shadow-grid build pass: cone marching, forward scattering and the grid.
 pub fn shadow_grid_build_module() -> String {
     [
         CIRCULAR_GAUSSIAN,
         DENSITY_PYRAMID,
+        FORWARD_SCATTERING,
         SHADOW_GRID,
         SHADOW_GRID_BUILD,
     ]
@@ -35,9 +44,16 @@ pub fn visibility_module() -> String {
     [CIRCULAR_GAUSSIAN, CAMERA, VISIBILITY].join("\n")
 }
 
-/// The shading pass: the fast model, the shadow-grid lookup, camera, and the kernel.
+/// The shading pass: the fast model, dual scattering, the shadow-grid lookup, camera, and the kernel.
 pub fn shading_module() -> String {
-    [fast_model_library().as_str(), SHADOW_GRID, CAMERA, SHADING].join("\n")
+    [
+        fast_model_library().as_str(),
+        DUAL_RESPONSE,
+        SHADOW_GRID,
+        CAMERA,
+        SHADING,
+    ]
+    .join("\n")
 }
 
 /// The resolve pass.
@@ -93,5 +109,6 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ("shading", shading_module()),
         ("resolve", resolve_module()),
         ("shadow_grid_build", shadow_grid_build_module()),
+        ("dual_eval", dual_eval_module()),
     ]
 }

@@ -55,12 +55,12 @@ impl Frame {
         (0..self.pixel_count()).filter(|&i| self.beauty[i][3] > 0.0)
     }
 
-    /// The same coverage and depth with other shading: `radiance[k]` (R, TT, TRT, before exposure) for
-    /// pixel `pixels[k]`, every other pixel and the multiple-scattering components zero.
-    pub fn with_lobes(
+    /// The same coverage and depth with other shading: `radiance[k]` (the components, before exposure)
+    /// for pixel `pixels[k]`, every other pixel zero.
+    pub fn with_components(
         &self,
         pixels: &[usize],
-        radiance: &[[[f32; 3]; 3]],
+        radiance: &[[[f32; 3]; 5]],
         exposure_scale: f32,
     ) -> Frame {
         let n = self.pixel_count();
@@ -72,7 +72,7 @@ impl Frame {
             px[2] = 0.0;
         }
         for (&i, l) in pixels.iter().zip(radiance) {
-            for t in 0..3 {
+            for t in 0..COMPONENTS.len() {
                 let v = l[t].map(|x| x * exposure_scale);
                 out.components[t][i] = v;
                 for c in 0..3 {

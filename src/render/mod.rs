@@ -16,4 +16,4 @@ pub mod visibility;
 
 pub use camera::Camera;
 pub use frame::Frame;
-pub use renderer::{RenderError, RenderSettings, Renderer};
+pub use renderer::{HairLook, RenderError, RenderSettings, Renderer};

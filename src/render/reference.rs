@@ -114,7 +114,11 @@ pub fn reference_shade(
             }
         }
     }
-    out.map(|l| l.map(|x| x as f32))
+    let mut radiance = [[0.0; 3]; 5];
+    for t in 0..3 {
+        radiance[t] = out[t].map(|x| x as f32);
+    }
+    radiance
 }
 
 /// What the reference needs besides the visibility of a frame.
@@ -132,7 +136,8 @@ pub struct ReferenceScene<'a> {
 }
 
 /// The reference shading of the points the GPU frame sees (same coverage, depth and ids); its
-/// components R, TT, TRT replace the frame's, multiple scattering is zero, the exposure is applied.
+/// components R, TT, TRT replace the frame's, multiple scattering is zero (single scattering only: the
+/// multiple-scattering reference is still to come), the exposure is applied.
 pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::Frame {
     let lights = importance_sample_env(scene.env, scene.directions, scene.yaw, 7);
     let settings = scene.settings;
@@ -149,5 +154,5 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
     let radiance = super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
         reference_shade(scene.params, sp, wo, &lights, shadows)
     });
-    frame.with_lobes(&pixels, &radiance, settings.exposure.exp2())
+    frame.with_components(&pixels, &radiance, settings.exposure.exp2())
 }

@@ -6,20 +6,28 @@
 use super::camera::Camera;
 use super::frame::Frame;
 use super::resolve::{ResolveInfo, ResolvePass};
-use super::shading::{FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass};
-use super::shadow_grid::{GpuShadowGrid, ShadowGridPass};
+use super::shading::{
+    FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass,
+};
+use super::shadow_grid::{GpuShadowGrid, ShadowGridInputs, ShadowGridPass};
 use super::targets::{FrameTargets, MAX_SEGMENTS};
 use super::timing::PassTimer;
 use super::visibility::VisibilityPass;
 use crate::envmap::SrbfLight;
 use crate::gpu::GpuContext;
 use crate::gpu::density_pyramid::{DensityPyramidPass, GpuDensityPyramid};
+use crate::gpu::dual_eval::dual_tables_texels;
 use crate::gpu::fast_eval::GpuLuts;
 use crate::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
+use crate::gpu::forward::{forward_table_texels, upload_forward_table};
 use crate::hair::Hair;
-use crate::scattering::fast_params::FastHairParams;
+use crate::render::reference::REFERENCE_VARIANT;
+use crate::scattering::dual_terms::DualTables;
+use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use crate::scattering::lut::Luts;
+use crate::scattering::params::HairParams;
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
+use crate::shadow::forward::ForwardTable;
 use crate::shadow::grid::ShadowGrid;
 use wgpu::util::DeviceExt;
 
@@ -47,6 +55,39 @@ pub enum RenderError {
     Gpu(String),
 }
 
+/// The hair parameters in both forms: the exact ones (for the tables built on the CPU) and the fast
+/// model's uniform (quadrature segments, d_f, d_b).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HairLook {
+    pub params: HairParams,
+    pub fast: FastHairParams,
+}
+
+impl HairLook {
+    /// Xu's m = 4 segments and Zinke's d_f = d_b = 0.7.
+    pub fn new(params: HairParams) -> Self {
+        Self {
+            params,
+            fast: FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS),
+        }
+    }
+
+    pub fn with_dual(mut self, d_f: f32, d_b: f32) -> Self {
+        self.fast.d_f = d_f;
+        self.fast.d_b = d_b;
+        self
+    }
+}
+
+/// The tables that depend on hair parameters and are built on the CPU: the forward table (eta, alpha,
+/// beta; read per crossed fiber's absorption) and the dual-scattering tables (all parameters).
+fn build_tables(params: &HairParams) -> (ForwardTable, DualTables) {
+    rayon::join(
+        || ForwardTable::build(params, REFERENCE_VARIANT),
+        || DualTables::build(params, REFERENCE_VARIANT),
+    )
+}
+
 /// What does not change from frame to frame without rebuilding targets.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -57,6 +98,8 @@ pub struct RenderSettings {
     /// Exposure in stops applied by the resolve pass.
     pub exposure: f32,
     pub shadows: bool,
+    /// Dual scattering (MS.global, MS.local) on top of single scattering.
+    pub multiple_scattering: bool,
     /// Ribbons are at least this many pixels wide.
     pub min_width_px: f32,
     /// SRBF lights per shading pass (at most 16).
@@ -77,6 +120,7 @@ impl Default for RenderSettings {
             samples: 4,
             exposure: 0.0,
             shadows: true,
+            multiple_scattering: true,
             min_width_px: 1.0,
             lights_per_pass: 16,
             volume_resolution: 128,
@@ -120,7 +164,10 @@ pub struct Renderer {
     pyramid: GpuDensityPyramid,
     shadow_grid: GpuShadowGrid,
     luts: GpuLuts,
+    look: HairLook,
     params: wgpu::Buffer,
+    forward_table: wgpu::Buffer,
+    dual_tables: wgpu::Buffer,
     camera: wgpu::Buffer,
     lights: wgpu::Buffer,
     light_count: u32,
@@ -164,7 +211,7 @@ impl Renderer {
         luts: &Luts,
         hair: &Hair,
         sigma_a: &[[f32; 3]],
-        params: &FastHairParams,
+        look: &HairLook,
         lights: &[SrbfLight],
         camera: &Camera,
     ) -> Result<Self, RenderError> {
@@ -213,7 +260,16 @@ impl Renderer {
             settings.shadow_grid(hair),
             lights.len() as u32,
             skip,
+            settings.multiple_scattering,
         );
+        let (forward, dual) = build_tables(&look.params);
+        let storage = |label: &str, bytes: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            })
+        };
         let mut renderer = Self {
             hair: gpu_hair,
             point_count: hair.point_count(),
@@ -222,7 +278,13 @@ impl Renderer {
             pyramid,
             shadow_grid,
             luts: GpuLuts::new(device, luts),
-            params: uniform("hair params", bytemuck::bytes_of(params)),
+            look: *look,
+            params: uniform("hair params", bytemuck::bytes_of(&look.fast)),
+            forward_table: upload_forward_table(device, &forward),
+            dual_tables: storage(
+                "dual tables",
+                bytemuck::cast_slice(&dual_tables_texels(&dual)),
+            ),
             camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
             lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("lights"),
@@ -249,11 +311,13 @@ impl Renderer {
     }
 
     fn update_batches(&mut self, device: &wgpu::Device) {
-        let flags = if self.settings.shadows {
-            FLAG_SHADOWS
-        } else {
-            0
-        };
+        let mut flags = 0;
+        if self.settings.shadows {
+            flags |= FLAG_SHADOWS;
+        }
+        if self.settings.multiple_scattering {
+            flags |= FLAG_MULTIPLE_SCATTERING;
+        }
         let samples = self.settings.samples;
         let batches: Vec<ShadeBatch> =
             ShadingPass::batches(self.light_count, self.settings.lights_per_pass)
@@ -272,10 +336,28 @@ impl Renderer {
         self.shading_pass.set_batches(device, &batches);
     }
 
-    /// Hair parameters changed (no geometry, pipeline or volume rebuild).
-    pub fn set_params(&self, ctx: &GpuContext, params: &FastHairParams) {
+    /// Hair parameters changed: the uniform is rewritten; when the exact parameters changed, the
+    /// forward and dual-scattering tables are rebuilt on the CPU and uploaded, and the shadow grid
+    /// (whose T_f reads the forward table) is marked for rebuilding. No geometry, pipeline or volume
+    /// rebuild.
+    pub fn set_params(&mut self, ctx: &GpuContext, look: &HairLook) {
         ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
+        if look.params != self.look.params {
+            let (forward, dual) = build_tables(&look.params);
+            ctx.queue.write_buffer(
+                &self.forward_table,
+                0,
+                bytemuck::cast_slice(&forward_table_texels(&forward)),
+            );
+            ctx.queue.write_buffer(
+                &self.dual_tables,
+                0,
+                bytemuck::cast_slice(&dual_tables_texels(&dual)),
+            );
+            self.shadow_grid_dirty |= self.settings.multiple_scattering;
+        }
+        self.look = *look;
     }
 
     pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) {
@@ -329,6 +411,7 @@ impl Renderer {
                 self.shadow_grid.grid,
                 self.light_count,
                 self.skip,
+                self.settings.multiple_scattering,
             );
         }
         self.shadow_grid_dirty = true;
@@ -377,11 +460,16 @@ impl Renderer {
             self.shadow_grid_dirty = true;
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
+            let inputs = ShadowGridInputs {
+                pyramid: &self.pyramid,
+                volume: &self.volume,
+                forward_table: &self.forward_table,
+                lights: &self.lights,
+            };
             self.shadow_grid_pass.encode(
                 device,
                 &mut enc,
-                &self.pyramid,
-                &self.lights,
+                &inputs,
                 &self.shadow_grid,
                 timer.and_then(|t| t.compute_writes("shadow_grid")),
             );
@@ -406,6 +494,7 @@ impl Renderer {
             lights: &self.lights,
             luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
             shadow_values: &self.shadow_grid.values,
+            dual_tables: &self.dual_tables,
         };
         self.shading_pass.encode(
             device,

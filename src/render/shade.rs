@@ -5,19 +5,23 @@
 use super::camera::{CameraUniform, closest_on_segment, pixel_ray};
 use super::frame::Frame;
 use crate::envmap::SrbfLight;
+use crate::envmap::srbf::srbf_integral;
 use crate::hair::Hair;
+use crate::scattering::dual_response::{
+    dual_scattering_components, global_response_lobe, local_response,
+};
+use crate::scattering::dual_terms::DualTables;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::fast_response::{SrbfInFrame, srbf_response};
 use crate::scattering::lut::Luts;
-use crate::shadow::cone::DensityPyramid;
-use crate::shadow::grid::ShadowGrid;
+use crate::shadow::grid::{GridShadow, GridSources, ShadowGrid};
 use glam::Vec3;
 use rayon::prelude::*;
 
 pub type Rgb = [f32; 3];
 
-/// Radiance per lobe (R, TT, TRT).
-pub type LobeRadiance = [Rgb; 3];
+/// Radiance per component (R, TT, TRT, MS.global, MS.local).
+pub type LobeRadiance = [Rgb; 5];
 
 /// A visible point on a fiber.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,12 +88,12 @@ pub fn fiber_angles(frame: (Vec3, Vec3, Vec3), omega: Vec3) -> (f32, f32) {
     )
 }
 
-/// Where the shading pass reads shadows from: the pyramid the grid points were marched through, the
-/// grid, and the skipped distance.
-pub type GridShadows<'a> = (&'a DensityPyramid, &'a ShadowGrid, f32);
+/// Where the shading pass reads shadows from: the grid and what it is built from.
+pub type GridShadows<'a> = (&'a ShadowGrid, &'a GridSources<'a>);
 
 /// `shade_point` of the WGSL: lights' R, TT, TRT radiance towards omega_o, each light scaled by its
-/// transmittance read from the shadow grid when shadows are given.
+/// transmittance read from the shadow grid when shadows are given; with `dual` (the dual-scattering
+/// tables), also MS.global and MS.local.
 pub fn shade_point(
     luts: &Luts,
     params: &FastHairParams,
@@ -97,24 +101,57 @@ pub fn shade_point(
     omega_o: Vec3,
     lights: &[SrbfLight],
     shadows: Option<GridShadows>,
+    dual: Option<&DualTables>,
 ) -> LobeRadiance {
     let mut p = *params;
     p.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
     let frame = fiber_frame(sp.tangent);
     let (theta_o, phi_o) = fiber_angles(frame, omega_o);
-    let mut out = [[0.0; 3]; 3];
+    let mut out = [[0.0; 3]; 5];
     for l in lights {
         let dir = l.dir().normalize().as_vec3();
         let lambda = l.lambda as f32;
         let (theta, phi) = fiber_angles(frame, dir);
-        let vis = shadows.map_or(1.0, |(pyr, grid, skip)| {
-            grid.transmittance(pyr, sp.position, dir, lambda, skip)
-        });
-        let m = srbf_response(luts, &p, SrbfInFrame { theta, phi, lambda }, theta_o, phi_o);
+        let sh = shadows.map_or(
+            GridShadow {
+                transmittance: 1.0,
+                transmittance_f: [1.0; 3],
+                sigma_f2: [0.0; 3],
+            },
+            |(grid, src)| grid.shadow(src, sp.position, dir, lambda),
+        );
+        let light = SrbfInFrame { theta, phi, lambda };
+        let m = srbf_response(luts, &p, light, theta_o, phi_o);
         for t in 0..3 {
             for c in 0..3 {
-                out[t][c] += vis * l.rgb[c] as f32 * m[t][c];
+                out[t][c] += sh.transmittance * l.rgb[c] as f32 * m[t][c];
             }
+        }
+        let Some(tables) = dual else {
+            continue;
+        };
+        let s2 = (sh.sigma_f2[0] + sh.sigma_f2[1] + sh.sigma_f2[2]) / 3.0;
+        let mut global = [0.0; 3];
+        for t in 0..3 {
+            let g = global_response_lobe(&p, t, light, theta_o, phi_o, s2);
+            for c in 0..3 {
+                global[c] += g[c];
+            }
+        }
+        let local = local_response(&p, tables, light, theta_o, phi_o, s2);
+        let local_direct = local_response(&p, tables, light, theta_o, phi_o, 0.0);
+        let (ms_global, ms_local) = dual_scattering_components(
+            &p,
+            sh.transmittance,
+            sh.transmittance_f,
+            local_direct,
+            global,
+            local,
+        );
+        let power = srbf_integral(l.lambda) as f32;
+        for c in 0..3 {
+            out[3][c] += power * l.rgb[c] as f32 * ms_global[c];
+            out[4][c] += power * l.rgb[c] as f32 * ms_local[c];
         }
     }
     out
@@ -152,12 +189,12 @@ pub fn shade_pixels(
                 (i / frame.width as usize) as f32,
             );
             let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
-            let mut acc = [[0.0; 3]; 3];
+            let mut acc = [[0.0; 3]; 5];
             for (id, count) in distinct_samples(ids) {
                 let sp = hair.shading_point(id - 1, origin, dir);
                 let l = shade(&sp, -dir);
                 let w = count as f32 / frame.samples as f32;
-                for t in 0..3 {
+                for t in 0..5 {
                     for c in 0..3 {
                         acc[t][c] += w * l[t][c];
                     }

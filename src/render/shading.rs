@@ -1,6 +1,7 @@
 //! The shading passes (`shaders/shading.wgsl`): one dispatch per batch of at most
 //! [`MAX_LIGHTS_PER_PASS`] SRBF lights (Xu 2011's multi-pass scheme), each adding its lights' R, TT and
-//! TRT radiance to the component buffers; one dispatch per visibility sample within a batch.
+//! TRT radiance (and with multiple scattering MS.global and MS.local) to the component buffers; one
+//! dispatch per visibility sample within a batch.
 
 use super::targets::FrameTargets;
 use crate::gpu::context::compute_pipeline;
@@ -10,6 +11,7 @@ use wgpu::util::DeviceExt;
 
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
+pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
@@ -48,6 +50,7 @@ pub struct ShadingInputs<'a> {
     pub lights: &'a wgpu::Buffer,
     pub luts: [&'a wgpu::Buffer; 3],
     pub shadow_values: &'a wgpu::Buffer,
+    pub dual_tables: &'a wgpu::Buffer,
 }
 
 pub struct ShadingPass {
@@ -132,12 +135,16 @@ impl ShadingPass {
                     binding: 12,
                     resource: wgpu::BindingResource::TextureView(&targets.visibility),
                 });
-                for (k, b) in targets.components[..3].iter().enumerate() {
+                for (k, b) in targets.components.iter().enumerate() {
                     entries.push(wgpu::BindGroupEntry {
                         binding: 13 + k as u32,
                         resource: b.as_entire_binding(),
                     });
                 }
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 18,
+                    resource: inputs.dual_tables.as_entire_binding(),
+                });
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("shading"),
                     layout: &self.pipeline.get_bind_group_layout(0),

@@ -1,11 +1,11 @@
 //! The shadow-grid pass (`shaders/shadow_grid_build.wgsl`): every light's cone-marched transmittance
-//! at every point of a coarse grid, rebuilt when the volume or the lights change
-//! ([`crate::shadow::grid`] is the CPU twin).
+//! and forward-scattering terms at every point of a coarse grid, rebuilt when the volume, the lights
+//! or the forward table change ([`crate::shadow::grid`] is the CPU twin).
 
 use super::shading::GpuLight;
 use crate::gpu::context::compute_pipeline;
 use crate::gpu::density_pyramid::GpuDensityPyramid;
-use crate::gpu::fiber_density::dispatch_2d;
+use crate::gpu::fiber_density::{GpuFiberDensity, dispatch_2d};
 use crate::gpu::shaders;
 use crate::shadow::grid::ShadowGrid;
 use bytemuck::{Pod, Zeroable};
@@ -19,28 +19,39 @@ pub struct ShadowGridInfo {
     pub dims: [u32; 3],
     pub light_count: u32,
     pub skip: f32,
-    pub _pad: [f32; 3],
+    /// 1: the forward-scattering terms are computed (multiple scattering on).
+    pub forward: u32,
+    pub _pad: [f32; 2],
 }
 
 const _: () = assert!(std::mem::size_of::<ShadowGridInfo>() == 48);
 
-/// The grid's uniform and its values (one f32 per grid point and light, light-major).
+/// The grid's uniform and its values (two vec4 per grid point and light, light-major: transmittance,
+/// T_f RGB; sigma_f^2 RGB, direct fraction of the forward march).
 pub struct GpuShadowGrid {
     pub grid: ShadowGrid,
     pub info: wgpu::Buffer,
     pub values: wgpu::Buffer,
     pub light_count: u32,
+    pub forward: bool,
 }
 
 impl GpuShadowGrid {
-    pub fn new(device: &wgpu::Device, grid: ShadowGrid, light_count: u32, skip: f32) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        grid: ShadowGrid,
+        light_count: u32,
+        skip: f32,
+        forward: bool,
+    ) -> Self {
         let info = ShadowGridInfo {
             origin: grid.origin.to_array(),
             spacing: grid.spacing,
             dims: grid.dims,
             light_count,
             skip,
-            _pad: [0.0; 3],
+            forward: forward as u32,
+            _pad: [0.0; 2],
         };
         Self {
             grid,
@@ -51,13 +62,22 @@ impl GpuShadowGrid {
             }),
             values: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("shadow grid"),
-                size: (grid.point_count() as u64 * light_count.max(1) as u64 * 4).max(4),
+                size: grid.point_count() as u64 * light_count.max(1) as u64 * 32,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
             light_count,
+            forward,
         }
     }
+}
+
+/// What the grid is built from.
+pub struct ShadowGridInputs<'a> {
+    pub pyramid: &'a GpuDensityPyramid,
+    pub volume: &'a GpuFiberDensity,
+    pub forward_table: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
 }
 
 pub struct ShadowGridPass {
@@ -79,17 +99,19 @@ impl ShadowGridPass {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        pyramid: &GpuDensityPyramid,
-        lights: &wgpu::Buffer,
+        inputs: &ShadowGridInputs,
         target: &GpuShadowGrid,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let buffers = [
-            &pyramid.info_buffer,
-            &pyramid.pyramid,
+            &inputs.pyramid.info_buffer,
+            &inputs.pyramid.pyramid,
             &target.info,
-            lights,
+            inputs.lights,
             &target.values,
+            &inputs.volume.info,
+            &inputs.volume.volume,
+            inputs.forward_table,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()

@@ -97,24 +97,25 @@ pub fn local_response(
     out
 }
 
-/// Zinke's shader (Fig. 5) per SRBF light: the direct part carries single scattering plus d_b f_back, the
-/// forward-scattered part (T_f - direct fraction) d_f (global + d_b local). `single` is M_R + M_TT + M_TRT,
-/// `local_direct` the local term with sigma_f = 0, `global` and `local` with the supplied sigma_f^2.
-/// Returns (direct, scattered) per channel; their sum is the light's response. Zinke's pseudo code
-/// multiplies f_back by pi in the scattered part because its f_back still holds s_b = 1/pi for one
-/// azimuth; Xu's M^L has already integrated the azimuthal spread (Eq. 30), so no pi appears here.
-pub fn dual_scattering_combine(
+/// Zinke's shader (Fig. 5) per SRBF light, split into the renderer's components. The direct part
+/// (direct fraction D) carries single scattering (not here: the R, TT, TRT components) plus d_b f_back;
+/// the forward-scattered part (T_f - D) d_f carries global + d_b local. `local_direct` is the local term
+/// with sigma_f = 0, `global` (summed over lobes) and `local` with the path's sigma_f^2. Returns
+/// (MS.global, MS.local) per unit light power. Zinke's pseudo code multiplies f_back by pi in the
+/// scattered part because its f_back still holds s_b = 1/pi for one azimuth; Xu's M^L has already
+/// integrated the azimuthal spread (Eq. 30), so no pi appears here.
+pub fn dual_scattering_components(
     p: &FastHairParams,
     direct_fraction: f32,
     transmittance_f: Rgb32,
-    single: Rgb32,
     local_direct: Rgb32,
     global: Rgb32,
     local: Rgb32,
 ) -> (Rgb32, Rgb32) {
-    let direct = std::array::from_fn(|c| direct_fraction * (single[c] + p.d_b * local_direct[c]));
-    let scattered = std::array::from_fn(|c| {
-        (transmittance_f[c] - direct_fraction).max(0.0) * p.d_f * (global[c] + p.d_b * local[c])
+    let scattered = transmittance_f.map(|t| (t - direct_fraction).max(0.0) * p.d_f);
+    let ms_global = std::array::from_fn(|c| scattered[c] * global[c]);
+    let ms_local = std::array::from_fn(|c| {
+        direct_fraction * p.d_b * local_direct[c] + scattered[c] * p.d_b * local[c]
     });
-    (direct, scattered)
+    (ms_global, ms_local)
 }

@@ -176,28 +176,38 @@ impl DensityPyramid {
     /// ring wide. Averaging exp(-tau) over seven cones keeps wide lights' far tails (which reach round
     /// the hair) and most of the Jensen gap that one averaged tau misses.
     pub fn srbf_transmittance(&self, p: Vec3, centre: Vec3, lambda: f32, skip: f32) -> f32 {
-        let kappa = 2.0 / (lambda * lambda);
-        let e = (-2.0 * kappa).exp();
-        let quantile = |q: f32| (1.0 + (q * (1.0 - e) + e).ln() / kappa).clamp(-1.0, 1.0);
-        let inner = quantile(0.5).acos();
-        if inner < 0.05 {
-            return (-self.cone_optical_depth(p, centre, inner.max(1e-4), skip)).exp();
-        }
-        let ring = quantile(0.25).acos();
-        let e1 = if centre.x.abs() < 0.9 {
-            Vec3::X
-        } else {
-            Vec3::Y
-        };
-        let e1 = (e1 - centre * centre.dot(e1)).normalize();
-        let e2 = centre.cross(e1);
-        let sub = (ring * std::f32::consts::PI / 6.0).min(ring);
-        let mut t = 0.5 * (-self.cone_optical_depth(p, centre, inner, skip)).exp();
-        for k in 0..6 {
-            let a = k as f32 * std::f32::consts::TAU / 6.0;
-            let d = (centre * ring.cos() + (e1 * a.cos() + e2 * a.sin()) * ring.sin()).normalize();
-            t += (0.5 / 6.0) * (-self.cone_optical_depth(p, d, sub, skip)).exp();
-        }
-        t
+        srbf_cones(centre, lambda)
+            .into_iter()
+            .map(|(d, half_angle, w)| w * (-self.cone_optical_depth(p, d, half_angle, skip)).exp())
+            .sum()
     }
+}
+
+/// The cones of [`DensityPyramid::srbf_transmittance`]: (direction, half-angle, weight). One cone of
+/// half-angle max(inner, 1e-4) when the inner half of G is narrower than 0.05 rad, else the central cone
+/// (weight 1/2) and six on the ring (1/12 each).
+pub fn srbf_cones(centre: Vec3, lambda: f32) -> Vec<(Vec3, f32, f32)> {
+    let kappa = 2.0 / (lambda * lambda);
+    let e = (-2.0 * kappa).exp();
+    let quantile = |q: f32| (1.0 + (q * (1.0 - e) + e).ln() / kappa).clamp(-1.0, 1.0);
+    let inner = quantile(0.5).acos();
+    if inner < 0.05 {
+        return vec![(centre, inner.max(1e-4), 1.0)];
+    }
+    let ring = quantile(0.25).acos();
+    let e1 = if centre.x.abs() < 0.9 {
+        Vec3::X
+    } else {
+        Vec3::Y
+    };
+    let e1 = (e1 - centre * centre.dot(e1)).normalize();
+    let e2 = centre.cross(e1);
+    let sub = (ring * std::f32::consts::PI / 6.0).min(ring);
+    let mut cones = vec![(centre, inner, 0.5)];
+    for k in 0..6 {
+        let a = k as f32 * std::f32::consts::TAU / 6.0;
+        let d = (centre * ring.cos() + (e1 * a.cos() + e2 * a.sin()) * ring.sin()).normalize();
+        cones.push((d, sub, 0.5 / 6.0));
+    }
+    cones
 }

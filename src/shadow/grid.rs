@@ -1,11 +1,60 @@
-//! Per-light transmittance on a coarse grid over the hair: every SRBF light's cone-marched
-//! transmittance is evaluated once per grid point (when geometry, absorption or lights change) and
-//! read trilinearly by the shading pass, instead of once per shaded sample and light. A parameter edit
-//! or a camera move recomputes nothing. Twin of `shaders/shadow_grid.wgsl`.
+//! Per-light shadows on a coarse grid over the hair: every SRBF light's cone-marched transmittance
+//! and, for multiple scattering, its forward-scattering terms (T_f, sigma_f^2, averaged over the same
+//! cones) are evaluated once per grid point (when geometry, absorption, lights or the forward table
+//! change) and read trilinearly by the shading pass, instead of once per shaded sample and light. A
+//! camera move recomputes nothing. Twin of `shaders/shadow_grid.wgsl` and `shadow_grid_build.wgsl`.
 
-use super::cone::DensityPyramid;
-use super::fiber_density::VolumeGrid;
+use super::cone::{DensityPyramid, srbf_cones};
+use super::fiber_density::{FiberDensity, VolumeGrid};
+use super::forward::{ForwardScattering, ForwardTable, forward_scattering};
 use glam::Vec3;
+
+/// Floor of the stored transmittances (they are stored as logarithms).
+pub const GRID_MIN_TRANSMITTANCE: f32 = 1e-8;
+
+/// What the shading pass reads per light at a point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GridShadow {
+    /// Cone-marched transmittance (the direct fraction of single scattering).
+    pub transmittance: f32,
+    pub transmittance_f: [f32; 3],
+    pub sigma_f2: [f32; 3],
+}
+
+/// forward_scattering averaged over the cones of `srbf_transmittance` (twin of `srbf_forward` in
+/// `shaders/shadow_grid_build.wgsl`); sigma_f^2 is averaged over the crossed part.
+pub fn srbf_forward(
+    volume: &FiberDensity,
+    table: &ForwardTable,
+    p: Vec3,
+    centre: Vec3,
+    lambda: f32,
+    skip: f32,
+) -> ForwardScattering {
+    let (mut direct, mut tf, mut spread, mut crossed) = (0.0, [0.0; 3], [0.0; 3], 0.0);
+    for (d, _, w) in srbf_cones(centre, lambda) {
+        let f = forward_scattering(volume, table, p, d, skip);
+        direct += w * f.direct_fraction;
+        crossed += w * (1.0 - f.direct_fraction);
+        for c in 0..3 {
+            tf[c] += w * f.transmittance_f[c];
+            spread[c] += w * (1.0 - f.direct_fraction) * f.sigma_f2[c];
+        }
+    }
+    ForwardScattering {
+        direct_fraction: direct,
+        transmittance_f: tf,
+        sigma_f2: spread.map(|s| s / crossed.max(1e-12)),
+    }
+}
+
+/// The sources the grid is built from (CPU twin).
+pub struct GridSources<'a> {
+    pub pyramid: &'a DensityPyramid,
+    /// With the forward table: multiple scattering on.
+    pub forward: Option<(&'a FiberDensity, &'a ForwardTable)>,
+    pub skip: f32,
+}
 
 /// Grid points at the centres of cells of side `spacing` covering the volume's box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,24 +112,46 @@ impl ShadowGrid {
         })
     }
 
-    /// The grid's reading of a light's transmittance at p, each corner evaluated on demand (tests).
-    pub fn transmittance(
-        &self,
-        pyramid: &DensityPyramid,
-        p: Vec3,
-        centre: Vec3,
-        lambda: f32,
-        skip: f32,
-    ) -> f32 {
-        self.corners(p)
-            .iter()
-            .map(|&(i, w)| {
-                if w == 0.0 {
-                    0.0
-                } else {
-                    w * pyramid.srbf_transmittance(self.point(i), centre, lambda, skip)
+    /// What the build pass stores at grid point i for a light (transmittances as logarithms, floored
+    /// at [`GRID_MIN_TRANSMITTANCE`]).
+    pub fn value(&self, src: &GridSources, i: usize, centre: Vec3, lambda: f32) -> GridShadow {
+        let x = self.point(i);
+        let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
+        let t = ln(src.pyramid.srbf_transmittance(x, centre, lambda, src.skip));
+        match src.forward {
+            None => GridShadow {
+                transmittance: t,
+                transmittance_f: [t; 3],
+                sigma_f2: [0.0; 3],
+            },
+            Some((volume, table)) => {
+                let f = srbf_forward(volume, table, x, centre, lambda, src.skip);
+                GridShadow {
+                    transmittance: t,
+                    transmittance_f: f.transmittance_f.map(ln),
+                    sigma_f2: f.sigma_f2,
                 }
-            })
-            .sum()
+            }
+        }
+    }
+
+    /// The grid's trilinear reading at p (of the logarithms, for the transmittances), each corner
+    /// evaluated on demand (tests).
+    pub fn shadow(&self, src: &GridSources, p: Vec3, centre: Vec3, lambda: f32) -> GridShadow {
+        let mut out = GridShadow::default();
+        for (i, w) in self.corners(p) {
+            if w == 0.0 {
+                continue;
+            }
+            let v = self.value(src, i, centre, lambda);
+            out.transmittance += w * v.transmittance;
+            for c in 0..3 {
+                out.transmittance_f[c] += w * v.transmittance_f[c];
+                out.sigma_f2[c] += w * v.sigma_f2[c];
+            }
+        }
+        out.transmittance = out.transmittance.exp();
+        out.transmittance_f = out.transmittance_f.map(f32::exp);
+        out
     }
 }

@@ -1,0 +1,52 @@
+//! Dual scattering on the GPU (`shaders/dual_response.wgsl`): the DualTables as a storage buffer (the
+//! renderer binds the same) and a batch evaluator that tests the WGSL against
+//! [`crate::scattering::dual_response`].
+
+use super::context::{GpuContext, compute_pipeline};
+use super::fast_eval::FastQuery;
+use super::shaders;
+use crate::scattering::dual_terms::DualTables;
+use wgpu::util::DeviceExt;
+
+/// A_b, Delta_b, sigma_b per sample (3 vec4), then the prefix sums of Delta_b and sigma_b (2 vec4 per
+/// entry), as `dual_response.wgsl` reads them.
+pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
+    let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
+    let mut out: Vec<[f32; 4]> = t
+        .samples
+        .iter()
+        .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b)])
+        .collect();
+    for (d, s) in t.sat_delta.iter().zip(&t.sat_sigma) {
+        out.push(v4(*d));
+        out.push(v4(*s));
+    }
+    out
+}
+
+pub fn upload_dual_tables(device: &wgpu::Device, t: &DualTables) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("dual tables"),
+        contents: bytemuck::cast_slice(&dual_tables_texels(t)),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+/// M_R^G, M_TT^G, M_TRT^G, M^L (RGB) per query; the query's `_pad[0]` is sigma_f^2.
+pub fn evaluate_dual(
+    ctx: &GpuContext,
+    tables: &wgpu::Buffer,
+    queries: &[FastQuery],
+) -> Result<Vec<[[f32; 3]; 4]>, String> {
+    let module = ctx
+        .device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("dual_eval"),
+            source: wgpu::ShaderSource::Wgsl(shaders::dual_eval_module().into()),
+        });
+    let pipeline = compute_pipeline(&ctx.device, &module, "main");
+    let v: Vec<[f32; 4]> = ctx.run_batch(&pipeline, &[tables], queries, 4)?;
+    Ok((0..queries.len())
+        .map(|i| std::array::from_fn(|t| [v[4 * i + t][0], v[4 * i + t][1], v[4 * i + t][2]]))
+        .collect())
+}
