@@ -41,13 +41,13 @@ struct ShadeBatch {
 @group(0) @binding(9) var<storage, read> lut_h_tt: array<f32>;
 @group(0) @binding(10) var<storage, read> lut_h_trt: array<f32>;
 @group(0) @binding(11) var<storage, read> shadow_values: array<vec4<f32>>;
-@group(0) @binding(12) var visibility: texture_multisampled_2d<f32>;
+@group(0) @binding(12) var<storage, read> dual_tables: array<vec4<f32>>;
 @group(0) @binding(13) var<storage, read_write> aov_r: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> aov_tt: array<vec4<f32>>;
 @group(0) @binding(15) var<storage, read_write> aov_trt: array<vec4<f32>>;
 @group(0) @binding(16) var<storage, read_write> aov_ms_global: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
-@group(0) @binding(18) var<storage, read> dual_tables: array<vec4<f32>>;
+@group(0) @binding(18) var visibility: texture_multisampled_2d<f32>;
 
 struct ShadingPoint {
     position: vec3<f32>,

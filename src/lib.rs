@@ -7,6 +7,7 @@
 pub mod envmap;
 pub mod gpu;
 pub mod hair;
+pub mod paint;
 pub mod render;
 pub mod scattering;
 pub mod shadow;

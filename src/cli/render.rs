@@ -8,6 +8,8 @@ use std::time::Instant;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::load::{LoadOptions, load_hair};
 use strandlight::hair::procedural::Style;
+use strandlight::paint::dye::parse_colour;
+use strandlight::paint::{AbsorptionSpec, PaintLayer, sigma_a_from_colour};
 use strandlight::render::camera::CAMERA_PRESETS;
 use strandlight::render::reference::{ReferenceScene, reference_frame};
 use strandlight::render::scene::{
@@ -41,6 +43,28 @@ pub struct RenderArgs {
     pub env_yaw: f64,
     #[command(flatten)]
     pub params: ParamArgs,
+    /// Dye colour of the whole hair (#rrggbb sRGB or r,g,b linear), turned into absorption by Chiang
+    /// et al. 2016's inversion; replaces the preset's melanin absorption.
+    #[arg(long)]
+    pub dye: Option<String>,
+    /// Dye colour at the roots (a root-to-tip gradient with --dye-tip).
+    #[arg(long)]
+    pub dye_root: Option<String>,
+    /// Dye colour at the tips.
+    #[arg(long)]
+    pub dye_tip: Option<String>,
+    /// Azimuthal roughness beta_N of the colour inversion (Chiang 2016).
+    #[arg(long, default_value_t = 0.3)]
+    pub beta_n: f64,
+    /// Per-strand variation of the absorption: log-normal with this standard deviation.
+    #[arg(long, default_value_t = 0.0)]
+    pub strand_variation: f32,
+    /// Seed of the per-strand variation.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Paint layer (.slpaint, as the editor saves it) applied over the absorption.
+    #[arg(long)]
+    pub paint: Option<PathBuf>,
     /// Camera preset: front, three-quarter, side, back, back-three-quarter, top.
     #[arg(long, default_value = "three-quarter")]
     pub camera: String,
@@ -104,6 +128,40 @@ pub struct RenderArgs {
     /// Use a software adapter (lavapipe).
     #[arg(long)]
     pub software: bool,
+}
+
+/// The per-point absorption (preset or dye, gradient, per-strand variation, paint layer) and the
+/// parameters with sigma_a set to its mean (the dual-scattering tables' absorption).
+fn absorption(
+    args: &RenderArgs,
+    hair: &strandlight::hair::Hair,
+    mut params: strandlight::scattering::HairParams,
+) -> anyhow::Result<(Vec<[f32; 3]>, strandlight::scattering::HairParams)> {
+    let base = params.sigma_a.map(|x| x as f32);
+    let dye = |c: &Option<String>| -> anyhow::Result<Option<[f32; 3]>> {
+        c.as_deref()
+            .map(|s| {
+                let colour = parse_colour(s).map_err(anyhow::Error::msg)?;
+                Ok(sigma_a_from_colour(colour, args.beta_n).map(|x| x as f32))
+            })
+            .transpose()
+    };
+    let whole = dye(&args.dye)?.unwrap_or(base);
+    let spec = AbsorptionSpec {
+        root: dye(&args.dye_root)?.unwrap_or(whole),
+        tip: dye(&args.dye_tip)?.unwrap_or(whole),
+        variation: args.strand_variation.max(0.0),
+        seed: args.seed,
+    };
+    let mut sigma_a = spec.per_point(hair);
+    if let Some(path) = &args.paint {
+        PaintLayer::read(path)?.apply(&mut sigma_a, hair.strand_count(), path)?;
+    }
+    let n = sigma_a.len().max(1) as f64;
+    for c in 0..3 {
+        params.sigma_a[c] = sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n;
+    }
+    Ok((sigma_a, params))
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
@@ -182,8 +240,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if !(0.0..=1.0).contains(&args.d_f) || !(0.0..=1.0).contains(&args.d_b) {
         bail!("--d-f and --d-b lie in [0, 1]");
     }
+    let (sigma_a, params) = absorption(&args, &hair, params)?;
     let look = HairLook::new(params).with_dual(args.d_f, args.d_b);
-    let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
     let t = Instant::now();
     let mut renderer = Renderer::new(
         &ctx,
@@ -246,6 +304,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         ("environment".to_string(), env.name.clone()),
         ("lights".to_string(), env.lights.lights.len().to_string()),
         ("params".to_string(), serde_json::to_string(&params)?),
+        (
+            "absorption".to_string(),
+            format!(
+                "dye {:?}, root {:?}, tip {:?}, strand variation {}, seed {}, paint {:?}",
+                args.dye, args.dye_root, args.dye_tip, args.strand_variation, args.seed, args.paint
+            ),
+        ),
         ("camera".to_string(), serde_json::to_string(&camera)?),
         ("exposure_ev".to_string(), args.exposure.to_string()),
         ("samples".to_string(), args.samples.to_string()),

@@ -157,19 +157,7 @@ impl GpuContext {
             mapped_at_creation: false,
         });
         let buffers: Vec<&wgpu::Buffer> = inputs.iter().copied().chain([&q, &results]).collect();
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("batch"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+        let bind = bind_buffers(&self.device, pipeline, "batch", &buffers, Vec::new());
         let mut enc = self.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -195,5 +183,29 @@ pub fn compute_pipeline(
         entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
+    })
+}
+
+/// A bind group for group 0 of `pipeline`: `buffers` at bindings 0, 1, ... and the `extra` entries.
+pub fn bind_buffers(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    buffers: &[&wgpu::Buffer],
+    extra: Vec<wgpu::BindGroupEntry>,
+) -> wgpu::BindGroup {
+    let mut entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    entries.extend(extra);
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
     })
 }

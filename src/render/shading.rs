@@ -4,7 +4,7 @@
 //! dispatch per visibility sample within a batch.
 
 use super::targets::FrameTargets;
-use crate::gpu::context::compute_pipeline;
+use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -122,34 +122,21 @@ impl ShadingPass {
                     inputs.luts[1],
                     inputs.luts[2],
                     inputs.shadow_values,
+                    inputs.dual_tables,
                 ];
-                let mut entries: Vec<wgpu::BindGroupEntry> = buffers
-                    .iter()
-                    .enumerate()
-                    .map(|(i, b)| wgpu::BindGroupEntry {
-                        binding: i as u32,
-                        resource: b.as_entire_binding(),
-                    })
-                    .collect();
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 12,
+                let buffers: Vec<&wgpu::Buffer> =
+                    buffers.into_iter().chain(&targets.components).collect();
+                let visibility = wgpu::BindGroupEntry {
+                    binding: buffers.len() as u32,
                     resource: wgpu::BindingResource::TextureView(&targets.visibility),
-                });
-                for (k, b) in targets.components.iter().enumerate() {
-                    entries.push(wgpu::BindGroupEntry {
-                        binding: 13 + k as u32,
-                        resource: b.as_entire_binding(),
-                    });
-                }
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 18,
-                    resource: inputs.dual_tables.as_entire_binding(),
-                });
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shading"),
-                    layout: &self.pipeline.get_bind_group_layout(0),
-                    entries: &entries,
-                })
+                };
+                bind_buffers(
+                    device,
+                    &self.pipeline,
+                    "shading",
+                    &buffers,
+                    vec![visibility],
+                )
             })
             .collect();
         // One compute pass per batch (Xu's passes); the timestamps bracket them all.

@@ -3,7 +3,7 @@
 //! or the forward table change ([`crate::shadow::grid`] is the CPU twin).
 
 use super::shading::GpuLight;
-use crate::gpu::context::compute_pipeline;
+use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::density_pyramid::GpuDensityPyramid;
 use crate::gpu::fiber_density::{GpuFiberDensity, dispatch_2d};
 use crate::gpu::shaders;
@@ -113,19 +113,7 @@ impl ShadowGridPass {
             &inputs.volume.volume,
             inputs.forward_table,
         ];
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow grid"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+        let bind = bind_buffers(device, &self.pipeline, "shadow grid", &buffers, Vec::new());
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shadow grid"),
             timestamp_writes: timestamps,

@@ -1,0 +1,150 @@
+//! The paint layer: painted absorption per hair point, as the editor saves it and `render --paint`
+//! reads it. Little-endian binary:
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `SLPAINT1` |
+//! | 4 | u32 format version (1) |
+//! | 4 | u32 reserved (0) |
+//! | 8 | u64 point count N (must equal the hair's) |
+//! | 8 | u64 strand count (must equal the hair's) |
+//! | 16 N | per point f32 sigma_a R, G, B and f32 weight in [0, 1] |
+//!
+//! A point's absorption is mix(base, painted, weight): weight 0 keeps the base (unpainted).
+
+use std::path::{Path, PathBuf};
+
+pub const MAGIC: &[u8; 8] = b"SLPAINT1";
+pub const VERSION: u32 = 1;
+const HEADER: usize = 32;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaintLayer {
+    pub strand_count: u64,
+    /// (sigma_a RGB, weight) per point.
+    pub points: Vec<[f32; 4]>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum PaintLayerError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Format { path: PathBuf, message: String },
+}
+
+impl PaintLayer {
+    /// Parses the bytes of a layer; errors name `path` and the problem.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, PaintLayerError> {
+        let bad = |message: String| PaintLayerError::Format {
+            path: path.into(),
+            message,
+        };
+        if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+            return Err(bad(
+                "not a strandlight paint layer (no SLPAINT1 header)".into()
+            ));
+        }
+        let u32_at =
+            |o: usize| u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+        let u64_at = |o: usize| u64::from_le_bytes(std::array::from_fn(|k| bytes[o + k]));
+        let version = u32_at(8);
+        if version != VERSION {
+            return Err(bad(format!(
+                "format version {version}, this build reads {VERSION}"
+            )));
+        }
+        let (n, strands) = (u64_at(16), u64_at(24));
+        let body = (bytes.len() - HEADER) as u64;
+        if n.checked_mul(16) != Some(body) {
+            return Err(bad(format!(
+                "declares {n} points but holds {body} bytes of point data ({} expected)",
+                n.saturating_mul(16)
+            )));
+        }
+        let mut points = Vec::with_capacity(n as usize);
+        for (k, chunk) in bytes[HEADER..].chunks_exact(16).enumerate() {
+            let v: [f32; 4] = std::array::from_fn(|c| {
+                f32::from_le_bytes([
+                    chunk[4 * c],
+                    chunk[4 * c + 1],
+                    chunk[4 * c + 2],
+                    chunk[4 * c + 3],
+                ])
+            });
+            if v[..3].iter().any(|x| !x.is_finite() || *x < 0.0) {
+                return Err(bad(format!(
+                    "point {k}: absorption {:?} is not finite and >= 0",
+                    &v[..3]
+                )));
+            }
+            if !(0.0..=1.0).contains(&v[3]) {
+                return Err(bad(format!("point {k}: weight {} outside [0, 1]", v[3])));
+            }
+            points.push(v);
+        }
+        Ok(Self {
+            strand_count: strands,
+            points,
+        })
+    }
+
+    pub fn read(path: &Path) -> Result<Self, PaintLayerError> {
+        let bytes = std::fs::read(path).map_err(|source| PaintLayerError::Io {
+            path: path.into(),
+            source,
+        })?;
+        Self::decode(&bytes, path)
+    }
+
+    pub fn encode(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(HEADER + 16 * self.points.len());
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&0u32.to_le_bytes());
+        out.extend_from_slice(&(self.points.len() as u64).to_le_bytes());
+        out.extend_from_slice(&self.strand_count.to_le_bytes());
+        for p in &self.points {
+            for v in p {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        out
+    }
+
+    pub fn write(&self, path: &Path) -> Result<(), PaintLayerError> {
+        std::fs::write(path, self.encode()).map_err(|source| PaintLayerError::Io {
+            path: path.into(),
+            source,
+        })
+    }
+
+    /// Applies the layer over `base` (one absorption per point of a hair of `strands` strands).
+    pub fn apply(
+        &self,
+        base: &mut [[f32; 3]],
+        strands: usize,
+        path: &Path,
+    ) -> Result<(), PaintLayerError> {
+        if self.points.len() != base.len() || self.strand_count != strands as u64 {
+            return Err(PaintLayerError::Format {
+                path: path.into(),
+                message: format!(
+                    "painted for {} points in {} strands, the hair has {} points in {strands} strands",
+                    self.points.len(),
+                    self.strand_count,
+                    base.len()
+                ),
+            });
+        }
+        for (b, p) in base.iter_mut().zip(&self.points) {
+            for c in 0..3 {
+                b[c] += p[3] * (p[c] - b[c]);
+            }
+        }
+        Ok(())
+    }
+}
