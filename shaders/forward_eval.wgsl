@@ -1,12 +1,5 @@
 // Batch evaluation of forward_scattering (shaders/forward_scattering.wgsl) for the tests.
 
-struct VolumeInfoF {
-    origin: vec3<f32>,
-    voxel: f32,
-    dims: vec3<u32>,
-    segment_count: u32,
-}
-
 struct ForwardQuery {
     p: vec3<f32>,
     skip: f32,

@@ -9,6 +9,14 @@ const FWD_SIGMA_SAMPLES: u32 = 33u;
 const FWD_SIGMA_MIN: f32 = 0.005;
 const FWD_SIGMA_MAX: f32 = 50.0;
 
+// The volume's placement (twin of VolumeInfo in src/gpu/fiber_density.rs).
+struct VolumeInfoF {
+    origin: vec3<f32>,
+    voxel: f32,
+    dims: vec3<u32>,
+    segment_count: u32,
+}
+
 struct ForwardScattering {
     direct_fraction: f32,
     transmittance_f: vec3<f32>,

@@ -11,13 +11,6 @@
 const FLAG_SHADOWS: u32 = 1u;
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 
-struct GpuLight {
-    direction: vec3<f32>,
-    lambda: f32,
-    rgb: vec3<f32>,
-    _pad: f32,
-}
-
 struct ShadeBatch {
     first: u32,
     count: u32,

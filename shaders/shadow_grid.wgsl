@@ -3,6 +3,14 @@
 // `grid_shadow` reads them trilinearly. Two vec4 per (point, light), light-major:
 // (ln transmittance, ln T_f RGB), (sigma_f^2 RGB, direct fraction of the forward march).
 
+// One SRBF light (twin of GpuLight in src/render/shading.rs); read by the grid build and shading.
+struct GpuLight {
+    direction: vec3<f32>,
+    lambda: f32,
+    rgb: vec3<f32>,
+    _pad: f32,
+}
+
 struct ShadowGridInfo {
     origin: vec3<f32>,
     spacing: f32,

@@ -3,24 +3,10 @@
 // forward-scattering terms T_f and sigma_f^2 averaged over the same seven cones (srbf_forward).
 // Prepended: circular_gaussian, density_pyramid, forward_scattering, shadow_grid.
 
-struct GridLight {
-    direction: vec3<f32>,
-    lambda: f32,
-    rgb: vec3<f32>,
-    _pad: f32,
-}
-
-struct VolumeInfoF {
-    origin: vec3<f32>,
-    voxel: f32,
-    dims: vec3<u32>,
-    segment_count: u32,
-}
-
 @group(0) @binding(0) var<uniform> pyramid_info: PyramidInfo;
 @group(0) @binding(1) var<storage, read> pyramid: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> shadow_grid: ShadowGridInfo;
-@group(0) @binding(3) var<storage, read> grid_lights: array<GridLight>;
+@group(0) @binding(3) var<storage, read> grid_lights: array<GpuLight>;
 @group(0) @binding(4) var<storage, read_write> shadow_values: array<vec4<f32>>;
 @group(0) @binding(5) var<uniform> volume_info: VolumeInfoF;
 @group(0) @binding(6) var<storage, read> volume: array<vec4<f32>>;

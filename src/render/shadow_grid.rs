@@ -2,7 +2,6 @@
 //! and forward-scattering terms at every point of a coarse grid, rebuilt when the volume, the lights
 //! or the forward table change ([`crate::shadow::grid`] is the CPU twin).
 
-use super::shading::GpuLight;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::density_pyramid::GpuDensityPyramid;
 use crate::gpu::fiber_density::{GpuFiberDensity, dispatch_2d};
@@ -124,6 +123,3 @@ impl ShadowGridPass {
         pass.dispatch_workgroups(x, y, 1);
     }
 }
-
-/// The lights as the grid pass reads them (same layout as the shading pass's).
-pub type GridLight = GpuLight;
