@@ -81,6 +81,36 @@ fn deposit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     }
 }
 
+// The absorption of an empty voxel: the length-weighted mean over its 26 neighbours (0 if they are
+// empty too), so the forward march sees the absorption of the fibers its trilinear density counts.
+fn neighbour_absorption(v: u32) -> vec3<f32> {
+    let d = info.dims;
+    let i = vec3<i32>(vec3<u32>(v % d.x, (v / d.x) % d.y, v / (d.x * d.y)));
+    var len = 0.0;
+    var sig = vec3<f32>(0.0);
+    for (var dz = -1; dz <= 1; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let q = i + vec3<i32>(dx, dy, dz);
+                if (any(q < vec3<i32>(0)) || any(q >= vec3<i32>(d))) {
+                    continue;
+                }
+                let u = (u32(q.z) * d.y + u32(q.y)) * d.x + u32(q.x);
+                len = len + f32(atomicLoad(&sums[u * CHANNELS])) / FIXED_SCALE;
+                sig = sig + vec3<f32>(
+                    f32(atomicLoad(&sums[u * CHANNELS + 7u])),
+                    f32(atomicLoad(&sums[u * CHANNELS + 8u])),
+                    f32(atomicLoad(&sums[u * CHANNELS + 9u])),
+                ) / FIXED_SCALE;
+            }
+        }
+    }
+    if (len <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return sig / len;
+}
+
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let v = id.x + id.y * groups.x * 64u;
@@ -95,7 +125,7 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     if (len <= 0.0) {
         volume[3u * v] = vec4<f32>(0.0);
         volume[3u * v + 1u] = vec4<f32>(0.0);
-        volume[3u * v + 2u] = vec4<f32>(0.0);
+        volume[3u * v + 2u] = vec4<f32>(neighbour_absorption(v), 0.0);
         return;
     }
     let rho = len / (info.voxel * info.voxel * info.voxel);

@@ -1,7 +1,7 @@
 // Forward scattering along a shadow path from the fiber-density volume: the direct fraction,
-// T_f = E[prod a_f] and sigma_f^2, with the crossed fibers' own absorption. Twin of
-// src/shadow/forward.rs. Reads the pyramid (level 0, for the trilinear crossings), the volume
-// (nearest voxel's tensor and absorption) and the (theta, sigma_a) table of a_f and beta_f^2.
+// T_f = E[prod a_f] and sigma_f^2 (weighted by the light each path transmits), with the crossed fibers' own absorption. Twin of
+// src/shadow/forward.rs. Reads the pyramid (level 0: trilinear crossings and tensor), the volume
+// (nearest voxel's absorption) and the (theta, sigma_a) table of a_f and beta_f^2.
 // Bindings declared by the including module: pyramid_info, pyramid, volume_info, volume, forward_table.
 
 const FWD_THETA_SAMPLES: u32 = 64u;
@@ -66,6 +66,7 @@ fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, skip: f32) -> ForwardScatt
     }
     var tau = 0.0;
     var loss = vec3<f32>(0.0);
+    var mass = vec3<f32>(0.0);
     var spread = vec3<f32>(0.0);
     if (exit < 1.0e38 && exit > skip) {
         let steps = u32(ceil((exit - skip) / h0));
@@ -76,31 +77,45 @@ fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, skip: f32) -> ForwardScatt
             if (v < 0) {
                 continue;
             }
-            let c = crossings_at(x, omega, 0.0);
+            // Crossing density and inclination from the same trilinear (a, M); absorption from the
+            // voxel (an empty one holds its neighbours').
+            let e = level_sample(pyramid_info.levels[0], x);
+            let c = crossings(e.a, e.m0, e.m1, omega);
             if (c <= 0.0) {
                 continue;
             }
-            let x0 = volume[3 * v];
-            let x1 = volume[3 * v + 1];
             let sig = volume[3 * v + 2].xyz;
-            let a = max(x0.x, 1e-30);
             let w = omega;
-            let q = (dot(x0.yzw, w * w) + 2.0 * (x1.x * w.x * w.y + x1.y * w.x * w.z + x1.z * w.y * w.z)) / a;
+            let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
             let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
             tau = tau + c * h;
             for (var ch = 0u; ch < 3u; ch++) {
                 let f1 = forward_lookup(theta, sig[ch]);
                 let f2 = forward_lookup(-theta, sig[ch]);
                 loss[ch] = loss[ch] + c * h * (1.0 - 0.5 * (f1.x + f2.x));
-                spread[ch] = spread[ch] + c * h * 0.5 * (f1.y + f2.y);
+                mass[ch] = mass[ch] + c * h * 0.5 * (f1.x + f2.x);
+                spread[ch] = spread[ch] + c * h * 0.5 * (f1.x * f1.y + f2.x * f2.y);
             }
         }
     }
-    let direct = exp(-tau);
-    let scattered = max(1.0 - direct, 1e-12);
     var out: ForwardScattering;
-    out.direct_fraction = direct;
+    out.direct_fraction = exp(-tau);
     out.transmittance_f = exp(-loss);
-    out.sigma_f2 = select(vec3<f32>(0.0), spread / scattered, tau > 0.0);
+    for (var ch = 0u; ch < 3u; ch++) {
+        out.sigma_f2[ch] = forward_spread_weighted(mass[ch], spread[ch]);
+    }
     return out;
+}
+
+// sigma_f^2 = T_f W / (T_f - direct) = W / (1 - exp(-A)), A = integral c a_f ds, W = integral c a_f beta_f^2 ds
+// (twin of forward_spread_weighted in src/shadow/forward.rs).
+fn forward_spread_weighted(forward_mass: f32, weighted_spread: f32) -> f32 {
+    if (forward_mass <= 0.0 || weighted_spread <= 0.0) {
+        return 0.0;
+    }
+    var scattered = 1.0 - exp(-forward_mass);
+    if (forward_mass < 1e-3) {
+        scattered = forward_mass * (1.0 - 0.5 * forward_mass);
+    }
+    return weighted_spread / scattered;
 }

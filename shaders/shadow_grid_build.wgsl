@@ -13,7 +13,8 @@
 @group(0) @binding(7) var<storage, read> forward_table: array<vec2<f32>>;
 
 // forward_scattering averaged over the cones of srbf_transmittance (weights 1/2 for the centre, 1/12
-// for each ring cone); sigma_f^2 is averaged over the crossed part (weights w (1 - direct)).
+// for each ring cone); sigma_f^2 is averaged per channel over the forward-scattered light (weights
+// w (T_f - direct)).
 fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> ForwardScattering {
     let kappa = 2.0 / (lambda * lambda);
     let e = exp(-2.0 * kappa);
@@ -28,19 +29,20 @@ fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> Forw
     let e2 = cross(centre, e1);
     var direct = 0.5 * c.direct_fraction;
     var tf = 0.5 * c.transmittance_f;
-    var spread = 0.5 * (1.0 - c.direct_fraction) * c.sigma_f2;
-    var crossed = 0.5 * (1.0 - c.direct_fraction);
+    var scattered = 0.5 * max(c.transmittance_f - vec3<f32>(c.direct_fraction), vec3<f32>(0.0));
+    var spread = scattered * c.sigma_f2;
     for (var k = 0; k < 6; k++) {
         let a = f32(k) * TAU / 6.0;
         let d = normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring));
         let f = forward_scattering(p, d, skip);
         let w = 0.5 / 6.0;
+        let s = w * max(f.transmittance_f - vec3<f32>(f.direct_fraction), vec3<f32>(0.0));
         direct = direct + w * f.direct_fraction;
         tf = tf + w * f.transmittance_f;
-        spread = spread + w * (1.0 - f.direct_fraction) * f.sigma_f2;
-        crossed = crossed + w * (1.0 - f.direct_fraction);
+        scattered = scattered + s;
+        spread = spread + s * f.sigma_f2;
     }
-    return ForwardScattering(direct, tf, spread / max(crossed, 1e-12));
+    return ForwardScattering(direct, tf, spread / max(scattered, vec3<f32>(1e-12)));
 }
 
 @compute @workgroup_size(64)

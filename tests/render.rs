@@ -10,7 +10,9 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::Style;
 use strandlight::render::reference::REFERENCE_VARIANT;
-use strandlight::render::reference::{ReferenceScene, importance_sample_env, reference_frame};
+use strandlight::render::reference::{
+    ReferenceLighting, ReferenceScene, importance_sample_env, reference_frame,
+};
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{ShadingHair, shade_pixels, shade_point};
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
@@ -179,10 +181,12 @@ fn reference(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
         &ReferenceScene {
             hair: &s.hair,
             sigma_a: &s.sigma_a,
-            params: &s.params,
-            env,
-            yaw,
-            directions: 1024,
+            look: &s.look,
+            lighting: ReferenceLighting::Environment {
+                env,
+                yaw,
+                directions: 1024,
+            },
             settings: &s.settings,
             camera: &s.camera,
         },

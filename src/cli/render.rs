@@ -11,7 +11,9 @@ use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
 use strandlight::paint::{AbsorptionSpec, PaintLayer, sigma_a_from_colour};
 use strandlight::render::camera::CAMERA_PRESETS;
-use strandlight::render::reference::{ReferenceScene, reference_frame};
+use strandlight::render::reference::{
+    ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
+};
 use strandlight::render::scene::{
     Environment, default_environment, generated_hair, load_environment,
 };
@@ -117,9 +119,10 @@ pub struct RenderArgs {
     /// Tonemapped PNG preview.
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// Shade with the exact Marschner model under directions importance-sampled from the environment
-    /// image instead (CPU; same camera, visibility and shadow volume; single scattering only). Needs an
-    /// .hdr / .exr environment or the built-in one.
+    /// Shade the same visible points on the CPU with the exact model instead: under directions
+    /// importance-sampled from the environment image (or, for .srbf.json, sampled from its lobes). With
+    /// multiple scattering (the default): Zinke's dual scattering with every direction's shadow ray
+    /// traced through the explicit fibers; with --single-scattering: the volume's exp(-tau) shadows.
     #[arg(long)]
     pub reference: bool,
     /// Directions sampled by --reference.
@@ -272,32 +275,47 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     );
     let mut mode = "srbf".to_string();
     if args.reference {
-        let image = env.image.as_ref().with_context(|| {
-            format!(
-                "--reference needs the environment image; {} holds only SRBF lights",
-                env.name
-            )
-        })?;
         let t = Instant::now();
+        let directions = args.reference_directions.max(1);
+        // The environment image when there is one (the fit's error is then part of what is measured),
+        // else the SRBF lobes themselves, sampled.
+        let lighting = match env.image.as_ref() {
+            Some(image) => ReferenceLighting::Environment {
+                env: image,
+                yaw: env.lights.yaw,
+                directions,
+            },
+            None => {
+                let per_light = directions.div_ceil(env.lights.lights.len().max(1)).max(16);
+                ReferenceLighting::Directional(sample_srbf_lights(&env.lights.lights, per_light, 7))
+            }
+        };
+        let source = match lighting {
+            ReferenceLighting::Environment { .. } => "environment image",
+            ReferenceLighting::Directional(_) => "SRBF lobes",
+        };
         frame = reference_frame(
             &frame,
             &ReferenceScene {
                 hair: &hair,
                 sigma_a: &sigma_a,
-                params: &params,
-                env: image,
-                yaw: env.lights.yaw,
-                directions: args.reference_directions.max(1),
+                look: &look,
+                lighting,
                 settings: &settings,
                 camera: &camera,
             },
         );
+        let shadows = match (settings.multiple_scattering, settings.shadows) {
+            (true, true) => "dual scattering, shadow rays through the fibers",
+            (true, false) => "dual scattering, unshadowed",
+            (false, true) => "single scattering, volume shadows",
+            (false, false) => "single scattering, unshadowed",
+        };
         eprintln!(
-            "reference: {} directions, shaded on the CPU in {:.2} s",
-            args.reference_directions,
+            "reference: {directions} directions from the {source}, {shadows}, shaded on the CPU in {:.2} s",
             t.elapsed().as_secs_f64()
         );
-        mode = format!("reference ({} directions)", args.reference_directions);
+        mode = format!("reference ({directions} directions from the {source}; {shadows})");
     }
     let attributes = vec![
         ("hair".to_string(), hair_name),

@@ -1,18 +1,38 @@
 //! The reference mode: the same visible points shaded with the exact Marschner model (Schlick Fresnel,
-//! bare root sum: the variant Xu's fast form approximates) under directional lights importance-sampled
-//! from the full environment image (not its SRBF fit), each shadowed by the exact-direction
-//! transmittance exp(-tau) of the same fiber-density volume. CPU, rayon. It exists to measure the
-//! SRBF renderer's error honestly.
+//! bare root sum: the variant Xu's fast form approximates) under directional lights, importance-sampled
+//! from the full environment image (not its SRBF fit) or sampled from SRBF lobes. CPU, rayon. It
+//! exists to measure the SRBF renderer's error honestly.
+//!
+//! Shadows, two ways:
+//! - single scattering: each direction is attenuated by the exact-direction transmittance exp(-tau) of
+//!   the same fiber-density volume the renderer builds;
+//! - with multiple scattering: Zinke's ray shooting (Sec. 4.1.1, [`crate::shadow::ray_shooting`]):
+//!   every direction's shadow ray is traced through the explicit fibers; a free ray carries single
+//!   scattering plus d_b f_back, a blocked one carries (T_f d_f)(f_s^G + d_b f_back^G) with that ray's
+//!   own T_f and per-channel sigma_f^2. The dual-scattering responses are those of
+//!   [`crate::scattering::dual_response`] for a directional light (lambda = 0) with 16 quadrature
+//!   segments; they are checked against direct quadrature of Xu's Eq. 27-31 in tests/dual_terms.rs.
+//!   What this reference does not share with the renderer is what the renderer approximates: the
+//!   fiber-density volume, the SRBF cone filtering and the shadow grid's interpolation.
 
-use super::shade::{LobeRadiance, ShadingPoint, fiber_frame};
+use super::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
 use crate::envmap::EnvMap;
-use crate::envmap::direction::{direction_from_uv, rotate_yaw};
+use crate::scattering::dual_response::{
+    dual_scattering_components, global_response_lobe, local_response,
+};
+use crate::scattering::dual_terms::DualTables;
+use crate::scattering::fast_params::FastHairParams;
+use crate::scattering::fast_response::SrbfInFrame;
 use crate::scattering::frame::{FiberAngles, FiberFrame};
 use crate::scattering::marschner::scattering_s;
 use crate::scattering::params::{CausticModel, FresnelModel, HairParams, ModelVariant};
 use crate::shadow::fiber_density::FiberDensity;
-use glam::{DVec3, Vec3};
-use rand_core::{Rng, SeedableRng};
+use crate::shadow::fiber_grid::FiberGrid;
+use crate::shadow::forward::{ForwardScattering, ForwardTable};
+use crate::shadow::ray_shooting::shoot_forward;
+use glam::Vec3;
+
+pub use super::reference_lights::{DirectionalLight, importance_sample_env, sample_srbf_lights};
 
 /// The variant the fast model approximates (and the reference evaluates).
 pub const REFERENCE_VARIANT: ModelVariant = ModelVariant {
@@ -20,89 +40,63 @@ pub const REFERENCE_VARIANT: ModelVariant = ModelVariant {
     caustic: CausticModel::None,
 };
 
-/// A directional light carrying its share of the environment's integral: L(omega) / (pdf N), summed
-/// over the samples that fell in the same texel.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionalLight {
-    pub direction: DVec3,
-    pub weight: [f64; 3],
+/// Quadrature segments of the reference's dual-scattering responses (the renderer uses Xu's m = 4).
+pub const REFERENCE_QUADRATURE_SEGMENTS: u32 = 16;
+
+/// What dual scattering needs besides the hair parameters.
+pub struct DualReference<'a> {
+    /// The explicit fibers (None: no shadows, every ray is free).
+    pub fibers: Option<&'a FiberGrid>,
+    pub forward: &'a ForwardTable,
+    pub dual: &'a DualTables,
+    /// d_f, d_b and the parameters in the fast model's form (its sigma_a is replaced per point).
+    pub fast: FastHairParams,
 }
 
-/// `n` stratified samples of the environment proportional to luminance x solid angle (texel CDF
-/// inversion, uniform within the texel), merged per texel. Their weights sum to the texels' integral of
-/// L d omega up to sampling error; `yaw` turns them as `SrbfSet::rotated` turns lights.
-pub fn importance_sample_env(env: &EnvMap, n: usize, yaw: f64, seed: u64) -> Vec<DirectionalLight> {
-    let (w, h) = (env.width, env.height);
-    let mut cdf = Vec::with_capacity(w * h + 1);
-    cdf.push(0.0f64);
-    let mut total = 0.0;
-    for y in 0..h {
-        let omega = env.solid_angle(y);
-        for x in 0..w {
-            let p = env.pixels[y * w + x];
-            let lum = 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-            total += lum.max(0.0) * omega;
-            cdf.push(total);
-        }
-    }
-    if total <= 0.0 || n == 0 {
-        return Vec::new();
-    }
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-    let mut merged: std::collections::BTreeMap<usize, DirectionalLight> = Default::default();
-    for k in 0..n {
-        let target = (k as f64 + unit()) / n as f64 * total;
-        let i = cdf.partition_point(|&c| c <= target).clamp(1, w * h) - 1;
-        let (x, y) = (i % w, i / w);
-        let pdf_texel = (cdf[i + 1] - cdf[i]) / total;
-        if pdf_texel <= 0.0 {
-            continue;
-        }
-        let omega = env.solid_angle(y);
-        let (ju, jv) = (unit(), unit());
-        let d = direction_from_uv((x as f64 + ju) / w as f64, (y as f64 + jv) / h as f64);
-        let d = rotate_yaw(d, yaw);
-        let p = env.pixels[i];
-        let scale = omega / (pdf_texel * n as f64);
-        let e = merged.entry(i).or_insert(DirectionalLight {
-            direction: DVec3::ZERO,
-            weight: [0.0; 3],
-        });
-        // Several samples in one texel: one light along their mean direction.
-        e.direction += d;
-        for c in 0..3 {
-            e.weight[c] += p[c] as f64 * scale;
-        }
-    }
-    merged
-        .into_values()
-        .map(|mut l| {
-            l.direction = l.direction.normalize();
-            l
-        })
-        .collect()
+/// How the reference shadows each direction.
+pub enum ReferenceShadows<'a> {
+    None,
+    /// exp(-tau) of the volume along the exact direction, past `skip` (single scattering only).
+    Volume(&'a FiberDensity, f32),
+    /// Ray shooting through the fibers, with single and dual scattering.
+    Dual(&'a DualReference<'a>),
 }
 
-/// Radiance per lobe towards omega_o: sum over the lights of weight S(omega_i, omega_o) cos(theta_i) T.
+/// Radiance per lobe towards omega_o: sum over the lights of weight S(omega_i, omega_o) cos(theta_i) T
+/// (R, TT, TRT) and, with [`ReferenceShadows::Dual`], MS.global and MS.local.
 pub fn reference_shade(
     params: &HairParams,
     sp: &ShadingPoint,
     omega_o: Vec3,
     lights: &[DirectionalLight],
-    shadows: Option<(&FiberDensity, f32)>,
+    shadows: &ReferenceShadows,
 ) -> LobeRadiance {
     let mut p = *params;
     p.sigma_a = sp.sigma_a.map(|s| s as f64);
     let (u, v, _) = fiber_frame(sp.tangent);
     let frame = FiberFrame::with_normal(u.as_dvec3(), v.as_dvec3());
     let wo: FiberAngles = frame.angles(omega_o.as_dvec3());
-    let mut out = [[0.0f64; 3]; 3];
+    let mut out = [[0.0f64; 3]; 5];
     for l in lights {
         let wi = frame.angles(l.direction);
-        let vis = shadows.map_or(1.0, |(vol, skip)| {
-            vol.transmittance(sp.position, l.direction.as_vec3(), skip) as f64
-        });
+        let dir = l.direction.as_vec3();
+        let vis = match shadows {
+            ReferenceShadows::None => 1.0,
+            ReferenceShadows::Volume(vol, skip) => {
+                vol.transmittance(sp.position, dir, *skip) as f64
+            }
+            ReferenceShadows::Dual(d) => {
+                let f = d.fibers.map_or(FREE_RAY, |g| {
+                    shoot_forward(g, d.forward, sp.position, dir, sp.segment)
+                });
+                let ms = dual_directional(d, sp, omega_o, dir, &f);
+                for c in 0..3 {
+                    out[3][c] += l.weight[c] * ms.0[c] as f64;
+                    out[4][c] += l.weight[c] * ms.1[c] as f64;
+                }
+                f.direct_fraction as f64
+            }
+        };
         if vis <= 0.0 {
             continue;
         }
@@ -114,45 +108,133 @@ pub fn reference_shade(
             }
         }
     }
-    let mut radiance = [[0.0; 3]; 5];
-    for t in 0..3 {
-        radiance[t] = out[t].map(|x| x as f32);
+    out.map(|lobe| lobe.map(|x| x as f32))
+}
+
+const FREE_RAY: ForwardScattering = ForwardScattering {
+    direct_fraction: 1.0,
+    transmittance_f: [1.0; 3],
+    sigma_f2: [0.0; 3],
+};
+
+/// (MS.global, MS.local) per unit irradiance-weight from one direction whose shadow ray found `f`.
+fn dual_directional(
+    d: &DualReference,
+    sp: &ShadingPoint,
+    omega_o: Vec3,
+    dir: Vec3,
+    f: &ForwardScattering,
+) -> ([f32; 3], [f32; 3]) {
+    let mut fp = d.fast;
+    fp.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
+    fp.quadrature_segments = REFERENCE_QUADRATURE_SEGMENTS;
+    let frame = fiber_frame(sp.tangent);
+    let (theta_o, phi_o) = fiber_angles(frame, omega_o);
+    let (theta, phi) = fiber_angles(frame, dir);
+    let light = SrbfInFrame {
+        theta,
+        phi,
+        lambda: 0.0,
+    };
+    let local_direct = local_response(&fp, d.dual, light, theta_o, phi_o, 0.0);
+    let (mut global, mut local) = ([0.0f32; 3], [0.0f32; 3]);
+    if f.direct_fraction < 1.0 {
+        // Each channel with its own sigma_f^2 (the renderer uses their mean).
+        for c in 0..3 {
+            let s2 = f.sigma_f2[c];
+            for t in 0..3 {
+                global[c] += global_response_lobe(&fp, t, light, theta_o, phi_o, s2)[c];
+            }
+            local[c] = local_response(&fp, d.dual, light, theta_o, phi_o, s2)[c];
+        }
     }
-    radiance
+    dual_scattering_components(
+        &fp,
+        f.direct_fraction,
+        f.transmittance_f,
+        local_direct,
+        global,
+        local,
+    )
+}
+
+/// The reference's lights.
+pub enum ReferenceLighting<'a> {
+    /// `directions` importance-sampled from the image, turned by `yaw` about +Y as its SRBF lights are.
+    Environment {
+        env: &'a EnvMap,
+        yaw: f64,
+        directions: usize,
+    },
+    /// Given directional lights (for example [`sample_srbf_lights`]).
+    Directional(Vec<DirectionalLight>),
+}
+
+impl ReferenceLighting<'_> {
+    pub fn lights(&self) -> Vec<DirectionalLight> {
+        match self {
+            ReferenceLighting::Environment {
+                env,
+                yaw,
+                directions,
+            } => importance_sample_env(env, *directions, *yaw, 7),
+            ReferenceLighting::Directional(l) => l.clone(),
+        }
+    }
 }
 
 /// What the reference needs besides the visibility of a frame.
 pub struct ReferenceScene<'a> {
     pub hair: &'a crate::hair::Hair,
     pub sigma_a: &'a [[f32; 3]],
-    pub params: &'a HairParams,
-    pub env: &'a EnvMap,
-    /// Rotation of the environment about +Y (radians), as applied to its SRBF lights.
-    pub yaw: f64,
-    /// Directions sampled from the environment (at least 1024 for the fidelity figures).
-    pub directions: usize,
+    pub look: &'a super::HairLook,
+    pub lighting: ReferenceLighting<'a>,
     pub settings: &'a super::RenderSettings,
     pub camera: &'a super::Camera,
 }
 
 /// The reference shading of the points the GPU frame sees (same coverage, depth and ids); its
-/// components R, TT, TRT replace the frame's, multiple scattering is zero (single scattering only: the
-/// multiple-scattering reference is still to come), the exposure is applied.
+/// components replace the frame's and the exposure is applied. With `settings.multiple_scattering`
+/// it is dual scattering by ray shooting through the fibers (shadows by the same rays); without, single
+/// scattering with the volume's exp(-tau) (or no) shadows.
 pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::Frame {
-    let lights = importance_sample_env(scene.env, scene.directions, scene.yaw, 7);
+    let lights = scene.lighting.lights();
     let settings = scene.settings;
-    let volume = settings
-        .shadows
-        .then(|| FiberDensity::build(scene.hair, scene.sigma_a, settings.voxel_size(scene.hair)));
-    let skip = settings.shadow_skip(scene.hair);
+    let params = &scene.look.params;
     let hair = super::shade::ShadingHair::new(scene.hair, scene.sigma_a);
     let cam = scene
         .camera
         .uniform(frame.width, frame.height, settings.min_width_px);
     let pixels: Vec<usize> = frame.covered().collect();
-    let shadows = volume.as_ref().map(|v| (v, skip));
-    let radiance = super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-        reference_shade(scene.params, sp, wo, &lights, shadows)
-    });
+    let radiance = if settings.multiple_scattering {
+        let fibers = settings
+            .shadows
+            .then(|| FiberGrid::build(scene.hair, scene.sigma_a));
+        // The dual tables at the hair's mean absorption, as the renderer builds them.
+        let (forward, dual) = rayon::join(
+            || ForwardTable::build(params, REFERENCE_VARIANT),
+            || DualTables::build(params, REFERENCE_VARIANT),
+        );
+        let d = DualReference {
+            fibers: fibers.as_ref(),
+            forward: &forward,
+            dual: &dual,
+            fast: scene.look.fast,
+        };
+        let shadows = ReferenceShadows::Dual(&d);
+        super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
+            reference_shade(params, sp, wo, &lights, &shadows)
+        })
+    } else {
+        let volume = settings.shadows.then(|| {
+            FiberDensity::build(scene.hair, scene.sigma_a, settings.voxel_size(scene.hair))
+        });
+        let shadows = volume.as_ref().map_or(ReferenceShadows::None, |v| {
+            ReferenceShadows::Volume(v, settings.shadow_skip(scene.hair))
+        });
+        super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
+            reference_shade(params, sp, wo, &lights, &shadows)
+        })
+    };
     frame.with_components(&pixels, &radiance, settings.exposure.exp2())
 }

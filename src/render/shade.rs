@@ -29,6 +29,8 @@ pub struct ShadingPoint {
     pub position: Vec3,
     pub tangent: Vec3,
     pub sigma_a: Rgb,
+    /// The segment the point lies on.
+    pub segment: u32,
 }
 
 /// The first point of every segment, in the order the GPU numbers segments.
@@ -67,6 +69,7 @@ impl<'a> ShadingHair<'a> {
             position: a + (b - a) * t,
             tangent: b - a,
             sigma_a: std::array::from_fn(|c| s0[c] + (s1[c] - s0[c]) * t),
+            segment: seg,
         }
     }
 }

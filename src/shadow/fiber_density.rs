@@ -23,7 +23,8 @@ pub struct FiberDensity {
     pub extinction: Vec<f32>,
     /// M = rho_L D <u u^T> per voxel as (xx, yy, zz, xy, xz, yz); trace M = a.
     pub extinction_tensor: Vec<[f32; 6]>,
-    /// Length-weighted mean sigma_a (RGB) of the fibers in the voxel.
+    /// Length-weighted mean sigma_a (RGB) of the fibers in the voxel; in an empty voxel, that of its
+    /// 26 neighbours.
     pub absorption: Vec<[f32; 3]>,
     /// rho_L, cm of fiber per cm^3.
     pub length_density: Vec<f32>,
@@ -46,6 +47,44 @@ pub fn box_exit(origin: Vec3, voxel: f32, dims: [usize; 3], p: Vec3, omega: Vec3
         }
     }
     exit
+}
+
+/// The absorption of an empty voxel: the length-weighted mean over its 26 neighbours (0 if they are
+/// empty too). Trilinear reading gives an empty voxel next to hair a non-zero crossing density; the
+/// fibers a ray crosses there are its neighbours', so the forward march must see their absorption,
+/// not none (clear fibers). Twin of `resolve` in `shaders/fiber_density.wgsl`.
+fn neighbour_absorption(dims: [usize; 3], v: usize, length: &[f64], sums: &[[f64; 3]]) -> [f32; 3] {
+    let (i, j, k) = (
+        (v % dims[0]) as i64,
+        ((v / dims[0]) % dims[1]) as i64,
+        (v / (dims[0] * dims[1])) as i64,
+    );
+    let (mut len, mut sig) = (0f64, [0f64; 3]);
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let (x, y, z) = (i + dx, j + dy, k + dz);
+                if x < 0
+                    || y < 0
+                    || z < 0
+                    || x >= dims[0] as i64
+                    || y >= dims[1] as i64
+                    || z >= dims[2] as i64
+                {
+                    continue;
+                }
+                let u = (z as usize * dims[1] + y as usize) * dims[0] + x as usize;
+                len += length[u];
+                for c in 0..3 {
+                    sig[c] += sums[u][c];
+                }
+            }
+        }
+    }
+    if len <= 0.0 {
+        return [0.0; 3];
+    }
+    sig.map(|x| (x / len) as f32)
 }
 
 /// Largest number of voxels along one axis.
@@ -153,6 +192,7 @@ impl FiberDensity {
         };
         for v in 0..n {
             if length[v] <= 0.0 {
+                out.absorption[v] = neighbour_absorption(dims, v, &length, &absorption);
                 continue;
             }
             let rho = length[v] / volume;

@@ -22,7 +22,8 @@ pub struct GridShadow {
 }
 
 /// forward_scattering averaged over the cones of `srbf_transmittance` (twin of `srbf_forward` in
-/// `shaders/shadow_grid_build.wgsl`); sigma_f^2 is averaged over the crossed part.
+/// `shaders/shadow_grid_build.wgsl`); sigma_f^2 is averaged per channel over the forward-scattered
+/// light, weights w (T_f - direct).
 pub fn srbf_forward(
     volume: &FiberDensity,
     table: &ForwardTable,
@@ -31,20 +32,21 @@ pub fn srbf_forward(
     lambda: f32,
     skip: f32,
 ) -> ForwardScattering {
-    let (mut direct, mut tf, mut spread, mut crossed) = (0.0, [0.0; 3], [0.0; 3], 0.0);
+    let (mut direct, mut tf, mut spread, mut scattered) = (0.0, [0.0; 3], [0.0; 3], [0.0; 3]);
     for (d, _, w) in srbf_cones(centre, lambda) {
         let f = forward_scattering(volume, table, p, d, skip);
         direct += w * f.direct_fraction;
-        crossed += w * (1.0 - f.direct_fraction);
         for c in 0..3 {
+            let s = w * (f.transmittance_f[c] - f.direct_fraction).max(0.0);
             tf[c] += w * f.transmittance_f[c];
-            spread[c] += w * (1.0 - f.direct_fraction) * f.sigma_f2[c];
+            scattered[c] += s;
+            spread[c] += s * f.sigma_f2[c];
         }
     }
     ForwardScattering {
         direct_fraction: direct,
         transmittance_f: tf,
-        sigma_f2: spread.map(|s| s / crossed.max(1e-12)),
+        sigma_f2: std::array::from_fn(|c| spread[c] / scattered[c].max(1e-12)),
     }
 }
 

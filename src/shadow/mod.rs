@@ -2,8 +2,10 @@
 
 pub mod cone;
 pub mod fiber_density;
+pub mod fiber_grid;
 pub mod forward;
 pub mod grid;
+pub mod ray_shooting;
 
 pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;
