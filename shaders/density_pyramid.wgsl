@@ -61,8 +61,8 @@ fn level_sample(l: PyramidLevel, p: vec3<f32>) -> Extinction {
     return e;
 }
 
-// Crossings per cm along omega at p, at continuous level `lod`.
-fn crossings_at(p: vec3<f32>, omega: vec3<f32>, lod: f32) -> f32 {
+// (a, M) at p at continuous level `lod` (trilinear in each level, linear between levels).
+fn extinction_at(p: vec3<f32>, lod: f32) -> Extinction {
     let top = f32(pyramid_info.count - 1u);
     let l = clamp(lod, 0.0, top);
     let l0 = u32(floor(l));
@@ -70,7 +70,13 @@ fn crossings_at(p: vec3<f32>, omega: vec3<f32>, lod: f32) -> f32 {
     let t = l - f32(l0);
     let e0 = level_sample(pyramid_info.levels[l0], p);
     let e1 = level_sample(pyramid_info.levels[l1], p);
-    return crossings(mix(e0.a, e1.a, t), mix(e0.m0, e1.m0, t), mix(e0.m1, e1.m1, t), omega);
+    return Extinction(mix(e0.a, e1.a, t), mix(e0.m0, e1.m0, t), mix(e0.m1, e1.m1, t));
+}
+
+// Crossings per cm along omega at p, at continuous level `lod`.
+fn crossings_at(p: vec3<f32>, omega: vec3<f32>, lod: f32) -> f32 {
+    let e = extinction_at(p, lod);
+    return crossings(e.a, e.m0, e.m1, omega);
 }
 
 fn cone_optical_depth(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> f32 {

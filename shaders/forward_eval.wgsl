@@ -4,7 +4,7 @@ struct ForwardQuery {
     p: vec3<f32>,
     skip: f32,
     omega: vec3<f32>,
-    _pad: f32,
+    half_angle: f32,
 }
 
 @group(0) @binding(0) var<uniform> pyramid_info: PyramidInfo;
@@ -22,7 +22,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let q = forward_queries[i];
-    let f = forward_scattering(q.p, q.omega, q.skip);
+    let f = forward_scattering(q.p, q.omega, q.half_angle, q.skip);
     forward_results[2u * i] = vec4<f32>(f.transmittance_f, f.direct_fraction);
     forward_results[2u * i + 1u] = vec4<f32>(f.sigma_f2, 0.0);
 }

@@ -54,48 +54,57 @@ fn forward_voxel_at(p: vec3<f32>) -> i32 {
     return i32((i.z * volume_info.dims.y + i.y) * volume_info.dims.x + i.x);
 }
 
-fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, skip: f32) -> ForwardScattering {
-    let h0 = 0.5 * volume_info.voxel;
-    let hi = volume_info.origin + volume_info.voxel * vec3<f32>(volume_info.dims);
+// A cone of half-angle `half_angle` marched as cone_optical_depth marches it (steps of half its
+// width, pyramid levels of that width; 0: a thin ray on level 0), so the direct fraction is that
+// cone's exp(-tau).
+fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> ForwardScattering {
+    let l0 = pyramid_info.levels[0];
+    let base = l0.voxel;
+    let hi = pyramid_info.origin + base * vec3<f32>(l0.dims);
     var exit = 3.0e38;
     for (var ax = 0; ax < 3; ax++) {
         let w = omega[ax];
         if (abs(w) > 1e-12) {
-            exit = min(exit, select((volume_info.origin[ax] - p[ax]) / w, (hi[ax] - p[ax]) / w, w > 0.0));
+            exit = min(exit, select((pyramid_info.origin[ax] - p[ax]) / w, (hi[ax] - p[ax]) / w, w > 0.0));
         }
     }
+    let tn = tan(min(half_angle, 1.5));
     var tau = 0.0;
     var loss = vec3<f32>(0.0);
     var mass = vec3<f32>(0.0);
     var spread = vec3<f32>(0.0);
-    if (exit < 1.0e38 && exit > skip) {
-        let steps = u32(ceil((exit - skip) / h0));
-        let h = (exit - skip) / f32(steps);
-        for (var k = 0u; k < steps; k++) {
-            let x = p + omega * (skip + (f32(k) + 0.5) * h);
-            let v = forward_voxel_at(x);
-            if (v < 0) {
-                continue;
-            }
-            // Crossing density and inclination from the same trilinear (a, M); absorption from the
-            // voxel (an empty one holds its neighbours').
-            let e = level_sample(pyramid_info.levels[0], x);
-            let c = crossings(e.a, e.m0, e.m1, omega);
-            if (c <= 0.0) {
-                continue;
-            }
-            let sig = volume[3 * v + 2].xyz;
-            let w = omega;
-            let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
-            let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
-            tau = tau + c * h;
-            for (var ch = 0u; ch < 3u; ch++) {
-                let f1 = forward_lookup(theta, sig[ch]);
-                let f2 = forward_lookup(-theta, sig[ch]);
-                loss[ch] = loss[ch] + c * h * (1.0 - 0.5 * (f1.x + f2.x));
-                mass[ch] = mass[ch] + c * h * 0.5 * (f1.x + f2.x);
-                spread[ch] = spread[ch] + c * h * 0.5 * (f1.x * f1.y + f2.x * f2.y);
-            }
+    var s = skip;
+    for (var it = 0; it < 4096; it++) {
+        if (s >= exit) {
+            break;
+        }
+        let width = max(2.0 * s * tn, base);
+        let lod = log2(width / base);
+        let h = max(min(0.5 * width, exit - s), 1e-6);
+        let x = p + omega * (s + 0.5 * h);
+        s = s + h;
+        let v = forward_voxel_at(x);
+        if (v < 0) {
+            continue;
+        }
+        // Crossing density and inclination from the same (a, M); absorption from the level-0 voxel
+        // (an empty one holds its neighbours').
+        let e = extinction_at(x, lod);
+        let c = crossings(e.a, e.m0, e.m1, omega);
+        if (c <= 0.0) {
+            continue;
+        }
+        let sig = volume[3 * v + 2].xyz;
+        let w = omega;
+        let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
+        let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
+        tau = tau + c * h;
+        for (var ch = 0u; ch < 3u; ch++) {
+            let f1 = forward_lookup(theta, sig[ch]);
+            let f2 = forward_lookup(-theta, sig[ch]);
+            loss[ch] = loss[ch] + c * h * (1.0 - 0.5 * (f1.x + f2.x));
+            mass[ch] = mass[ch] + c * h * 0.5 * (f1.x + f2.x);
+            spread[ch] = spread[ch] + c * h * 0.5 * (f1.x * f1.y + f2.x * f2.y);
         }
     }
     var out: ForwardScattering;

@@ -12,21 +12,22 @@
 @group(0) @binding(6) var<storage, read> volume: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> forward_table: array<vec2<f32>>;
 
-// forward_scattering averaged over the cones of srbf_transmittance (weights 1/2 for the centre, 1/12
-// for each ring cone); sigma_f^2 is averaged per channel over the forward-scattered light (weights
+// forward_scattering over the cones of srbf_transmittance (weights 1/2 for the centre, 1/12 for each
+// ring cone), each marched with its own width: the direct fraction is srbf_transmittance; sigma_f^2 is averaged per channel over the forward-scattered light (weights
 // w (T_f - direct)).
 fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> ForwardScattering {
     let kappa = 2.0 / (lambda * lambda);
     let e = exp(-2.0 * kappa);
     let inner = acos(clamp(1.0 + log(0.5 * (1.0 - e) + e) / kappa, -1.0, 1.0));
-    let c = forward_scattering(p, centre, skip);
     if (inner < 0.05) {
-        return c;
+        return forward_scattering(p, centre, max(inner, 1e-4), skip);
     }
+    let c = forward_scattering(p, centre, inner, skip);
     let ring = acos(clamp(1.0 + log(0.25 * (1.0 - e) + e) / kappa, -1.0, 1.0));
     var e1 = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(centre.x) < 0.9);
     e1 = normalize(e1 - centre * dot(centre, e1));
     let e2 = cross(centre, e1);
+    let sub = min(ring * PI / 6.0, ring);
     var direct = 0.5 * c.direct_fraction;
     var tf = 0.5 * c.transmittance_f;
     var scattered = 0.5 * max(c.transmittance_f - vec3<f32>(c.direct_fraction), vec3<f32>(0.0));
@@ -34,7 +35,7 @@ fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> Forw
     for (var k = 0; k < 6; k++) {
         let a = f32(k) * TAU / 6.0;
         let d = normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring));
-        let f = forward_scattering(p, d, skip);
+        let f = forward_scattering(p, d, sub, skip);
         let w = 0.5 / 6.0;
         let s = w * max(f.transmittance_f - vec3<f32>(f.direct_fraction), vec3<f32>(0.0));
         direct = direct + w * f.direct_fraction;
@@ -57,6 +58,9 @@ fn build_shadow_grid(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
     let x = grid_point(g, k % n);
     // Transmittances are stored as logarithms: attenuation falls off exponentially into the hair, so
     // interpolating its logarithm follows it between grid points far better.
+    // The single-scattering transmittance from the same function with or without dual scattering, so
+    // d_f = d_b = 0 is single scattering exactly (the forward march's direct fraction is the same
+    // quantity, summed by other code).
     let t = log(max(srbf_transmittance(x, l.direction, l.lambda, g.skip), GRID_MIN_TRANSMITTANCE));
     if (g.forward == 0u) {
         shadow_values[2u * k] = vec4<f32>(t, vec3<f32>(t));

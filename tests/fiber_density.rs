@@ -283,6 +283,7 @@ fn forward_scattering_matches_ray_shooting_through_explicit_fibers() {
     let hair = hair_of(&fibers, diameter);
     let point_sigma: Vec<[f32; 3]> = fiber_sigma.iter().flat_map(|s| [*s, *s]).collect();
     let volume = FiberDensity::build(&hair, &point_sigma, 0.25);
+    let pyramid = strandlight::shadow::DensityPyramid::build(&volume);
     let mut r = Rng01::new(31);
     let rays = 3000;
     let (mut tf_ref, mut tf_vol) = ([0f64; 3], [0f64; 3]);
@@ -310,7 +311,7 @@ fn forward_scattering_matches_ray_shooting_through_explicit_fibers() {
                 n += 1;
             }
         }
-        let fs = forward_scattering(&volume, &table, p, w, 0.0);
+        let fs = forward_scattering(&pyramid, &volume, &table, p, w, 0.0, 0.0);
         for c in 0..3 {
             tf_ref[c] += prod[c];
             tf_vol[c] += fs.transmittance_f[c] as f64;

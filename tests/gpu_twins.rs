@@ -334,6 +334,7 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
     let table = ForwardTable::build(&HairParams::default(), variant);
     let voxel = 0.4;
     let cpu_volume = FiberDensity::build(&hair, &sigma, voxel);
+    let cpu_pyramid = strandlight::shadow::DensityPyramid::build(&cpu_volume);
     let grid = VolumeGrid::around(&hair, voxel);
     let gpu_hair = GpuHair::new(&ctx.device, &hair, &sigma);
     let volume = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
@@ -355,7 +356,8 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
                 p: p.to_array(),
                 skip: 0.01,
                 omega: [r * a.cos(), z, r * a.sin()],
-                _pad: 0.0,
+                // Thin rays and cones (coarser pyramid levels further out).
+                half_angle: if k % 2 == 0 { 0.0 } else { 0.15 },
             }
         })
         .collect();
@@ -363,10 +365,12 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
     let (mut worst_t, mut worst_s, mut lo) = (0f32, 0f32, 1f32);
     for (q, g) in queries.iter().zip(&gpu) {
         let c = forward_scattering(
+            &cpu_pyramid,
             &cpu_volume,
             &table,
             Vec3::from(q.p),
             Vec3::from(q.omega),
+            q.half_angle,
             q.skip,
         );
         worst_t = worst_t.max((c.direct_fraction - g.direct_fraction).abs());

@@ -13,9 +13,10 @@ use strandlight::render::reference::{
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::Preset;
+use strandlight::shadow::DensityPyramid;
 use strandlight::shadow::fiber_density::FiberDensity;
 use strandlight::shadow::fiber_grid::FiberGrid;
-use strandlight::shadow::forward::ForwardTable;
+use strandlight::shadow::forward::{ForwardTable, forward_scattering};
 use strandlight::shadow::ray_shooting::shoot_forward;
 
 /// Uniform numbers from a seeded PCG.
@@ -137,6 +138,7 @@ fn volume_direct_fraction_matches_the_fraction_of_free_rays() {
     let sigma = vec![params.sigma_a.map(|s| s as f32); hair.point_count()];
     let grid = FiberGrid::build(&hair, &sigma);
     let volume = FiberDensity::build(&hair, &sigma, 0.0625);
+    let pyramid = DensityPyramid::build(&volume);
     let table = ForwardTable::build(&params, REFERENCE_VARIANT);
     let mut rng = Uniform::new(11);
     for (name, dir, normal) in [
@@ -158,7 +160,7 @@ fn volume_direct_fraction_matches_the_fraction_of_free_rays() {
             let f = shoot_forward(&grid, &table, p, dir, u32::MAX);
             free += f.direct_fraction as f64;
             expected += volume.transmittance(p, dir, 0.0) as f64;
-            let v = strandlight::shadow::forward::forward_scattering(&volume, &table, p, dir, 0.0);
+            let v = forward_scattering(&pyramid, &volume, &table, p, dir, 0.0, 0.0);
             for c in 0..3 {
                 tf_rays[c] += f.transmittance_f[c] as f64 / n as f64;
                 tf_vol[c] += v.transmittance_f[c] as f64 / n as f64;

@@ -164,7 +164,7 @@ fn a_dyed_strand_layer_tints_the_light_it_forward_scatters_onto_white_hair() {
             .collect();
         let volume = FiberDensity::build(&hair, &sigma, 0.05);
         let pyramid = DensityPyramid::build(&volume);
-        let f = srbf_forward(&volume, &table, p, light, 0.1, 0.05);
+        let f = srbf_forward(&pyramid, &volume, &table, p, light, 0.1, 0.05);
         let t = pyramid.srbf_transmittance(p, light, 0.1, 0.05);
         println!(
             "front layer dyed {dyed}: direct {t:.4} (forward march {:.4}), T_f {:?}, sigma_f^2 {:?}",

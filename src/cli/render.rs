@@ -110,6 +110,9 @@ pub struct RenderArgs {
     /// Voxels along the hair's longest side (fiber-density volume).
     #[arg(long, default_value_t = 128)]
     pub volume_resolution: u32,
+    /// Points of the per-light shadow grid along the hair's longest side.
+    #[arg(long, default_value_t = 48)]
+    pub shadow_grid: u32,
     /// Linear float EXR (RGBA, alpha = coverage).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -233,6 +236,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         multiple_scattering: !args.single_scattering,
         lights_per_pass: args.lights_per_pass,
         volume_resolution: args.volume_resolution,
+        shadow_grid_resolution: args.shadow_grid,
         ..Default::default()
     };
     let mut options = GpuOptions::from_env();

@@ -10,14 +10,14 @@ use crate::shadow::forward::{ForwardScattering, ForwardTable};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-/// One query: point, skipped distance, direction towards the light.
+/// One query: point, skipped distance, direction towards the light, cone half-angle.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct ForwardQuery {
     pub p: [f32; 3],
     pub skip: f32,
     pub omega: [f32; 3],
-    pub _pad: f32,
+    pub half_angle: f32,
 }
 
 const _: () = assert!(std::mem::size_of::<ForwardQuery>() == 32);

@@ -108,7 +108,8 @@ pub struct RenderSettings {
     pub volume_resolution: u32,
     /// Shadow marches skip this many voxels at the shaded point (its own fiber's density).
     pub shadow_skip_voxels: f32,
-    /// Points of the per-light transmittance grid along the hair's longest side.
+    /// Points of the per-light transmittance grid along the hair's longest side (48: on the blond-clump
+    /// test against ray shooting the worst mean-colour error was 16 % at 32 points, 9.5 % at 48).
     pub shadow_grid_resolution: u32,
 }
 
@@ -125,7 +126,7 @@ impl Default for RenderSettings {
             lights_per_pass: 16,
             volume_resolution: 128,
             shadow_skip_voxels: 0.5,
-            shadow_grid_resolution: 32,
+            shadow_grid_resolution: 48,
         }
     }
 }

@@ -139,6 +139,12 @@ impl DensityPyramid {
 
     /// Crossings per cm along omega at p, read at continuous level `lod` (linear between levels).
     pub fn crossings_at(&self, p: Vec3, omega: Vec3, lod: f32) -> f32 {
+        let (a, m) = self.extinction_at(p, lod);
+        crossings(a, m, omega)
+    }
+
+    /// (a, M) at p at continuous level `lod` (trilinear in each level, linear between levels).
+    pub fn extinction_at(&self, p: Vec3, lod: f32) -> (f32, [f32; 6]) {
         let top = (self.levels.len() - 1) as f32;
         let lod = lod.clamp(0.0, top);
         let l0 = lod.floor() as usize;
@@ -146,9 +152,10 @@ impl DensityPyramid {
         let t = lod - l0 as f32;
         let (a0, m0) = self.levels[l0].sample(self.origin, p);
         let (a1, m1) = self.levels[l1].sample(self.origin, p);
-        let a = a0 + t * (a1 - a0);
-        let m = std::array::from_fn(|c| m0[c] + t * (m1[c] - m0[c]));
-        crossings(a, m, omega)
+        (
+            a0 + t * (a1 - a0),
+            std::array::from_fn(|c| m0[c] + t * (m1[c] - m0[c])),
+        )
     }
 
     /// Optical depth averaged over the cone around omega (half-angle `half_angle`) from p, out of the

@@ -21,10 +21,12 @@ pub struct GridShadow {
     pub sigma_f2: [f32; 3],
 }
 
-/// forward_scattering averaged over the cones of `srbf_transmittance` (twin of `srbf_forward` in
-/// `shaders/shadow_grid_build.wgsl`); sigma_f^2 is averaged per channel over the forward-scattered
-/// light, weights w (T_f - direct).
+/// forward_scattering over the cones of `srbf_transmittance` (twin of `srbf_forward` in
+/// `shaders/shadow_grid_build.wgsl`), each cone marched with its own width, so the direct fraction is
+/// `srbf_transmittance` itself; sigma_f^2 is averaged per channel over the forward-scattered light,
+/// weights w (T_f - direct).
 pub fn srbf_forward(
+    pyramid: &DensityPyramid,
     volume: &FiberDensity,
     table: &ForwardTable,
     p: Vec3,
@@ -33,8 +35,8 @@ pub fn srbf_forward(
     skip: f32,
 ) -> ForwardScattering {
     let (mut direct, mut tf, mut spread, mut scattered) = (0.0, [0.0; 3], [0.0; 3], [0.0; 3]);
-    for (d, _, w) in srbf_cones(centre, lambda) {
-        let f = forward_scattering(volume, table, p, d, skip);
+    for (d, half_angle, w) in srbf_cones(centre, lambda) {
+        let f = forward_scattering(pyramid, volume, table, p, d, half_angle, skip);
         direct += w * f.direct_fraction;
         for c in 0..3 {
             let s = w * (f.transmittance_f[c] - f.direct_fraction).max(0.0);
@@ -119,6 +121,8 @@ impl ShadowGrid {
     pub fn value(&self, src: &GridSources, i: usize, centre: Vec3, lambda: f32) -> GridShadow {
         let x = self.point(i);
         let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
+        // The same transmittance with or without dual scattering (d_f = d_b = 0 is single scattering
+        // exactly).
         let t = ln(src.pyramid.srbf_transmittance(x, centre, lambda, src.skip));
         match src.forward {
             None => GridShadow {
@@ -127,7 +131,7 @@ impl ShadowGrid {
                 sigma_f2: [0.0; 3],
             },
             Some((volume, table)) => {
-                let f = srbf_forward(volume, table, x, centre, lambda, src.skip);
+                let f = srbf_forward(src.pyramid, volume, table, x, centre, lambda, src.skip);
                 GridShadow {
                     transmittance: t,
                     transmittance_f: f.transmittance_f.map(ln),
