@@ -79,10 +79,10 @@ fn crossings_at(p: vec3<f32>, omega: vec3<f32>, lod: f32) -> f32 {
     return crossings(e.a, e.m0, e.m1, omega);
 }
 
-fn cone_optical_depth(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> f32 {
+// Distance from p along omega (unit) to where the ray leaves the pyramid's box.
+fn pyramid_exit(p: vec3<f32>, omega: vec3<f32>) -> f32 {
     let l0 = pyramid_info.levels[0];
-    let base = l0.voxel;
-    let hi = pyramid_info.origin + base * vec3<f32>(l0.dims);
+    let hi = pyramid_info.origin + l0.voxel * vec3<f32>(l0.dims);
     var exit = 3.0e38;
     for (var ax = 0; ax < 3; ax++) {
         let w = omega[ax];
@@ -91,6 +91,19 @@ fn cone_optical_depth(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32
             exit = min(exit, t);
         }
     }
+    return exit;
+}
+
+// One step of a cone march at distance s (tn = tan of the half-angle): (step length, pyramid level).
+// The step is half the cone's width there (at least half a level-0 voxel), the level that width's.
+fn cone_step(s: f32, tn: f32, exit: f32) -> vec2<f32> {
+    let base = pyramid_info.levels[0].voxel;
+    let width = max(2.0 * s * tn, base);
+    return vec2<f32>(max(min(0.5 * width, exit - s), 1e-6), log2(width / base));
+}
+
+fn cone_optical_depth(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> f32 {
+    let exit = pyramid_exit(p, omega);
     let tn = tan(min(half_angle, 1.5));
     var s = skip;
     var tau = 0.0;
@@ -98,11 +111,9 @@ fn cone_optical_depth(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32
         if (s >= exit) {
             break;
         }
-        let width = max(2.0 * s * tn, base);
-        let lod = log2(width / base);
-        let h = max(min(0.5 * width, exit - s), 1e-6);
-        tau = tau + crossings_at(p + omega * (s + 0.5 * h), omega, lod) * h;
-        s = s + h;
+        let st = cone_step(s, tn, exit);
+        tau = tau + crossings_at(p + omega * (s + 0.5 * st.x), omega, st.y) * st.x;
+        s = s + st.x;
     }
     return tau;
 }

@@ -58,16 +58,7 @@ fn forward_voxel_at(p: vec3<f32>) -> i32 {
 // width, pyramid levels of that width; 0: a thin ray on level 0), so the direct fraction is that
 // cone's exp(-tau).
 fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> ForwardScattering {
-    let l0 = pyramid_info.levels[0];
-    let base = l0.voxel;
-    let hi = pyramid_info.origin + base * vec3<f32>(l0.dims);
-    var exit = 3.0e38;
-    for (var ax = 0; ax < 3; ax++) {
-        let w = omega[ax];
-        if (abs(w) > 1e-12) {
-            exit = min(exit, select((pyramid_info.origin[ax] - p[ax]) / w, (hi[ax] - p[ax]) / w, w > 0.0));
-        }
-    }
+    let exit = pyramid_exit(p, omega);
     let tn = tan(min(half_angle, 1.5));
     var tau = 0.0;
     var loss = vec3<f32>(0.0);
@@ -78,9 +69,9 @@ fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32
         if (s >= exit) {
             break;
         }
-        let width = max(2.0 * s * tn, base);
-        let lod = log2(width / base);
-        let h = max(min(0.5 * width, exit - s), 1e-6);
+        let st = cone_step(s, tn, exit);
+        let h = st.x;
+        let lod = st.y;
         let x = p + omega * (s + 0.5 * h);
         s = s + h;
         let v = forward_voxel_at(x);

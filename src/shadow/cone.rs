@@ -161,19 +161,35 @@ impl DensityPyramid {
     /// Optical depth averaged over the cone around omega (half-angle `half_angle`) from p, out of the
     /// volume; `skip` cm left out at the start. Steps grow with the cone (half the level's voxel).
     pub fn cone_optical_depth(&self, p: Vec3, omega: Vec3, half_angle: f32, skip: f32) -> f32 {
-        let base = self.levels[0].voxel;
-        let exit = box_exit(self.origin, base, self.levels[0].dims, p, omega);
+        let exit = self.exit(p, omega);
         let tan = half_angle.min(1.5).tan();
         let mut s = skip;
         let mut tau = 0.0;
         while s < exit {
-            let width = (2.0 * s * tan).max(base);
-            let lod = (width / base).log2();
-            let h = (0.5 * width).min(exit - s).max(1e-6);
+            let (h, lod) = self.cone_step(s, tan, exit);
             tau += self.crossings_at(p + omega * (s + 0.5 * h), omega, lod) * h;
             s += h;
         }
         tau
+    }
+
+    /// Distance from p along omega (unit) to where the ray leaves the pyramid's box.
+    pub fn exit(&self, p: Vec3, omega: Vec3) -> f32 {
+        box_exit(
+            self.origin,
+            self.levels[0].voxel,
+            self.levels[0].dims,
+            p,
+            omega,
+        )
+    }
+
+    /// One step of a cone march at distance s (`tan` of the half-angle): (step length, level). The
+    /// step is half the cone's width there (at least half a level-0 voxel), the level that width's.
+    pub fn cone_step(&self, s: f32, tan: f32, exit: f32) -> (f32, f32) {
+        let base = self.levels[0].voxel;
+        let width = (2.0 * s * tan).max(base);
+        ((0.5 * width).min(exit - s).max(1e-6), (width / base).log2())
     }
 
     /// The SRBF light's transmittance at p: the G-weighted average of exp(-tau) over its directions,

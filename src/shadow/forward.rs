@@ -23,7 +23,7 @@
 //! fourth crossing in a sparse clump a clear fiber, and T_f of blond hair 1.5-2x too high in blue.
 
 use super::cone::{DensityPyramid, crossings};
-use super::fiber_density::{FiberDensity, box_exit};
+use super::fiber_density::FiberDensity;
 use crate::scattering::dual_terms::dual_sample;
 use crate::scattering::{HairParams, ModelVariant};
 use glam::Vec3;
@@ -128,15 +128,12 @@ pub fn forward_scattering(
     half_angle: f32,
     skip: f32,
 ) -> ForwardScattering {
-    let base = pyramid.levels[0].voxel;
-    let exit = box_exit(pyramid.origin, base, pyramid.levels[0].dims, p, omega);
+    let exit = pyramid.exit(p, omega);
     let tan = half_angle.min(1.5).tan();
     let (mut tau, mut loss, mut mass, mut spread) = (0f32, [0f32; 3], [0f32; 3], [0f32; 3]);
     let mut s = skip;
     while s < exit {
-        let width = (2.0 * s * tan).max(base);
-        let lod = (width / base).log2();
-        let h = (0.5 * width).min(exit - s).max(1e-6);
+        let (h, lod) = pyramid.cone_step(s, tan, exit);
         let x = p + omega * (s + 0.5 * h);
         s += h;
         let Some(v) = volume.voxel_at(x) else {
