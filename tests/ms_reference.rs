@@ -2,6 +2,8 @@
 //! renderer's dual scattering against it on a blond clump lit from the front, the side and the back.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use glam::{DVec3, Vec3};
 use rand_core::{Rng, SeedableRng};
 use strandlight::envmap::SrbfLight;
@@ -10,7 +12,7 @@ use strandlight::hair::{Hair, RawStrand};
 use strandlight::render::reference::{
     REFERENCE_VARIANT, ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
-use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
+use strandlight::render::{Camera, Frame, HairLook, RenderSettings};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::Preset;
 use strandlight::shadow::DensityPyramid;
@@ -146,7 +148,7 @@ fn volume_direct_fraction_matches_the_fraction_of_free_rays() {
         ("side", Vec3::new(1.0, 0.3, 0.0).normalize(), Vec3::X),
         ("back", Vec3::new(0.0, 0.3, -1.0).normalize(), -Vec3::Z),
     ] {
-        // Points 0.1..0.4 cm under the lit face (x = 2 or z = +-1), away from the clump's edges.
+        // Points 0.1..1.5 cm under the lit face (x = 2 or z = +-1), away from the clump's edges.
         let (mut free, mut expected, n) = (0.0f64, 0.0f64, 4000);
         let (mut tf_rays, mut tf_vol) = ([0.0f64; 3], [0.0f64; 3]);
         for _ in 0..n {
@@ -177,31 +179,6 @@ fn volume_direct_fraction_matches_the_fraction_of_free_rays() {
         assert!((expected / free - 1.0).abs() < 0.15);
         assert!(tf_err.iter().all(|e| e.abs() < 0.15), "T_f {tf_err:?}");
     }
-}
-
-fn render(
-    ctx: &GpuContext,
-    luts: &Luts,
-    hair: &Hair,
-    look: &HairLook,
-    light: &SrbfLight,
-    settings: &RenderSettings,
-    camera: &Camera,
-) -> Frame {
-    let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
-    let mut r = Renderer::new(
-        ctx,
-        settings.clone(),
-        luts,
-        hair,
-        &sigma_a,
-        look,
-        std::slice::from_ref(light),
-        camera,
-    )
-    .expect("renderer");
-    r.render_frame(ctx);
-    r.read_frame(ctx).expect("read back")
 }
 
 /// Mean over covered pixels of the beauty (None) or of the MS components' sum (Some(())), RGB.
@@ -263,7 +240,15 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
             rgb: [30.0; 3],
         };
         let t = std::time::Instant::now();
-        let frame = render(&ctx, &luts, &hair, &look, &light, &settings, &camera);
+        let frame = common::render_uniform(
+            &ctx,
+            &settings,
+            &luts,
+            &hair,
+            &look,
+            std::slice::from_ref(&light),
+            &camera,
+        );
         let t_gpu = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let reference = reference_frame(

@@ -3,6 +3,8 @@
 //! against their Rust twins in tests/gpu_twins.rs and tests/render.rs.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use glam::Vec3;
 use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
@@ -10,7 +12,7 @@ use strandlight::hair::procedural::Style;
 use strandlight::hair::{Hair, RawStrand};
 use strandlight::render::reference::REFERENCE_VARIANT;
 use strandlight::render::scene::generated_hair;
-use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
+use strandlight::render::{Camera, Frame, HairLook, RenderSettings};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::{HairParams, Preset};
 use strandlight::shadow::cone::DensityPyramid;
@@ -38,20 +40,7 @@ fn render(ctx: &GpuContext, luts: &Luts, hair: &Hair, look: &HairLook, multiple:
         shadow_grid_resolution: 12,
         ..Default::default()
     };
-    let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
-    let mut r = Renderer::new(
-        ctx,
-        settings,
-        luts,
-        hair,
-        &sigma_a,
-        look,
-        &lights().lights,
-        &camera,
-    )
-    .expect("renderer");
-    r.render_frame(ctx);
-    r.read_frame(ctx).expect("read back")
+    common::render_uniform(ctx, &settings, luts, hair, look, &lights().lights, &camera)
 }
 
 /// Sum over covered pixels of the green channel of component `c` (None: the beauty).

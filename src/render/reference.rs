@@ -136,7 +136,12 @@ fn dual_directional(
         phi,
         lambda: 0.0,
     };
-    let local_direct = local_response(&fp, d.dual, light, theta_o, phi_o, 0.0);
+    // The direct part's local term weighs with the direct fraction (0 or 1 per ray).
+    let local_direct = if f.direct_fraction > 0.0 {
+        local_response(&fp, d.dual, light, theta_o, phi_o, 0.0)
+    } else {
+        [0.0; 3]
+    };
     let (mut global, mut local) = ([0.0f32; 3], [0.0f32; 3]);
     if f.direct_fraction < 1.0 {
         // Each channel with its own sigma_f^2 (the renderer uses their mean).

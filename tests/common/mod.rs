@@ -133,3 +133,30 @@ pub fn glb() -> Vec<u8> {
 
 pub const OBJ: &str =
     "o quad\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvn 0 1 0\nf 1//1 2//1 3//1 4//1\n";
+
+/// One frame of `hair` with the look's absorption at every point (a renderer made, drawn once, read
+/// back).
+pub fn render_uniform(
+    ctx: &strandlight::gpu::GpuContext,
+    settings: &strandlight::render::RenderSettings,
+    luts: &strandlight::scattering::lut::Luts,
+    hair: &strandlight::hair::Hair,
+    look: &strandlight::render::HairLook,
+    lights: &[strandlight::envmap::SrbfLight],
+    camera: &strandlight::render::Camera,
+) -> strandlight::render::Frame {
+    let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
+    let mut r = strandlight::render::Renderer::new(
+        ctx,
+        settings.clone(),
+        luts,
+        hair,
+        &sigma_a,
+        look,
+        lights,
+        camera,
+    )
+    .expect("renderer");
+    r.render_frame(ctx);
+    r.read_frame(ctx).expect("read back")
+}
