@@ -12,8 +12,11 @@ struct FastHairParams {
     quadrature_segments: u32,
     d_f: f32,
     d_b: f32,
-    _pad: f32,
+    // 0: d'Eon et al. 2011's normalised M (LONGITUDINAL_NORMALIZED); 1: published (LONGITUDINAL_PUBLISHED).
+    longitudinal: u32,
 }
+
+const LONGITUDINAL_PUBLISHED: u32 = 1u;
 
 struct SrbfInFrame {
     theta: f32,
@@ -61,13 +64,54 @@ fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
     return min(lambda_j / sqrt(c), LAMBDA_PRIME_MAX);
 }
 
-// cos^2(theta_i) / cos^2(theta_d) calN_t at theta_i.
+// theta_o' = theta_o - 2 alpha, reflected back into [-pi/2, pi/2] past a pole.
+fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
+    let t = theta_o - 2.0 * alpha;
+    if (t > FRAC_PI_2) {
+        return PI - t;
+    }
+    if (t < -FRAC_PI_2) {
+        return -PI - t;
+    }
+    return t;
+}
+
+// The centre of the quadrature's Gaussian: published 2 alpha - theta_o, normalised -theta_o'.
+fn longitudinal_centre(longitudinal: u32, theta_o: f32, alpha: f32) -> f32 {
+    if (longitudinal == LONGITUDINAL_PUBLISHED) {
+        return 2.0 * alpha - theta_o;
+    }
+    return -tilted_outgoing(theta_o, alpha);
+}
+
+// ln M_p(theta_i, theta_o) of d'Eon et al. 2011, variance v, tilt 2 alpha on the outgoing inclination
+// (reflected back at the poles).
+fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f32 {
+    let t = tilted_outgoing(theta_o, alpha);
+    let a = max(cos(theta_i), 0.0) * cos(t) / v;
+    let half = sin(0.5 * (theta_i + t));
+    return log(bessel_i0_scaled(a)) - 2.0 * half * half / v - log(v) - log(1.0 - exp(-2.0 / v));
+}
+
+// The longitudinal factor relative to the unit-area Gaussian of std 2 beta around 2 alpha - theta_o:
+// published 2 cos^2(theta_i) / cos^2(theta_d); normalised cos(theta_i) M^dEon / Gaussian.
+fn longitudinal_factor(longitudinal: u32, theta_i: f32, theta_o: f32, alpha: f32, beta: f32) -> f32 {
+    let ci = max(cos(theta_i), 0.0);
+    if (longitudinal == LONGITUDINAL_PUBLISHED) {
+        let cd = cos(0.5 * (theta_o - theta_i));
+        return 2.0 * ci * ci / max(cd * cd, 1e-8);
+    }
+    let v = 4.0 * beta * beta;
+    let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
+    let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha) + d * d / (2.0 * v) + 0.5 * log(2.0 * PI * v);
+    return ci * exp(clamp(ln_ratio, -80.0, 20.0));
+}
+
+// longitudinal_factor x calN_t at theta_i.
 fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, theta_i: f32) -> vec3<f32> {
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let ci = cos(theta_i);
-    let cd = cos(theta_d);
-    let w = ci * ci / max(cd * cd, 1e-8);
+    let w = longitudinal_factor(params.longitudinal, theta_i, theta_o, params.alpha[lobe], params.beta[lobe]);
     let dphi = phi_o - light.phi;
     let sigma = params.sigma_a.xyz;
     if (lobe == 0u) {
@@ -150,10 +194,10 @@ fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f
 fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
     let alpha = params.alpha[lobe];
     let beta = params.beta[lobe];
-    let mu_m = 2.0 * alpha - theta_o;
+    let mu_m = longitudinal_centre(params.longitudinal, theta_o, alpha);
     let lambda_m = 2.0 * SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
-    let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * beta);
+    let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * 2.0 * beta);
     if (scale < 1e-30) {
         return vec3<f32>(0.0);
     }

@@ -316,3 +316,28 @@ fn srbf_response_fast_against_reference_and_batch() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn render_reference_takes_an_optional_mode() {
+    // A bad mode is refused before anything is rendered, naming the modes.
+    let out = strandlight()
+        .args([
+            "render",
+            "--reference=bogus",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("dual") && err.contains("path"), "{err}");
+    // The help documents both forms and the path tracer's flags.
+    let out = strandlight().args(["render", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&out.stdout);
+    for want in ["--reference[=<REFERENCE>]", "--spp", "--max-depth"] {
+        assert!(help.contains(want), "help lacks {want}");
+    }
+}

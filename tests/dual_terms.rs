@@ -8,12 +8,12 @@ use strandlight::scattering::dual_terms::{
 use strandlight::scattering::numeric::integrate_piecewise_relative;
 use strandlight::scattering::reference::{azimuthal_energy, scatter_fraction};
 use strandlight::scattering::{
-    CausticModel, FiberAngles, FresnelModel, HairParams, Lobe, ModelVariant, scattering_s_p,
+    CausticModel, FiberAngles, HairParams, Lobe, LongitudinalModel, ModelVariant, scattering_s_p,
 };
 
 const XU_ROOTS: ModelVariant = ModelVariant {
-    fresnel: FresnelModel::XuSchlick,
     caustic: CausticModel::None,
+    ..ModelVariant::XU
 };
 
 /// Brute-force front (or back) energy fraction from incident inclination theta: (1/2) integral over
@@ -32,11 +32,15 @@ fn brute_force_split(params: &HairParams, theta: f64, front: bool, ch: usize) ->
             }
         }
         breaks.sort_by(f64::total_cmp);
+        // a_f, a_b are energy fractions of light arriving from theta, split over the outgoing sphere: the
+        // published M_t(theta_h) / 2 is a unit-area density over theta_o (dual_terms.rs), hence the
+        // published S here with (1/2) cos^2(theta_d) undoing its 1/cos^2(theta_d).
+        let published = XU_ROOTS.with_longitudinal(LongitudinalModel::Published);
         let inner = |theta_o: f64| {
             let f = |phi: f64| {
                 let s = scattering_s_p(
                     params,
-                    XU_ROOTS,
+                    published,
                     lobe,
                     FiberAngles::new(theta, 0.0),
                     FiberAngles::new(theta_o, phi),
@@ -198,18 +202,41 @@ fn global_and_local_terms_against_direct_quadrature() {
     };
     use strandlight::scattering::fast_params::FastHairParams;
     use strandlight::scattering::fast_response::SrbfInFrame;
-    use strandlight::scattering::marschner::{AzimuthalLobe, longitudinal_m_p};
+    use strandlight::scattering::marschner::{
+        AzimuthalLobe, ln_longitudinal_deon, longitudinal_m_p, longitudinal_m_p_normalized,
+        tilted_outgoing,
+    };
     let p = HairParams::with_sigma_a([0.2, 0.5, 1.0]);
-    let fp = FastHairParams::new(&p, 4);
     let tables = DualTables::build(&p, XU_ROOTS);
     let gauss = |x: f64, s: f64| (-x * x / (2.0 * s * s)).exp() / ((2.0 * PI).sqrt() * s);
     let (mut worst_g, mut worst_l): (f64, f64) = (0.0, 0.0);
-    for &(theta_j, dphi, lambda, sigma_f2, theta_o) in &[
-        (0.3f64, 2.8f64, 0.2f64, 0.01f64, -0.2f64),
-        (-0.4, 3.1, 0.6, 0.05, 0.5),
-        (0.1, 1.2, 0.1, 0.002, -0.1),
-        (0.6, 2.2, 0.3, 0.03, -0.7),
-    ] {
+    for (longitudinal, &(theta_j, dphi, lambda, sigma_f2, theta_o)) in
+        [LongitudinalModel::Normalized, LongitudinalModel::Published]
+            .iter()
+            .flat_map(|l| {
+                [
+                    (0.3f64, 2.8f64, 0.2f64, 0.01f64, -0.2f64),
+                    (-0.4, 3.1, 0.6, 0.05, 0.5),
+                    (0.1, 1.2, 0.1, 0.002, -0.1),
+                    (0.6, 2.2, 0.3, 0.03, -0.7),
+                ]
+                .iter()
+                .map(move |c| (*l, c))
+            })
+            .collect::<Vec<_>>()
+    {
+        let fp = FastHairParams::new(&p, 4).with_longitudinal(longitudinal);
+        let published = longitudinal == LongitudinalModel::Published;
+        // M_p times what turns S cos(theta_i) d omega_i into d theta_i d phi_i.
+        let m_weight = |lobe: Lobe, ti: f64| {
+            if published {
+                let td = 0.5 * (theta_o - ti);
+                longitudinal_m_p(&p, lobe, 0.5 * (ti + theta_o)) * ti.cos().powi(2)
+                    / td.cos().powi(2)
+            } else {
+                longitudinal_m_p_normalized(&p, lobe, ti, theta_o) * ti.cos()
+            }
+        };
         let light = SrbfInFrame {
             theta: theta_j as f32,
             phi: (0.4 - dphi) as f32,
@@ -243,12 +270,7 @@ fn global_and_local_terms_against_direct_quadrature() {
                         &b,
                         1e-6,
                     ) / PI;
-                    gauss(ti - theta_j, sigma)
-                        * longitudinal_m_p(&p, lobe, 0.5 * (ti + theta_o))
-                        * ti.cos().powi(2)
-                        / td.cos().powi(2)
-                        * n
-                        / theta_j.cos()
+                    gauss(ti - theta_j, sigma) * m_weight(lobe, ti) * n / theta_j.cos()
                 };
                 let mut br = vec![lo, hi, theta_j];
                 let c = 2.0 * p.alpha(lobe) - theta_o;
@@ -271,18 +293,22 @@ fn global_and_local_terms_against_direct_quadrature() {
                 let td = 0.5 * (theta_o - ti);
                 let s = tables.lookup(td as f32);
                 let sb = s.sigma_b[ch] as f64;
-                2.0 * azim / theta_j.cos()
-                    * gauss(ti - theta_j, sigma)
-                    * gauss(ti - (s.delta_b[ch] as f64 - theta_o), sb)
-                    * s.big_a_b[ch] as f64
-                    * ti.cos().powi(2)
-                    / td.cos().powi(2)
+                let delta_b = s.delta_b[ch] as f64;
+                // Zinke's back lobe: published 2 g(theta_i + theta_o - Delta_b; sigma_b) cos^2/cos^2(theta_d);
+                // normalised, d'Eon's M of variance sigma_b^2 tilted by Delta_b, times cos(theta_i).
+                let back = if published {
+                    2.0 * gauss(ti - (delta_b - theta_o), sb) * ti.cos().powi(2) / td.cos().powi(2)
+                } else {
+                    let (so, co) = tilted_outgoing(theta_o, 0.5 * delta_b);
+                    ln_longitudinal_deon(sb * sb, ti, so, co).exp() * ti.cos()
+                };
+                azim / theta_j.cos() * gauss(ti - theta_j, sigma) * back * s.big_a_b[ch] as f64
             };
             let direct_l = integrate_piecewise_relative(&fl, &[lo, theta_j, hi], 1e-6);
             let el = fast_l / direct_l - 1.0;
             worst_l = worst_l.max(el.abs());
             println!(
-                "theta_j {theta_j:+.1} dphi {dphi:.1} lambda {lambda} sigma_f^2 {sigma_f2} ch {ch}: M^G {fast:.4e} vs {direct:.4e} ({eg:+.2e}); M^L {fast_l:.4e} vs {direct_l:.4e} ({el:+.2e})"
+                "{longitudinal:?} theta_j {theta_j:+.1} dphi {dphi:.1} lambda {lambda} sigma_f^2 {sigma_f2} ch {ch}: M^G {fast:.4e} vs {direct:.4e} ({eg:+.2e}); M^L {fast_l:.4e} vs {direct_l:.4e} ({el:+.2e})"
             );
         }
     }

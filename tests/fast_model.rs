@@ -16,13 +16,11 @@ use strandlight::scattering::lut::Luts;
 use strandlight::scattering::marschner::AzimuthalLobe;
 use strandlight::scattering::reference::scatter_fraction;
 use strandlight::scattering::srbf_reference::{SrbfLight64, srbf_response_reference};
-use strandlight::scattering::{
-    CausticModel, FiberAngles, FresnelModel, HairParams, Lobe, ModelVariant,
-};
+use strandlight::scattering::{CausticModel, FiberAngles, HairParams, Lobe, ModelVariant};
 
 const XU_ROOTS: ModelVariant = ModelVariant {
-    fresnel: FresnelModel::XuSchlick,
     caustic: CausticModel::None,
+    ..ModelVariant::XU
 };
 
 fn fit_energy_and_l1(az: &AzimuthalLobe, fit: &LobeFit) -> (f64, f64, f64) {
@@ -190,29 +188,49 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
     v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
-/// Xu Fig. 5 as numbers: m = 4 segments against m = 200.
+/// Xu Fig. 5 as numbers: m = 4 segments against m = 200, for both longitudinal functions.
+///
+/// The normalised M (d'Eon) is integrated against the Gaussian of its peak and width with the ratio in the
+/// interpolated factor. Near a pole (|theta_o'| > 60 degrees with a wide R lobe and a wide light) that ratio
+/// times cos(theta_i) bends from sqrt(cos theta_i) to linear in cos theta_i over the lobe, which four
+/// segments follow less well than the published cos^2(theta_i) / cos^2(theta_d): p95 about 3 % against 0.9 %.
 #[test]
 fn fig5_linear_quadrature_m4_against_m200() {
+    use strandlight::scattering::LongitudinalModel;
     let luts = Luts::default_tables();
     let configs = grid(400, 5);
-    let mut errs: Vec<f64> = configs
-        .iter()
-        .map(|c| {
-            let (a, b) = (fast(&luts, c, 4), fast(&luts, c, 200));
-            let floor = 1e-4 * light_power(c.light.lambda);
-            rel_err(a.iter().sum(), b.iter().sum(), floor)
-        })
-        .collect();
-    let (med, p95, max) = (
-        percentile(&mut errs, 0.5),
-        percentile(&mut errs, 0.95),
-        percentile(&mut errs, 1.0),
-    );
-    println!(
-        "m = 4 vs m = 200 over {} configurations: median {med:.2e}, p95 {p95:.2e}, max {max:.2e}",
-        errs.len()
-    );
-    assert!(p95 <= 0.01, "p95 {p95}");
+    for (longitudinal, limit) in [
+        (LongitudinalModel::Published, 0.01),
+        (LongitudinalModel::Normalized, 0.04),
+    ] {
+        let fast = |c: &Config, m: u32| {
+            let fp = FastHairParams::new(&c.params, m).with_longitudinal(longitudinal);
+            let light = SrbfInFrame {
+                theta: c.light.theta as f32,
+                phi: c.light.phi as f32,
+                lambda: c.light.lambda as f32,
+            };
+            let r = srbf_response(&luts, &fp, light, c.view.theta as f32, c.view.phi as f32);
+            r[0][0] as f64 + r[1][0] as f64 + r[2][0] as f64
+        };
+        let mut errs: Vec<f64> = configs
+            .iter()
+            .map(|c| {
+                let floor = 1e-4 * light_power(c.light.lambda);
+                rel_err(fast(c, 4), fast(c, 200), floor)
+            })
+            .collect();
+        let (med, p95, max) = (
+            percentile(&mut errs, 0.5),
+            percentile(&mut errs, 0.95),
+            percentile(&mut errs, 1.0),
+        );
+        println!(
+            "{longitudinal:?}: m = 4 vs m = 200 over {} configurations: median {med:.2e}, p95 {p95:.2e}, max {max:.2e}",
+            errs.len()
+        );
+        assert!(p95 <= limit, "{longitudinal:?}: p95 {p95}");
+    }
 }
 
 /// The fast response against the brute-force integral of the exact model over 512 configurations.

@@ -260,11 +260,11 @@ fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
 /// a_f(theta_k, sigma_a_k) over the fibers crossed and the sum of their beta_f^2, weighted by that product.
 #[test]
 fn forward_scattering_matches_ray_shooting_through_explicit_fibers() {
-    use strandlight::scattering::{CausticModel, FresnelModel, HairParams, ModelVariant};
+    use strandlight::scattering::{CausticModel, HairParams, ModelVariant};
     use strandlight::shadow::forward::{ForwardTable, forward_scattering};
     let variant = ModelVariant {
-        fresnel: FresnelModel::XuSchlick,
         caustic: CausticModel::None,
+        ..ModelVariant::XU
     };
     let table = ForwardTable::build(&HairParams::with_sigma_a([0.3; 3]), variant);
     let size = 4.0;

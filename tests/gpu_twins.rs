@@ -7,6 +7,7 @@ use std::f64::consts::PI;
 use strandlight::gpu::fast_eval::{FastEvalPipeline, FastQuery, GpuLuts};
 use strandlight::gpu::{GpuContext, GpuOptions, shaders};
 use strandlight::scattering::HairParams;
+use strandlight::scattering::LongitudinalModel;
 use strandlight::scattering::fast_params::FastHairParams;
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
@@ -89,7 +90,14 @@ fn queries(n: usize) -> Vec<FastQuery> {
             p.eccentricity = if i % 2 == 0 { 1.0 } else { 0.85 + 0.15 * u() };
             let phi_o = ((2.0 * u() - 1.0) * PI) as f32;
             FastQuery {
-                params: FastHairParams::new(&p, if i % 7 == 0 { 6 } else { 4 }),
+                // Every fifth query with the published longitudinal function (both twins' branches).
+                params: FastHairParams::new(&p, if i % 7 == 0 { 6 } else { 4 }).with_longitudinal(
+                    if i % 5 == 0 {
+                        LongitudinalModel::Published
+                    } else {
+                        LongitudinalModel::Normalized
+                    },
+                ),
                 theta_j: ((2.0 * u() - 1.0) * 1.4) as f32,
                 phi_j: phi_o - ((2.0 * u() - 1.0) * PI) as f32,
                 lambda: (0.03 * 70f64.powf(u())) as f32,
@@ -314,7 +322,7 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
     use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
     use strandlight::gpu::forward::{ForwardQuery, evaluate_forward, upload_forward_table};
     use strandlight::hair::procedural::{Style, StyleParams, generate};
-    use strandlight::scattering::{CausticModel, FresnelModel, ModelVariant};
+    use strandlight::scattering::{CausticModel, ModelVariant};
     use strandlight::shadow::FiberDensity;
     use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::forward::{ForwardTable, forward_scattering};
@@ -328,8 +336,8 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
         .map(|&t| [0.2, 0.3 + 1.5 * t, 0.5 + 2.0 * t])
         .collect();
     let variant = ModelVariant {
-        fresnel: FresnelModel::XuSchlick,
         caustic: CausticModel::None,
+        ..ModelVariant::XU
     };
     let table = ForwardTable::build(&HairParams::default(), variant);
     let voxel = 0.4;
@@ -415,7 +423,11 @@ fn wgsl_dual_scattering_responses_equal_the_rust_twins() {
         let fast = FastHairParams::new(&params, 4);
         let mut qs = queries(256);
         for (i, q) in qs.iter_mut().enumerate() {
-            q.params = fast;
+            q.params = if i % 5 == 0 {
+                fast.with_longitudinal(LongitudinalModel::Published)
+            } else {
+                fast
+            };
             q._pad[0] = 0.02 * ((i * 7 + k) % 11) as f32; // sigma_f^2 in 0..0.2 rad^2
         }
         let gpu = evaluate_dual(&ctx, &buffer, &qs).expect("GPU evaluation");

@@ -12,7 +12,7 @@ use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHair
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::tables::build_all;
-use strandlight::scattering::{CausticModel, FiberFrame, FresnelModel, HairParams, ModelVariant};
+use strandlight::scattering::{CausticModel, FiberFrame, HairParams, ModelVariant};
 
 #[derive(Args, Debug)]
 pub struct BenchFastArgs {
@@ -62,8 +62,8 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
     let lut_median = median(&mut lut_times);
     let params = HairParams::default();
     let variant = ModelVariant {
-        fresnel: FresnelModel::XuSchlick,
         caustic: CausticModel::None,
+        ..ModelVariant::XU
     };
     let mut dual_times: Vec<f64> = (0..repeats)
         .map(|_| {

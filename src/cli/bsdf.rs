@@ -61,6 +61,7 @@ pub struct Answer {
     pub theta_d: f64,
     pub phi: f64,
     pub variant: super::params_args::VariantArg,
+    pub longitudinal: strandlight::scattering::LongitudinalModel,
     pub params: ParamsReport,
     #[serde(rename = "S")]
     pub s: LobeReport,
@@ -82,7 +83,13 @@ pub fn evaluate(q: &Query, defaults: &ParamArgs) -> anyhow::Result<Answer> {
     let wi = FiberAngles::new(q.theta_i.to_radians(), q.phi_i.to_radians());
     let wo = FiberAngles::new(q.theta_o.to_radians(), q.phi_o.to_radians());
     let ha = HalfAngles::new(wi, wo);
-    let v = scattering_s(&params, variant.variant(), wi, wo);
+    let longitudinal = args.longitudinal.unwrap_or_default();
+    let v = scattering_s(
+        &params,
+        variant.variant().with_longitudinal(longitudinal),
+        wi,
+        wo,
+    );
     Ok(Answer {
         theta_i: q.theta_i,
         phi_i: q.phi_i,
@@ -92,6 +99,7 @@ pub fn evaluate(q: &Query, defaults: &ParamArgs) -> anyhow::Result<Answer> {
         theta_d: ha.theta_d.to_degrees(),
         phi: ha.phi.to_degrees(),
         variant,
+        longitudinal,
         params: ParamsReport::new(&params),
         s: LobeReport {
             total: v.total(),

@@ -4,7 +4,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
 use strandlight::scattering::params::sigma_a_from_melanin;
-use strandlight::scattering::{HairParams, Lobe, ModelVariant, Preset};
+use strandlight::scattering::{HairParams, Lobe, LongitudinalModel, ModelVariant, Preset};
 
 /// Which form of the exact model to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize, Default)]
@@ -85,6 +85,10 @@ pub struct ParamArgs {
     /// Model variant.
     #[arg(long, value_enum)]
     pub variant: Option<VariantArg>,
+    /// Longitudinal function: normalized (d'Eon et al. 2011, energy-conserving, the default) or
+    /// published (Marschner 2003 / Xu 2011 Eq. 7: about twice too bright, for comparison with the papers).
+    #[arg(long, value_enum)]
+    pub longitudinal: Option<LongitudinalModel>,
 }
 
 impl ParamArgs {
@@ -110,7 +114,8 @@ impl ParamArgs {
             caustic_fade,
             caustic_limit,
             glint_scale,
-            variant
+            variant,
+            longitudinal
         )
     }
 

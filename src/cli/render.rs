@@ -11,6 +11,7 @@ use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
 use strandlight::paint::{AbsorptionSpec, PaintLayer, sigma_a_from_colour};
 use strandlight::render::camera::CAMERA_PRESETS;
+use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
@@ -123,17 +124,36 @@ pub struct RenderArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// Shade the same visible points on the CPU with the exact model instead: under directions
-    /// importance-sampled from the environment image (or, for .srbf.json, sampled from its lobes). With
-    /// multiple scattering (the default): Zinke's dual scattering with every direction's shadow ray
-    /// traced through the explicit fibers; with --single-scattering: the volume's exp(-tau) shadows.
-    #[arg(long)]
-    pub reference: bool,
-    /// Directions sampled by --reference.
+    /// importance-sampled from the environment image (or, for .srbf.json, sampled from its lobes).
+    /// `--reference` (or `--reference=dual`): with multiple scattering (the default), Zinke's dual
+    /// scattering with every direction's shadow ray traced through the explicit fibers; with
+    /// --single-scattering, the volume's exp(-tau) shadows. `--reference=path`: a path tracer through
+    /// the explicit fibers, every order of scattering (see --spp, --max-depth); with
+    /// --single-scattering, single scattering with exact shadows (--no-shadows is ignored: a path
+    /// tracer always has occlusion). MS.global holds all orders above single scattering.
+    #[arg(long, value_enum, num_args = 0..=1, require_equals = true, default_missing_value = "dual")]
+    pub reference: Option<ReferenceMode>,
+    /// Directions sampled by --reference (per visible point with --reference=path and an image).
     #[arg(long, default_value_t = 1024)]
     pub reference_directions: usize,
+    /// Paths per visible point of --reference=path.
+    #[arg(long, default_value_t = PathTraceSettings::default().samples_per_pixel)]
+    pub spp: u32,
+    /// Most bounces after the visible point of --reference=path.
+    #[arg(long, default_value_t = PathTraceSettings::default().max_depth)]
+    pub max_depth: u32,
     /// Use a software adapter (lavapipe).
     #[arg(long)]
     pub software: bool,
+}
+
+/// Which reference `--reference` computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ReferenceMode {
+    /// Single scattering and Zinke's dual scattering by ray shooting (the default).
+    Dual,
+    /// Brute-force path tracing through the explicit fibers.
+    Path,
 }
 
 /// The per-point absorption (preset or dye, gradient, per-strand variation, paint layer) and the
@@ -248,7 +268,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         bail!("--d-f and --d-b lie in [0, 1]");
     }
     let (sigma_a, params) = absorption(&args, &hair, params)?;
-    let look = HairLook::new(params).with_dual(args.d_f, args.d_b);
+    let look = HairLook::new(params)
+        .with_dual(args.d_f, args.d_b)
+        .with_longitudinal(args.params.longitudinal.unwrap_or_default());
     let t = Instant::now();
     let mut renderer = Renderer::new(
         &ctx,
@@ -278,7 +300,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         t.elapsed().as_secs_f64()
     );
     let mut mode = "srbf".to_string();
-    if args.reference {
+    if let Some(reference) = args.reference {
         let t = Instant::now();
         let directions = args.reference_directions.max(1);
         // The environment image when there is one (the fit's error is then part of what is measured),
@@ -298,28 +320,49 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             ReferenceLighting::Environment { .. } => "environment image",
             ReferenceLighting::Directional(_) => "SRBF lobes",
         };
-        frame = reference_frame(
-            &frame,
-            &ReferenceScene {
-                hair: &hair,
-                sigma_a: &sigma_a,
-                look: &look,
-                lighting,
-                settings: &settings,
-                camera: &camera,
-            },
-        );
-        let shadows = match (settings.multiple_scattering, settings.shadows) {
-            (true, true) => "dual scattering, shadow rays through the fibers",
-            (true, false) => "dual scattering, unshadowed",
-            (false, true) => "single scattering, volume shadows",
-            (false, false) => "single scattering, unshadowed",
+        let scene = ReferenceScene {
+            hair: &hair,
+            sigma_a: &sigma_a,
+            look: &look,
+            lighting,
+            settings: &settings,
+            camera: &camera,
+        };
+        let what = match reference {
+            ReferenceMode::Dual => {
+                frame = reference_frame(&frame, &scene);
+                match (settings.multiple_scattering, settings.shadows) {
+                    (true, true) => "dual scattering, shadow rays through the fibers".to_string(),
+                    (true, false) => "dual scattering, unshadowed".to_string(),
+                    (false, true) => "single scattering, volume shadows".to_string(),
+                    (false, false) => "single scattering, unshadowed".to_string(),
+                }
+            }
+            ReferenceMode::Path => {
+                let pt = PathTraceSettings {
+                    samples_per_pixel: args.spp.max(1),
+                    max_depth: args.max_depth,
+                    ..Default::default()
+                };
+                frame = path_trace_frame(&frame, &scene, &pt);
+                if settings.multiple_scattering {
+                    format!(
+                        "path traced, {} paths per point, at most {} bounces",
+                        pt.samples_per_pixel, pt.max_depth
+                    )
+                } else {
+                    format!(
+                        "path traced single scattering with shadow rays, {} samples per point",
+                        pt.samples_per_pixel
+                    )
+                }
+            }
         };
         eprintln!(
-            "reference: {directions} directions from the {source}, {shadows}, shaded on the CPU in {:.2} s",
+            "reference: {directions} directions from the {source}, {what}, shaded on the CPU in {:.2} s",
             t.elapsed().as_secs_f64()
         );
-        mode = format!("reference ({directions} directions from the {source}; {shadows})");
+        mode = format!("reference ({directions} directions from the {source}; {what})");
     }
     let attributes = vec![
         ("hair".to_string(), hair_name),

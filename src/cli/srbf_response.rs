@@ -10,9 +10,7 @@ use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHair
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::srbf_reference::{SrbfLight64, srbf_response_reference};
-use strandlight::scattering::{
-    CausticModel, FiberAngles, FresnelModel, Lobe, LobeValues, ModelVariant, Rgb,
-};
+use strandlight::scattering::{CausticModel, FiberAngles, Lobe, LobeValues, ModelVariant, Rgb};
 
 #[derive(Args, Debug)]
 pub struct SrbfResponseArgs {
@@ -121,7 +119,8 @@ fn evaluate(
         );
     }
     let params = args.resolve()?;
-    let fp = FastHairParams::new(&params, segments);
+    let longitudinal = args.longitudinal.unwrap_or_default();
+    let fp = FastHairParams::new(&params, segments).with_longitudinal(longitudinal);
     let light = SrbfInFrame {
         theta: q.theta_j.to_radians() as f32,
         phi: q.phi_j.to_radians() as f32,
@@ -138,9 +137,10 @@ fn evaluate(
     let fast = lobes(fast);
     let (reference, relative_error) = if reference {
         let variant = ModelVariant {
-            fresnel: FresnelModel::XuSchlick,
             caustic: CausticModel::None,
-        };
+            ..ModelVariant::XU
+        }
+        .with_longitudinal(longitudinal);
         let l64 = SrbfLight64 {
             theta: q.theta_j.to_radians(),
             phi: q.phi_j.to_radians(),

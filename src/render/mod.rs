@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod frame;
+pub mod path_trace;
 pub mod reference;
 pub mod reference_lights;
 pub mod renderer;

@@ -25,7 +25,7 @@ use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::fast_response::SrbfInFrame;
 use crate::scattering::frame::{FiberAngles, FiberFrame};
 use crate::scattering::marschner::scattering_s;
-use crate::scattering::params::{CausticModel, FresnelModel, HairParams, ModelVariant};
+use crate::scattering::params::{CausticModel, HairParams, ModelVariant};
 use crate::shadow::fiber_density::FiberDensity;
 use crate::shadow::fiber_grid::FiberGrid;
 use crate::shadow::forward::{ForwardScattering, ForwardTable};
@@ -36,8 +36,8 @@ pub use super::reference_lights::{DirectionalLight, importance_sample_env, sampl
 
 /// The variant the fast model approximates (and the reference evaluates).
 pub const REFERENCE_VARIANT: ModelVariant = ModelVariant {
-    fresnel: FresnelModel::XuSchlick,
     caustic: CausticModel::None,
+    ..ModelVariant::XU
 };
 
 /// Quadrature segments of the reference's dual-scattering responses (the renderer uses Xu's m = 4).
@@ -66,6 +66,7 @@ pub enum ReferenceShadows<'a> {
 /// (R, TT, TRT) and, with [`ReferenceShadows::Dual`], MS.global and MS.local.
 pub fn reference_shade(
     params: &HairParams,
+    variant: ModelVariant,
     sp: &ShadingPoint,
     omega_o: Vec3,
     lights: &[DirectionalLight],
@@ -100,7 +101,7 @@ pub fn reference_shade(
         if vis <= 0.0 {
             continue;
         }
-        let s = scattering_s(&p, REFERENCE_VARIANT, wi, wo);
+        let s = scattering_s(&p, variant, wi, wo);
         let k = vis * wi.theta.cos();
         for (t, lobe) in [s.r, s.tt, s.trt].iter().enumerate() {
             for c in 0..3 {
@@ -205,6 +206,7 @@ pub struct ReferenceScene<'a> {
 pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::Frame {
     let lights = scene.lighting.lights();
     let settings = scene.settings;
+    let variant = REFERENCE_VARIANT.with_longitudinal(scene.look.longitudinal());
     let params = &scene.look.params;
     let hair = super::shade::ShadingHair::new(scene.hair, scene.sigma_a);
     let cam = scene
@@ -228,7 +230,7 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
         };
         let shadows = ReferenceShadows::Dual(&d);
         super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-            reference_shade(params, sp, wo, &lights, &shadows)
+            reference_shade(params, variant, sp, wo, &lights, &shadows)
         })
     } else {
         let volume = settings.shadows.then(|| {
@@ -238,7 +240,7 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             ReferenceShadows::Volume(v, settings.shadow_skip(scene.hair))
         });
         super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-            reference_shade(params, sp, wo, &lights, &shadows)
+            reference_shade(params, variant, sp, wo, &lights, &shadows)
         })
     };
     frame.with_components(&pixels, &radiance, settings.exposure.exp2())

@@ -23,9 +23,11 @@ use crate::gpu::forward::{forward_table_texels, upload_forward_table};
 use crate::hair::Hair;
 use crate::render::reference::REFERENCE_VARIANT;
 use crate::scattering::dual_terms::DualTables;
-use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
+use crate::scattering::fast_params::{
+    DEFAULT_QUADRATURE_SEGMENTS, FastHairParams, LONGITUDINAL_PUBLISHED,
+};
 use crate::scattering::lut::Luts;
-use crate::scattering::params::HairParams;
+use crate::scattering::params::{HairParams, LongitudinalModel};
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
 use crate::shadow::forward::ForwardTable;
 use crate::shadow::grid::ShadowGrid;
@@ -76,6 +78,21 @@ impl HairLook {
         self.fast.d_f = d_f;
         self.fast.d_b = d_b;
         self
+    }
+
+    /// The longitudinal function (normalised by default).
+    pub fn with_longitudinal(mut self, model: LongitudinalModel) -> Self {
+        self.fast = self.fast.with_longitudinal(model);
+        self
+    }
+
+    /// The exact model's form of this look's longitudinal function, for the references.
+    pub fn longitudinal(&self) -> LongitudinalModel {
+        if self.fast.longitudinal == LONGITUDINAL_PUBLISHED {
+            LongitudinalModel::Published
+        } else {
+            LongitudinalModel::Normalized
+        }
     }
 }
 

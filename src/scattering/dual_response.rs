@@ -13,7 +13,9 @@ use super::dual_terms::DualTables;
 use super::fast_azimuthal::Rgb32;
 use super::fast_exact_azimuthal::azimuthal_window_integral;
 use super::fast_params::FastHairParams;
-use super::fast_response::{SrbfInFrame, gaussian_product, linear_quadrature};
+use super::fast_response::{
+    SrbfInFrame, gaussian_product, linear_quadrature, longitudinal_centre, longitudinal_factor,
+};
 use super::lut::wrap_angle_f32;
 use std::f32::consts::{FRAC_PI_2, PI, SQRT_2};
 
@@ -30,8 +32,9 @@ pub fn inner_integral_global(p: &FastHairParams, lobe: u32, theta_d: f32, dphi: 
 }
 
 /// M_t^G per unit light power (Xu Eq. 27): (1/cos theta_j) integral g^u(theta_i; theta_j, sigma) M_t(theta_h)
-/// cos^2(theta_i) / cos^2(theta_d) calN_t^G d theta_i, by the quadrature of Sec. 4.2.2 against the
-/// product of the two Gaussians.
+/// cos^2(theta_i) / cos^2(theta_d) calN_t^G d theta_i as published, or with d'Eon's M_t(theta_i, theta_o) cos(theta_i)
+/// normalised ([`longitudinal_factor`]), by the quadrature of Sec. 4.2.2 against the product of the two
+/// Gaussians.
 pub fn global_response_lobe(
     p: &FastHairParams,
     lobe: u32,
@@ -46,24 +49,28 @@ pub fn global_response_lobe(
     let (scale, mu, l) = gaussian_product(
         light.theta,
         SQRT_2 * sigma,
-        2.0 * alpha - theta_o,
+        longitudinal_centre(p.longitudinal, theta_o, alpha),
         2.0 * SQRT_2 * beta,
     );
-    let c = scale / (2.0 * PI * sigma * beta * light.theta.cos().max(1e-3));
+    // The two unit-area Gaussians (std sigma and 2 beta); longitudinal_factor holds the rest of M_t.
+    let c = scale / (2.0 * PI * sigma * 2.0 * beta * light.theta.cos().max(1e-3));
     if c < 1e-30 {
         return [0.0; 3];
     }
     let dphi = phi_o - light.phi;
     linear_quadrature(p.quadrature_segments, mu, l, |ti| {
         let theta_d = 0.5 * (theta_o - ti);
-        let w = ti.cos().powi(2) / theta_d.cos().powi(2).max(1e-8);
+        let w = longitudinal_factor(p.longitudinal, ti, theta_o, alpha, beta);
         inner_integral_global(p, lobe, theta_d, dphi).map(|n| w * n)
     })
     .map(|v| (c * v).max(0.0))
 }
 
 /// M^L per unit light power (Xu Eq. 29-31): (2 / cos theta_j) (pi - |phi_j - phi_o|) / pi^2 times
-/// integral g^u(theta_i; theta_j, sigma) g^u(theta_i; Delta_b~ - theta_o, sigma_b~) A_b(theta_d) cos^2(theta_i) / cos^2(theta_d) d theta_i,
+/// integral g^u(theta_i; theta_j, sigma) g^u(theta_i; Delta_b~ - theta_o, sigma_b~) A_b(theta_d) cos^2(theta_i) / cos^2(theta_d) d theta_i
+/// as published (the 2 is Zinke's Eq. 10, the same factor as M_t's), or normalised
+/// (1 / cos theta_j) (pi - |phi_j - phi_o|) / pi^2 integral g^u(theta_i; theta_j, sigma) M^dEon(theta_i, theta_o - Delta_b~; sigma_b~^2)
+/// A_b cos(theta_i) d theta_i, so that A_b is the energy the back-scattered light carries,
 /// with Delta_b~, sigma_b~ the means of Delta_b, sigma_b over theta_i in theta_j +- sigma (from the SATs).
 pub fn local_response(
     p: &FastHairParams,
@@ -81,16 +88,20 @@ pub fn local_response(
     let mut out = [0.0; 3];
     for c in 0..3 {
         let sb = sig_b[c].max(1e-3);
-        let (scale, mu, l) =
-            gaussian_product(light.theta, SQRT_2 * sigma, delta[c] - theta_o, SQRT_2 * sb);
-        let k = 2.0 * azimuthal * scale / (2.0 * PI * sigma * sb * light.theta.cos().max(1e-3));
+        let centre = longitudinal_centre(p.longitudinal, theta_o, 0.5 * delta[c]);
+        let (scale, mu, l) = gaussian_product(light.theta, SQRT_2 * sigma, centre, SQRT_2 * sb);
+        // Zinke's back lobe g(theta_i + theta_o - Delta_b; sigma_b) is M with tilt Delta_b / 2 and width sigma_b / 2
+        // in longitudinal_factor's terms: published, its explicit factor 2 (Eq. 10) and cos^2/cos^2(theta_d);
+        // normalised, d'Eon's M of variance sigma_b^2.
+        let k = azimuthal * scale / (2.0 * PI * sigma * sb * light.theta.cos().max(1e-3));
         if k < 1e-30 {
             continue;
         }
         let v = linear_quadrature(p.quadrature_segments, mu, l, |ti| {
             let theta_d = 0.5 * (theta_o - ti);
             let a = tables.lookup(theta_d).big_a_b[c];
-            [a * ti.cos().powi(2) / theta_d.cos().powi(2).max(1e-8); 3]
+            let w = longitudinal_factor(p.longitudinal, ti, theta_o, 0.5 * delta[c], 0.5 * sb);
+            [a * w; 3]
         });
         out[c] = (k * v[0]).max(0.0);
     }

@@ -401,7 +401,7 @@ pub fn eta_star_mean(luts: &Luts, eta: f32, a: f32, lambda_prime: f32, phi_sum: 
 mod tests {
     use super::*;
     use crate::scattering::marschner::AzimuthalLobe;
-    use crate::scattering::{CausticModel, FresnelModel, HairParams, Lobe, ModelVariant};
+    use crate::scattering::{CausticModel, HairParams, Lobe, ModelVariant};
 
     #[test]
     fn kappa_inversion_recovers_the_energy() {
@@ -422,8 +422,8 @@ mod tests {
     #[test]
     fn n_r_polynomial_is_the_exact_r_lobe() {
         let v = ModelVariant {
-            fresnel: FresnelModel::XuSchlick,
             caustic: CausticModel::None,
+            ..ModelVariant::XU
         };
         let p = HairParams::default();
         for theta_d in [0.0f64, 0.4, 1.1] {

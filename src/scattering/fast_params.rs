@@ -1,7 +1,7 @@
 //! The hair parameters as the fast model (and its WGSL twin, a uniform buffer) reads them: f32,
 //! `#[repr(C)]`, Pod, every lobe's shift and width resolved.
 
-use super::params::{HairParams, Lobe};
+use super::params::{HairParams, Lobe, LongitudinalModel};
 use bytemuck::{Pod, Zeroable};
 
 /// Default number of segments of Xu's linear quadrature (Sec. 4.2.2).
@@ -29,8 +29,15 @@ pub struct FastHairParams {
     /// Zinke's d_f and d_b (dual scattering; default 0.7).
     pub d_f: f32,
     pub d_b: f32,
-    pub _pad: f32,
+    /// The longitudinal function: [`LONGITUDINAL_NORMALIZED`] (d'Eon et al. 2011, the default) or
+    /// [`LONGITUDINAL_PUBLISHED`] (Marschner 2003 / Xu Eq. 7, about twice too bright).
+    pub longitudinal: u32,
 }
+
+/// `FastHairParams::longitudinal`: d'Eon et al. 2011's normalised M ([`LongitudinalModel::Normalized`]).
+pub const LONGITUDINAL_NORMALIZED: u32 = 0;
+/// `FastHairParams::longitudinal`: the published M_t(theta_h) / cos^2(theta_d) ([`LongitudinalModel::Published`]).
+pub const LONGITUDINAL_PUBLISHED: u32 = 1;
 
 const _: () = assert!(std::mem::size_of::<FastHairParams>() == 80);
 
@@ -60,7 +67,18 @@ impl FastHairParams {
             quadrature_segments: quadrature_segments.max(2),
             d_f: 0.7,
             d_b: 0.7,
-            _pad: 0.0,
+            longitudinal: LONGITUDINAL_NORMALIZED,
+        }
+    }
+
+    /// The same parameters with another longitudinal function.
+    pub fn with_longitudinal(self, model: LongitudinalModel) -> Self {
+        Self {
+            longitudinal: match model {
+                LongitudinalModel::Normalized => LONGITUDINAL_NORMALIZED,
+                LongitudinalModel::Published => LONGITUDINAL_PUBLISHED,
+            },
+            ..self
         }
     }
 

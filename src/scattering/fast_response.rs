@@ -4,6 +4,11 @@
 //! with lambda' = lambda_j / sqrt(cos theta_i cos theta_j), and the outer integral done by the linear
 //! quadrature of Sec. 4.2.2 against the product Gaussian g(theta_i; theta_j, lambda_j) M_t.
 //!
+//! The longitudinal function is d'Eon et al. 2011's normalised M_p(theta_i, theta_o) by default (then
+//! S cos(theta_i) = M_p calN_p and the weight is cos(theta_i), not cos^2(theta_i)/cos^2(theta_d)); the quadrature
+//! still integrates against the Gaussian of M_p's peak and width, and [`longitudinal_factor`] carries the
+//! ratio of the true M_p to that Gaussian into the interpolated factor.
+//!
 //! Angles are in the fiber frame ([`super::frame`]); f32 as in the WGSL twin.
 //!
 //! Sample placement (Sec. 4.2.2), m segments: the ends -pi/2 and pi/2 plus m - 1 samples evenly over
@@ -11,10 +16,12 @@
 //! paper's rule (mu - lambda, mu, mu + lambda); clipping keeps every sample useful and lets a large m
 //! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
 
-use super::circular_gaussian::{gaussian_linear_integral, gaussian_quadratic_integral};
+use super::circular_gaussian::{
+    bessel_i0_scaled, gaussian_linear_integral, gaussian_quadratic_integral,
+};
 use super::fast_azimuthal::{LobeFit, Rgb32, eta_star_mean, inner_integral_r, trt_lobes, tt_lobe};
 use super::fast_exact_azimuthal::inner_integral_blended;
-use super::fast_params::FastHairParams;
+use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
 use std::f32::consts::{FRAC_PI_2, PI};
 
@@ -150,7 +157,69 @@ pub fn azimuthal_fit(
     }
 }
 
-/// The smooth factor of the outer integral at theta_i: cos^2(theta_i) / cos^2(theta_d) calN_t.
+/// The tilted outgoing inclination theta_o' = theta_o - 2 alpha, reflected back into [-pi/2, pi/2] past a
+/// pole (pbrt-v4 takes |cos theta_o'|), so M stays normalised over theta_i.
+pub fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
+    let t = theta_o - 2.0 * alpha;
+    if t > FRAC_PI_2 {
+        PI - t
+    } else if t < -FRAC_PI_2 {
+        -PI - t
+    } else {
+        t
+    }
+}
+
+/// The centre in theta_i of the Gaussian the quadrature integrates against: published, 2 alpha - theta_o
+/// (M_t(theta_h)'s peak, possibly past a pole); normalised, -theta_o' (d'Eon's peak, always inside).
+pub fn longitudinal_centre(longitudinal: u32, theta_o: f32, alpha: f32) -> f32 {
+    if longitudinal == LONGITUDINAL_PUBLISHED {
+        2.0 * alpha - theta_o
+    } else {
+        -tilted_outgoing(theta_o, alpha)
+    }
+}
+
+/// ln M_p(theta_i, theta_o) of d'Eon et al. 2011 with variance v and the tilt 2 alpha on the outgoing
+/// inclination, theta_o' = theta_o - 2 alpha reflected back at the poles (f32 twin of
+/// [`crate::scattering::marschner::ln_longitudinal_deon`]):
+/// ln M = ln(I0(a) e^-a) - 2 sin^2((theta_i + theta_o')/2) / v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v.
+pub fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f32 {
+    let t = tilted_outgoing(theta_o, alpha);
+    let a = theta_i.cos().max(0.0) * t.cos() / v;
+    let half = (0.5 * (theta_i + t)).sin();
+    bessel_i0_scaled(a).ln() - 2.0 * half * half / v - v.ln() - (1.0 - (-2.0 / v).exp()).ln()
+}
+
+/// The longitudinal factor of an outer integrand at theta_i, relative to the Gaussian the quadrature
+/// integrates against, g(theta_i; mu, 2 sqrt(2) beta) / (sqrt(2 pi) 2 beta) (unit area, standard deviation 2 beta
+/// in theta_i, centred at mu = [`longitudinal_centre`]):
+/// - published: M(theta_h) = 2 x that Gaussian (it has unit area in theta_h, Xu Eq. 7), and S cos(theta_i)
+///   d omega_i brings cos^2(theta_i) / cos^2(theta_d): the factor is 2 cos^2(theta_i) / cos^2(theta_d);
+/// - normalised: cos(theta_i) M^dEon(theta_i, theta_o; v = (2 beta)^2) / Gaussian, smooth (about
+///   sqrt(cos theta_i / cos theta_o') near the peak), its log clamped as the light's ratio is.
+pub fn longitudinal_factor(
+    longitudinal: u32,
+    theta_i: f32,
+    theta_o: f32,
+    alpha: f32,
+    beta: f32,
+) -> f32 {
+    let ci = theta_i.cos().max(0.0);
+    if longitudinal == LONGITUDINAL_PUBLISHED {
+        let cd = (0.5 * (theta_o - theta_i)).cos();
+        return 2.0 * ci * ci / (cd * cd).max(1e-8);
+    }
+    let v = 4.0 * beta * beta;
+    let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
+    let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha)
+        + d * d / (2.0 * v)
+        + 0.5 * (2.0 * PI * v).ln();
+    ci * ln_ratio.clamp(-80.0, 20.0).exp()
+}
+
+/// The smooth factor of the outer integral at theta_i: the longitudinal factor ([`longitudinal_factor`])
+/// times calN_t.
 pub fn outer_integrand(
     luts: &Luts,
     p: &FastHairParams,
@@ -162,8 +231,8 @@ pub fn outer_integrand(
 ) -> Rgb32 {
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let ci = theta_i.cos();
-    let w = ci * ci / theta_d.cos().powi(2).max(1e-8);
+    let l = lobe as usize;
+    let w = longitudinal_factor(p.longitudinal, theta_i, theta_o, p.alpha[l], p.beta[l]);
     let dphi = phi_o - light.phi;
     if lobe == 0 {
         let n = inner_integral_r(luts, p.eta, theta_d, lp, dphi);
@@ -185,7 +254,8 @@ pub fn outer_integrand(
 
 /// The longitudinal weight w(theta_i) = M_t(theta_h) g^c(theta_i; theta_j, lambda_j) of one lobe, in Laplace
 /// form: its peak theta*, the bandwidth lambda* of the Gaussian with the same curvature there, and ln w(theta*).
-/// M_t(theta_h) is the Gaussian g(theta_i; 2 alpha_t - theta_o, 2 sqrt(2) beta_t) / (sqrt(2 pi) beta_t) (Xu Eq. 7).
+/// M_t is taken as the Gaussian g(theta_i; mu_M, 2 sqrt(2) beta_t) around [`longitudinal_centre`] (published:
+/// exactly M_t(theta_h) = g / (sqrt(2 pi) beta_t), Xu Eq. 7); [`longitudinal_factor`] carries the rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LongitudinalWeight {
     pub kappa_j: f32,
@@ -273,9 +343,13 @@ pub fn srbf_response_lobe(
     phi_o: f32,
 ) -> Rgb32 {
     let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
-    let (mu_m, lambda_m) = (2.0 * alpha - theta_o, 2.0 * std::f32::consts::SQRT_2 * beta);
+    let (mu_m, lambda_m) = (
+        longitudinal_centre(p.longitudinal, theta_o, alpha),
+        2.0 * std::f32::consts::SQRT_2 * beta,
+    );
     let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
-    let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * beta);
+    // The unit-area Gaussian of standard deviation 2 beta in theta_i; longitudinal_factor holds the rest.
+    let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * 2.0 * beta);
     if scale < 1e-30 {
         return [0.0; 3];
     }

@@ -1,6 +1,11 @@
 //! The exact Marschner et al. 2003 hair scattering model on the CPU, in f64.
 //!
 //! S(omega_i, omega_o) = sum_p M_p(theta_h) N_p(eta'(theta_d), phi) / cos^2(theta_d)   (Marschner Eq. 2)
+//! as published ([`LongitudinalModel::Published`]), or by default with d'Eon et al. 2011's normalised
+//! longitudinal function ([`LongitudinalModel::Normalized`]):
+//!   S(omega_i, omega_o) cos(theta_i) = sum_p M_p(theta_i, theta_o) N_p(eta'(theta_d), phi),
+//! integral M_p cos(theta_i) d theta_i = 1, so that integral S cos(theta_i) d omega_i = sum_p integral N_p d phi
+//! = (1/2) sum_p integral A_p dh, the energy the three lobes carry (~0.95-1 for sigma_a = 0).
 //!
 //! This is the reference every fast path is tested against. Angles follow
 //! [`crate::scattering::frame`]. Symbols are the paper's; MATH-NOTES restates them.
@@ -9,7 +14,9 @@ use super::frame::{FiberAngles, HalfAngles, wrap_angle};
 use super::fresnel::{
     bravais_parallel, bravais_perpendicular, fresnel_bravais, fresnel_schlick_xu,
 };
-use super::params::{CausticModel, FresnelModel, HairParams, Lobe, ModelVariant};
+use super::params::{
+    CausticModel, FresnelModel, HairParams, Lobe, LongitudinalModel, ModelVariant,
+};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 
@@ -26,6 +33,71 @@ pub fn gaussian(beta: f64, x: f64) -> f64 {
 /// Longitudinal scattering M_p(theta_h) = g(beta_p; theta_h - alpha_p) (Marschner Sec. 4.1).
 pub fn longitudinal_m_p(params: &HairParams, lobe: Lobe, theta_h: f64) -> f64 {
     gaussian(params.beta(lobe), theta_h - params.alpha(lobe))
+}
+
+/// I0(x) e^-x for x >= 0 in f64: the power series up to x = 30 (positive terms, no cancellation),
+/// the asymptotic series beyond (relative error < 1e-12 on both sides).
+pub fn bessel_i0_scaled_f64(x: f64) -> f64 {
+    let x = x.abs();
+    if x <= 30.0 {
+        let q = 0.25 * x * x;
+        let (mut term, mut sum) = (1.0f64, 1.0f64);
+        for k in 1..200 {
+            term *= q / (k * k) as f64;
+            sum += term;
+            if term < 1e-17 * sum {
+                break;
+            }
+        }
+        return sum * (-x).exp();
+    }
+    // e^x / sqrt(2 pi x) sum_k ((2k - 1)!!)^2 / (k! 8^k x^k)
+    let (mut term, mut sum) = (1.0f64, 1.0f64);
+    for k in 1..12 {
+        let m = (2 * k - 1) as f64;
+        term *= m * m / (8.0 * k as f64 * x);
+        sum += term;
+    }
+    sum / (2.0 * PI * x).sqrt()
+}
+
+/// The variance v_p = (2 beta_p)^2 of d'Eon's longitudinal function: Marschner's M_p(theta_h) has standard
+/// deviation beta_p in theta_h = (theta_i + theta_o)/2, so 2 beta_p in theta_i; both forms have that width.
+pub fn deon_variance(beta: f64) -> f64 {
+    4.0 * beta * beta
+}
+
+/// The outgoing inclination tilted by the scales, theta_o' = theta_o - 2 alpha (pbrt-v4 applies the tilt to
+/// theta_o alone), as (sin, cos) with cos >= 0: past the pole the angle is reflected back, as pbrt's
+/// absolute value of cos(theta_o') does, so M stays normalised over theta_i.
+pub fn tilted_outgoing(theta_o: f64, alpha: f64) -> (f64, f64) {
+    let t = theta_o - 2.0 * alpha;
+    (t.sin(), t.cos().abs())
+}
+
+/// ln M_p(theta_i, theta_o') of d'Eon et al. 2011 (Eq. 6 of their paper; pbrt-v4's `Mp`), with variance v:
+/// M = csch(1/v) / (2v) exp(-sin theta_i sin theta_o' / v) I0(cos theta_i cos theta_o' / v),
+/// in log space so narrow lobes (v -> 0, 1/v in the hundreds) neither overflow nor lose precision:
+/// ln M = ln(I0(a) e^-a) + (cos(theta_i + theta_o') - 1)/v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v,
+/// with cos(x) - 1 = -2 sin^2(x/2).
+pub fn ln_longitudinal_deon(v: f64, theta_i: f64, sin_o: f64, cos_o: f64) -> f64 {
+    let a = theta_i.cos().max(0.0) * cos_o / v;
+    // cos(theta_i + theta_o') - 1 from the angle of the tilted outgoing direction.
+    let theta_o = sin_o.atan2(cos_o);
+    let half = (0.5 * (theta_i + theta_o)).sin();
+    bessel_i0_scaled_f64(a).ln() - 2.0 * half * half / v - v.ln() - (-(-2.0 / v).exp()).ln_1p()
+}
+
+/// d'Eon's normalised M_p(theta_i, theta_o) for lobe p: variance (2 beta_p)^2, tilt 2 alpha_p on theta_o.
+/// integral_{-pi/2}^{pi/2} M_p cos(theta_i) d theta_i = 1.
+pub fn longitudinal_m_p_normalized(
+    params: &HairParams,
+    lobe: Lobe,
+    theta_i: f64,
+    theta_o: f64,
+) -> f64 {
+    let (s, c) = tilted_outgoing(theta_o, params.alpha(lobe));
+    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_i, s, c).exp()
 }
 
 /// Marschner's eccentric index eta*(phi_h) (Marschner Sec. 4.4; Xu Eq. 24).
@@ -361,7 +433,9 @@ impl LobeValues {
     }
 }
 
-/// One lobe of the scattering function: S_p = M_p(theta_h) N_p(phi) / cos^2(theta_d).
+/// One lobe of the scattering function: published, S_p = M_p(theta_h) N_p(phi) / cos^2(theta_d);
+/// normalised, S_p = M_p(theta_i, theta_o) N_p(phi) / cos(theta_i) (so that S_p cos(theta_i), what every
+/// caller integrates over the incident directions, is d'Eon's M_p N_p).
 pub fn scattering_s_p(
     params: &HairParams,
     variant: ModelVariant,
@@ -370,14 +444,23 @@ pub fn scattering_s_p(
     wo: FiberAngles,
 ) -> Rgb {
     let ha = HalfAngles::new(wi, wo);
-    let m = longitudinal_m_p(params, lobe, ha.theta_h);
-    if m == 0.0 {
+    let (m, divisor) = match variant.longitudinal {
+        LongitudinalModel::Published => (
+            longitudinal_m_p(params, lobe, ha.theta_h),
+            ha.theta_d.cos().powi(2),
+        ),
+        LongitudinalModel::Normalized => (
+            longitudinal_m_p_normalized(params, lobe, wi.theta, wo.theta),
+            wi.theta.cos(),
+        ),
+    };
+    if m == 0.0 || !m.is_finite() {
         return [0.0; 3];
     }
     let az = AzimuthalLobe::new(params, variant, lobe, ha.theta_d, ha.phi_h);
     let n = azimuthal_n_p(params, variant, &az, ha.phi);
-    let cos2 = ha.theta_d.cos().powi(2).max(1e-12);
-    n.map(|x| m * x / cos2)
+    let d = divisor.max(1e-12);
+    n.map(|x| m * x / d)
 }
 
 /// The full scattering function S(omega_i, omega_o), per lobe (Marschner Eq. 2).

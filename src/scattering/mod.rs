@@ -20,4 +20,6 @@ pub mod tables_io;
 
 pub use frame::{FiberAngles, FiberFrame, HalfAngles};
 pub use marschner::{LobeValues, Rgb, scattering_s, scattering_s_p};
-pub use params::{CausticModel, FresnelModel, HairParams, Lobe, ModelVariant, Preset};
+pub use params::{
+    CausticModel, FresnelModel, HairParams, Lobe, LongitudinalModel, ModelVariant, Preset,
+};

@@ -60,29 +60,60 @@ pub enum CausticModel {
     None,
 }
 
+/// The longitudinal function M_p and the factor that goes with it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum LongitudinalModel {
+    /// d'Eon et al. 2011's energy-conserving form, normalised over the incident inclination:
+    /// M_p(theta_i, theta_o) = csch(1/v) / (2v) exp(-sin theta_i sin theta_o' / v) I0(cos theta_i cos theta_o' / v)
+    /// with integral M_p cos(theta_i) d theta_i = 1, v_p = (2 beta_p)^2 (the published lobe's variance in
+    /// theta_i, so the two forms have the same width) and the tilt on the outgoing inclination,
+    /// theta_o' = theta_o - 2 alpha_p (as pbrt-v4 and Mitsuba 3 apply it). No 1/cos^2(theta_d):
+    /// S cos(theta_i) = sum_p M_p N_p, and a lossless fiber in a white furnace renders at ~1.
+    #[default]
+    Normalized,
+    /// Marschner 2003 / Xu 2011 Eq. 7 as published: M_p(theta_h) a unit-area Gaussian in theta_h and
+    /// S = sum_p M_p N_p / cos^2(theta_d). It integrates to ~2 over theta_i: lossless hair in a white
+    /// furnace renders at ~1.3-2.3 (MATH-NOTES, "normalisation trap"). Kept for comparison with the papers.
+    Published,
+}
+
 /// Which variant of the exact model is evaluated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub struct ModelVariant {
     pub fresnel: FresnelModel,
     pub caustic: CausticModel,
+    pub longitudinal: LongitudinalModel,
 }
 
 impl ModelVariant {
-    /// Marschner 2003 as published (exact Fresnel, caustic fix).
+    /// Marschner 2003's azimuthal model (exact Fresnel, caustic fix); the longitudinal function is
+    /// chosen apart ([`LongitudinalModel`], normalised unless asked).
     pub const MARSCHNER: Self = Self {
         fresnel: FresnelModel::Exact,
         caustic: CausticModel::Marschner,
+        longitudinal: LongitudinalModel::Normalized,
     };
     /// The variant Xu 2011's fast model approximates (Schlick Fresnel reused inside, caustic fix).
     pub const XU: Self = Self {
         fresnel: FresnelModel::XuSchlick,
         caustic: CausticModel::Marschner,
+        longitudinal: LongitudinalModel::Normalized,
     };
     /// Exact Fresnel, bare root sum: the energy-conserving form.
     pub const UNSMOOTHED: Self = Self {
         fresnel: FresnelModel::Exact,
         caustic: CausticModel::None,
+        longitudinal: LongitudinalModel::Normalized,
     };
+
+    /// The same variant with another longitudinal function.
+    pub const fn with_longitudinal(self, longitudinal: LongitudinalModel) -> Self {
+        Self {
+            longitudinal,
+            ..self
+        }
+    }
 }
 
 /// All parameters of Marschner's model. Angles in radians.

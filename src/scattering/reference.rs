@@ -1,9 +1,11 @@
 //! Brute-force integrals of the exact model: the numbers fast forms and tests are checked against.
 //! Each works on one colour channel (`channel` in 0..3) so no work is repeated per channel.
 
-use super::marschner::{AzimuthalLobe, CausticFix, azimuthal_n_p, longitudinal_m_p};
+use super::marschner::{
+    AzimuthalLobe, CausticFix, azimuthal_n_p, longitudinal_m_p, longitudinal_m_p_normalized,
+};
 use super::numeric::integrate_piecewise_relative;
-use super::params::{CausticModel, HairParams, Lobe, ModelVariant};
+use super::params::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Relative accuracy of the reference integrals.
@@ -63,24 +65,29 @@ pub fn azimuthal_energy(
     )
 }
 
-/// Directional albedo E_p(theta_i) = integral over the sphere of S_p(omega_i, omega_o) cos(theta_o) d omega_o
-/// = integral_{-pi/2}^{pi/2} integral_{-pi}^{pi} S_p cos^2(theta_o) dphi dtheta_o, for a circular fiber
-/// (eccentricity is set to 1).
+/// Directional albedo E_p(theta_o) = integral over the incident sphere of S_p(omega_i, omega_o) cos(theta_i) d omega_i
+/// = integral_{-pi/2}^{pi/2} cos(theta_i) [integral_{-pi}^{pi} S_p cos(theta_i) dphi] dtheta_i, for a circular fiber
+/// (eccentricity is set to 1): the radiance a fiber in a uniform white environment sends towards omega_o,
+/// the white-furnace number.
 ///
-/// Because M_p is a unit-area Gaussian in theta_h = (theta_i + theta_o)/2, it integrates to 2 over
-/// theta_o, so E is close to 2 x the scattered fraction for narrow lobes (MATH-NOTES).
+/// Normalised ([`LongitudinalModel::Normalized`]): integral M_p cos(theta_i) d theta_i = 1, so E is the
+/// scattered fraction (1/2) integral A_p dh, averaged over the theta_d the lobe covers; the three lobes
+/// together reach 1 minus what p >= 3 would carry. Published: M_p is a unit-area Gaussian in
+/// theta_h = (theta_i + theta_o)/2, so it integrates to 2 over theta_i and E is close to 2 x the scattered
+/// fraction for narrow lobes (MATH-NOTES). The published S is symmetric, so this equals the integral over
+/// theta_o at fixed theta_i.
 pub fn directional_albedo(
     params: &HairParams,
     variant: ModelVariant,
     lobe: Lobe,
-    theta_i: f64,
+    theta_o: f64,
     channel: usize,
 ) -> f64 {
     let mut p = *params;
     p.eccentricity = 1.0;
     let beta = p.beta(lobe);
-    // Split theta_o around the lobe centre theta_o* = 2 alpha_p - theta_i (M has std 2 beta in theta_o).
-    let centre = 2.0 * p.alpha(lobe) - theta_i;
+    // Split theta_i around the lobe centre theta_i* = 2 alpha_p - theta_o (std 2 beta in theta_i).
+    let centre = 2.0 * p.alpha(lobe) - theta_o;
     let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
     for k in [-8.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
         let x = centre + 2.0 * k * beta;
@@ -89,31 +96,41 @@ pub fn directional_albedo(
         }
     }
     breaks.sort_by(f64::total_cmp);
-    let integrand = |theta_o: f64| -> f64 {
-        let theta_h = 0.5 * (theta_i + theta_o);
+    let integrand = |theta_i: f64| -> f64 {
         let theta_d = 0.5 * (theta_o - theta_i);
-        let m = longitudinal_m_p(&p, lobe, theta_h);
-        if m < 1e-200 {
+        // M_p times the factor that turns S cos(theta_i) d omega_i into d theta_i d phi.
+        let m_weight = match variant.longitudinal {
+            LongitudinalModel::Published => {
+                let theta_h = 0.5 * (theta_i + theta_o);
+                longitudinal_m_p(&p, lobe, theta_h) * theta_i.cos().powi(2) / theta_d.cos().powi(2)
+            }
+            LongitudinalModel::Normalized => {
+                longitudinal_m_p_normalized(&p, lobe, theta_i, theta_o) * theta_i.cos()
+            }
+        };
+        if m_weight < 1e-200 {
             return 0.0;
         }
-        let n = azimuthal_energy(&p, variant, lobe, theta_d, 0.0, channel);
-        m * n * theta_o.cos().powi(2) / theta_d.cos().powi(2)
+        m_weight * azimuthal_energy(&p, variant, lobe, theta_d, 0.0, channel)
     };
     integrate_piecewise_relative(&integrand, &breaks, 1e-7)
 }
 
-/// The narrow-lobe limit of [`directional_albedo`]: 2 f_p(theta_d*) cos^2(theta_o*) / cos^2(theta_d*), with
-/// theta_o* = 2 alpha_p - theta_i the lobe centre and f_p the scattered fraction there. Exact as beta -> 0
-/// when the lobe stays inside (-pi/2, pi/2).
+/// The narrow-lobe limit of [`directional_albedo`] at theta_o, with theta_i* = 2 alpha_p - theta_o the lobe
+/// centre and f_p the scattered fraction there: published, 2 f_p(theta_d*) cos^2(theta_i*) / cos^2(theta_d*);
+/// normalised, f_p(theta_d*). Exact as beta -> 0 when the lobe stays inside (-pi/2, pi/2).
 pub fn directional_albedo_narrow_limit(
     params: &HairParams,
     variant: ModelVariant,
     lobe: Lobe,
-    theta_i: f64,
+    theta_o: f64,
     channel: usize,
 ) -> f64 {
-    let theta_o = 2.0 * params.alpha(lobe) - theta_i;
+    let theta_i = 2.0 * params.alpha(lobe) - theta_o;
     let theta_d = 0.5 * (theta_o - theta_i);
     let f = scatter_fraction(params, variant, lobe, theta_d, 0.0, channel);
-    2.0 * f * theta_o.cos().powi(2) / theta_d.cos().powi(2)
+    match variant.longitudinal {
+        LongitudinalModel::Published => 2.0 * f * theta_i.cos().powi(2) / theta_d.cos().powi(2),
+        LongitudinalModel::Normalized => f,
+    }
 }

@@ -7,7 +7,8 @@
 //! the energy with the glint scale, which Xu's fit has no parameter for). The Fresnel model is the
 //! caller's (Xu's Schlick for the fast-model tests).
 //!
-//! d omega = cos(theta_i) d theta_i d phi_i, so the integrand carries cos^2(theta_i).
+//! d omega = cos(theta_i) d theta_i d phi_i, so the integrand carries cos^2(theta_i) with the published M (cos(theta_i) with
+//! the normalised M, whose S cos(theta_i) is M N).
 //! Inner integral over phi_i: for a circular fiber, N_p(phi) = sum over roots of A_p(h) / |2 dphi/dh|, so
 //! integral N_p(phi) w(phi) dphi = integral_{-1}^{1} A_p(h) / 2 w(phi(p, h)) dh, which needs no root finding
 //! and has no singularity (h = sin t removes the square-root ends). With eccentricity the TRT index depends
@@ -15,9 +16,11 @@
 //! (located by fixed-point iteration, since they move with eta*(phi_h)).
 
 use super::frame::{FiberAngles, wrap_angle};
-use super::marschner::{AzimuthalLobe, caustic_offset, longitudinal_m_p, phi_p};
+use super::marschner::{
+    AzimuthalLobe, caustic_offset, longitudinal_m_p, longitudinal_m_p_normalized, phi_p,
+};
 use super::numeric::integrate_piecewise;
-use super::params::{CausticModel, HairParams, Lobe, ModelVariant};
+use super::params::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// An SRBF light in the fiber frame (f64).
@@ -147,6 +150,7 @@ pub fn srbf_response_reference(
     let variant = ModelVariant {
         fresnel: fresnel_variant.fresnel,
         caustic: CausticModel::None,
+        ..fresnel_variant
     };
     let (theta_o, phi_o) = (wo.theta, wo.phi);
     let centre = 2.0 * params.alpha(lobe) - theta_o;
@@ -158,9 +162,17 @@ pub fn srbf_response_reference(
     }
     let eccentric = lobe == Lobe::TRT && params.eccentricity != 1.0;
     let integrand = |theta_i: f64| {
-        let theta_h = 0.5 * (theta_i + theta_o);
         let theta_d = 0.5 * (theta_o - theta_i);
-        let m = longitudinal_m_p(params, lobe, theta_h);
+        // M_p times what turns S cos(theta_i) d omega_i into d theta_i d phi_i (with the inner integral's 1).
+        let m = match variant.longitudinal {
+            LongitudinalModel::Published => {
+                longitudinal_m_p(params, lobe, 0.5 * (theta_i + theta_o)) * theta_i.cos().powi(2)
+                    / theta_d.cos().powi(2)
+            }
+            LongitudinalModel::Normalized => {
+                longitudinal_m_p_normalized(params, lobe, theta_i, theta_o) * theta_i.cos()
+            }
+        };
         if m < 1e-300 {
             return 0.0;
         }
@@ -170,7 +182,7 @@ pub fn srbf_response_reference(
             let az = AzimuthalLobe::new(params, variant, lobe, theta_d, 0.0);
             inner_h(&az, &light, theta_i, phi_o, ch)
         };
-        m * inner * theta_i.cos().powi(2) / theta_d.cos().powi(2)
+        m * inner
     };
     // Absolute floor: 1e-10 of the light's power (responses below 1e-4 of it are "dark" in the tests).
     let power =

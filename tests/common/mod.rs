@@ -160,3 +160,135 @@ pub fn render_uniform(
     r.render_frame(ctx);
     r.read_frame(ctx).expect("read back")
 }
+
+/// A procedural bob (12 points per strand) framed at three-quarters, with uniform absorption: the
+/// scene the renderer and the reference modes are compared on.
+pub struct BobScene {
+    pub hair: strandlight::hair::Hair,
+    pub sigma_a: Vec<[f32; 3]>,
+    pub look: strandlight::render::HairLook,
+    pub camera: strandlight::render::Camera,
+    pub settings: strandlight::render::RenderSettings,
+}
+
+/// `strands` strands of a bob, `width` x `height` pixels, shadows on, dual scattering if `multiple`.
+pub fn bob_scene(
+    strands: usize,
+    width: u32,
+    height: u32,
+    params: strandlight::scattering::params::HairParams,
+    multiple: bool,
+) -> BobScene {
+    let hair = strandlight::render::scene::generated_hair(
+        strandlight::hair::procedural::Style::Bob,
+        strands,
+        12,
+        3,
+    );
+    let look = strandlight::render::HairLook::new(params);
+    let (lo, hi) = hair.bounds();
+    let camera = strandlight::render::Camera::framing(
+        lo,
+        hi,
+        35.0,
+        10.0,
+        width as f32 / height as f32,
+        0.95,
+    );
+    BobScene {
+        sigma_a: vec![look.fast.sigma_a_rgb(); hair.point_count()],
+        hair,
+        look,
+        camera,
+        settings: strandlight::render::RenderSettings {
+            width,
+            height,
+            shadows: true,
+            multiple_scattering: multiple,
+            volume_resolution: 48,
+            shadow_grid_resolution: 32,
+            ..Default::default()
+        },
+    }
+}
+
+impl BobScene {
+    /// The GPU frame under SRBF lights.
+    pub fn render(
+        &self,
+        ctx: &strandlight::gpu::GpuContext,
+        luts: &strandlight::scattering::lut::Luts,
+        lights: &[strandlight::envmap::SrbfLight],
+    ) -> strandlight::render::Frame {
+        render_uniform(
+            ctx,
+            &self.settings,
+            luts,
+            &self.hair,
+            &self.look,
+            lights,
+            &self.camera,
+        )
+    }
+
+    /// The reference modes' scene under 1024 directions importance-sampled from `env` (turned by `yaw`).
+    pub fn reference<'a>(
+        &'a self,
+        env: &'a strandlight::envmap::EnvMap,
+        yaw: f64,
+    ) -> strandlight::render::reference::ReferenceScene<'a> {
+        strandlight::render::reference::ReferenceScene {
+            hair: &self.hair,
+            sigma_a: &self.sigma_a,
+            look: &self.look,
+            lighting: strandlight::render::reference::ReferenceLighting::Environment {
+                env,
+                yaw,
+                directions: 1024,
+            },
+            settings: &self.settings,
+            camera: &self.camera,
+        }
+    }
+}
+
+/// Mean radiance of the hair: the beauty summed over covered pixels over their summed coverage
+/// (the un-premultiplied mean), RGB.
+pub fn mean_radiance(f: &strandlight::render::Frame) -> [f64; 3] {
+    let alpha: f64 = f.covered().map(|i| f.beauty[i][3] as f64).sum();
+    std::array::from_fn(|c| {
+        f.covered().map(|i| f.beauty[i][c] as f64).sum::<f64>() / alpha.max(1e-30)
+    })
+}
+
+/// The multiple-scattering share of the beauty: (MS.global + MS.local) / beauty, summed over covered
+/// pixels and channels.
+pub fn ms_share(f: &strandlight::render::Frame) -> f64 {
+    let (mut ms, mut all) = (0.0f64, 0.0f64);
+    for i in f.covered() {
+        for c in 0..3 {
+            ms += (f.components[3][i][c] + f.components[4][i][c]) as f64;
+            all += f.beauty[i][c] as f64;
+        }
+    }
+    ms / all.max(1e-30)
+}
+
+/// Mean radiance of the hair in the given components (0..3: R + TT + TRT), as [`mean_radiance`].
+pub fn mean_components(
+    f: &strandlight::render::Frame,
+    components: std::ops::Range<usize>,
+) -> [f64; 3] {
+    let alpha: f64 = f.covered().map(|i| f.beauty[i][3] as f64).sum();
+    std::array::from_fn(|c| {
+        f.covered()
+            .map(|i| {
+                components
+                    .clone()
+                    .map(|t| f.components[t][i][c] as f64)
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / alpha.max(1e-30)
+    })
+}
