@@ -93,7 +93,7 @@ fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f32 {
     return log(bessel_i0_scaled(a)) - 2.0 * half * half / v - log(v) - log(1.0 - exp(-2.0 / v));
 }
 
-// The longitudinal factor relative to the unit-area Gaussian of std 2 beta around 2 alpha - theta_o:
+// The longitudinal factor relative to the unit-area Gaussian of std 2 beta around longitudinal_centre:
 // published 2 cos^2(theta_i) / cos^2(theta_d); normalised cos(theta_i) M^dEon / Gaussian.
 fn longitudinal_factor(longitudinal: u32, theta_i: f32, theta_o: f32, alpha: f32, beta: f32) -> f32 {
     let ci = max(cos(theta_i), 0.0);
@@ -101,7 +101,7 @@ fn longitudinal_factor(longitudinal: u32, theta_i: f32, theta_o: f32, alpha: f32
         let cd = cos(0.5 * (theta_o - theta_i));
         return 2.0 * ci * ci / max(cd * cd, 1e-8);
     }
-    let v = 4.0 * beta * beta;
+    let v = max(4.0 * beta * beta, 1e-8);
     let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
     let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha) + d * d / (2.0 * v) + 0.5 * log(2.0 * PI * v);
     return ci * exp(clamp(ln_ratio, -80.0, 20.0));

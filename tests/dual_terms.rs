@@ -5,21 +5,29 @@ use strandlight::scattering::dual_terms::{
     DualTables, backscatter_attenuation, backscatter_shift, backscatter_width, dual_sample,
     dual_theta,
 };
+use strandlight::scattering::marschner::{
+    AzimuthalLobe, azimuthal_n_p, deon_variance, ln_longitudinal_deon, longitudinal_m_p,
+    tilted_outgoing,
+};
 use strandlight::scattering::numeric::integrate_piecewise_relative;
 use strandlight::scattering::reference::{azimuthal_energy, scatter_fraction};
-use strandlight::scattering::{
-    CausticModel, FiberAngles, HairParams, Lobe, LongitudinalModel, ModelVariant, scattering_s_p,
-};
+use strandlight::scattering::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
 
 const XU_ROOTS: ModelVariant = ModelVariant {
     caustic: CausticModel::None,
     ..ModelVariant::XU
 };
 
-/// Brute-force front (or back) energy fraction from incident inclination theta: (1/2) integral over
-/// theta_o and phi of M_p(theta_h) N_p(theta_d, phi) w(phi), w = |phi|/pi (front) or 1 - |phi|/pi (back),
-/// with N at the true theta_d of every theta_o (no separation); M N = S cos^2(theta_d).
-fn brute_force_split(params: &HairParams, theta: f64, front: bool, ch: usize) -> f64 {
+/// Brute-force front (or back) energy fraction from incident inclination theta: integral over theta_o and phi
+/// of a unit longitudinal density times N_p(theta_d, phi) w(phi), w = |phi|/pi (front) or 1 - |phi|/pi (back),
+/// with N at the true theta_d of every theta_o (no separation).
+fn brute_force_split(
+    params: &HairParams,
+    variant: ModelVariant,
+    theta: f64,
+    front: bool,
+    ch: usize,
+) -> f64 {
     let mut total = 0.0;
     for lobe in Lobe::ALL {
         let centre = 2.0 * params.alpha(lobe) - theta;
@@ -32,31 +40,32 @@ fn brute_force_split(params: &HairParams, theta: f64, front: bool, ch: usize) ->
             }
         }
         breaks.sort_by(f64::total_cmp);
-        // a_f, a_b are energy fractions of light arriving from theta, split over the outgoing sphere: the
-        // published M_t(theta_h) / 2 is a unit-area density over theta_o (dual_terms.rs), hence the
-        // published S here with (1/2) cos^2(theta_d) undoing its 1/cos^2(theta_d).
-        let published = XU_ROOTS.with_longitudinal(LongitudinalModel::Published);
+        // a_f, a_b are energy fractions of light arriving from theta, split over the outgoing sphere: a unit
+        // density over theta_o times N_t (which integrates to the scattered fraction over phi), front/back
+        // weighted. Published: M_t(theta_h) / 2 (dual_terms.rs). Normalised: d'Eon's M with the roles of the
+        // directions exchanged, M(theta_o, theta - 2 alpha_t) cos(theta_o), exactly a unit density over theta_o
+        // with the lobe's centre 2 alpha_t - theta.
         let inner = |theta_o: f64| {
-            let f = |phi: f64| {
-                let s = scattering_s_p(
-                    params,
-                    published,
-                    lobe,
-                    FiberAngles::new(theta, 0.0),
-                    FiberAngles::new(theta_o, phi),
-                )[ch];
-                let w = phi.abs() / PI;
-                s * if front { w } else { 1.0 - w }
-            };
             let theta_d = 0.5 * (theta_o - theta);
-            let cos2 = theta_d.cos().powi(2);
-            let az = strandlight::scattering::marschner::AzimuthalLobe::new(
-                params, XU_ROOTS, lobe, theta_d, 0.0,
-            );
+            let density = match variant.longitudinal {
+                LongitudinalModel::Published => {
+                    0.5 * longitudinal_m_p(params, lobe, 0.5 * (theta + theta_o))
+                }
+                LongitudinalModel::Normalized => {
+                    let (s, c) = tilted_outgoing(theta, params.alpha(lobe));
+                    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_o, s, c).exp()
+                        * theta_o.cos()
+                }
+            };
+            let az = AzimuthalLobe::new(params, variant, lobe, theta_d, 0.0);
+            let f = |phi: f64| {
+                let w = phi.abs() / PI;
+                azimuthal_n_p(params, variant, &az, phi)[ch] * if front { w } else { 1.0 - w }
+            };
             let mut b = az.breakpoints();
             b.push(0.0);
             b.sort_by(f64::total_cmp);
-            0.5 * cos2 * integrate_piecewise_relative(&f, &b, 1e-6)
+            density * integrate_piecewise_relative(&f, &b, 1e-6)
         };
         total += integrate_piecewise_relative(&inner, &breaks, 1e-6);
     }
@@ -95,19 +104,22 @@ fn front_plus_back_is_the_scattered_fraction_without_absorption() {
 #[test]
 fn front_and_back_fractions_against_brute_force() {
     let mut worst: f64 = 0.0;
-    for sigma in [0.1, 0.4, 1.5] {
-        let p = HairParams::with_sigma_a([sigma; 3]);
-        for deg in [-45.0f64, 0.0, 30.0] {
-            let theta = deg.to_radians();
-            let s = dual_sample(&p, XU_ROOTS, theta);
-            let bf = brute_force_split(&p, theta, true, 0);
-            let bb = brute_force_split(&p, theta, false, 0);
-            let (ef, eb) = (s.a_f[0] as f64 / bf - 1.0, s.a_b[0] as f64 / bb - 1.0);
-            println!(
-                "sigma_a {sigma:.1} theta {deg:+5.1}: a_f {:.4} vs {bf:.4} ({ef:+.2e}), a_b {:.4} vs {bb:.4} ({eb:+.2e})",
-                s.a_f[0], s.a_b[0]
-            );
-            worst = worst.max(ef.abs()).max(eb.abs());
+    for longitudinal in [LongitudinalModel::Normalized, LongitudinalModel::Published] {
+        let variant = XU_ROOTS.with_longitudinal(longitudinal);
+        for sigma in [0.1, 0.4, 1.5] {
+            let p = HairParams::with_sigma_a([sigma; 3]);
+            for deg in [-45.0f64, 0.0, 30.0] {
+                let theta = deg.to_radians();
+                let s = dual_sample(&p, variant, theta);
+                let bf = brute_force_split(&p, variant, theta, true, 0);
+                let bb = brute_force_split(&p, variant, theta, false, 0);
+                let (ef, eb) = (s.a_f[0] as f64 / bf - 1.0, s.a_b[0] as f64 / bb - 1.0);
+                println!(
+                    "{longitudinal:?} sigma_a {sigma:.1} theta {deg:+5.1}: a_f {:.4} vs {bf:.4} ({ef:+.2e}), a_b {:.4} vs {bb:.4} ({eb:+.2e})",
+                    s.a_f[0], s.a_b[0]
+                );
+                worst = worst.max(ef.abs()).max(eb.abs());
+            }
         }
     }
     println!("worst relative error {worst:.2e}");
@@ -202,10 +214,7 @@ fn global_and_local_terms_against_direct_quadrature() {
     };
     use strandlight::scattering::fast_params::FastHairParams;
     use strandlight::scattering::fast_response::SrbfInFrame;
-    use strandlight::scattering::marschner::{
-        AzimuthalLobe, ln_longitudinal_deon, longitudinal_m_p, longitudinal_m_p_normalized,
-        tilted_outgoing,
-    };
+    use strandlight::scattering::marschner::longitudinal_m_p_normalized;
     let p = HairParams::with_sigma_a([0.2, 0.5, 1.0]);
     let tables = DualTables::build(&p, XU_ROOTS);
     let gauss = |x: f64, s: f64| (-x * x / (2.0 * s * s)).exp() / ((2.0 * PI).sqrt() * s);

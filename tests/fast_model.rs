@@ -335,3 +335,64 @@ fn brute_force_reference_limits() {
     println!("wide light R: adaptive {r:.6e}, midpoint {sum:.6e}");
     assert!((r / sum - 1.0).abs() < 1e-3);
 }
+
+/// d'Eon's normalised M: integral M cos(theta_i) d theta_i = 1 over [-pi/2, pi/2] for any tilt and outgoing
+/// inclination, the pole reflection included; the f32 twin (fast form, WGSL's source) equals the f64 one.
+#[test]
+fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
+    use strandlight::scattering::fast_response::ln_longitudinal_deon as ln_m_f32;
+    use strandlight::scattering::marschner::{
+        deon_variance, ln_longitudinal_deon, tilted_outgoing,
+    };
+    use strandlight::scattering::numeric::integrate_piecewise_relative;
+    let (mut worst_norm, mut worst_twin) = (0.0f64, 0.0f64);
+    for beta_deg in [0.5f64, 5.0, 20.0] {
+        for alpha_deg in [-10.0f64, 0.0, 10.0] {
+            for theta_o_deg in [0.0f64, 80.0, -80.0, 89.9, -89.9] {
+                let (beta, alpha, theta_o) = (
+                    beta_deg.to_radians(),
+                    alpha_deg.to_radians(),
+                    theta_o_deg.to_radians(),
+                );
+                let v = deon_variance(beta);
+                let (s, c) = tilted_outgoing(theta_o, alpha);
+                let m = |ti: f64| ln_longitudinal_deon(v, ti, s, c).exp();
+                let peak = -s.atan2(c);
+                let w = v.sqrt();
+                let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
+                breaks.extend(
+                    [-8.0, -3.0, -1.0, 0.0, 1.0, 3.0, 8.0]
+                        .iter()
+                        .map(|k| peak + k * w)
+                        .filter(|x| x.abs() < FRAC_PI_2),
+                );
+                breaks.sort_by(f64::total_cmp);
+                let total = integrate_piecewise_relative(&|ti| m(ti) * ti.cos(), &breaks, 1e-10);
+                worst_norm = worst_norm.max((total - 1.0).abs());
+                assert!(
+                    (total - 1.0).abs() < 1e-6,
+                    "beta {beta_deg} alpha {alpha_deg} theta_o {theta_o_deg}: integral {total}"
+                );
+                let m_peak = m(peak);
+                for k in 0..=64 {
+                    let ti = -FRAC_PI_2 + PI * k as f64 / 64.0;
+                    let exact = m(ti);
+                    if exact < 1e-6 * m_peak {
+                        continue;
+                    }
+                    let f32_value =
+                        (ln_m_f32(v as f32, ti as f32, theta_o as f32, alpha as f32) as f64).exp();
+                    let rel = (f32_value / exact - 1.0).abs();
+                    worst_twin = worst_twin.max(rel);
+                    assert!(
+                        rel < 2e-3,
+                        "beta {beta_deg} alpha {alpha_deg} theta_o {theta_o_deg} theta_i {ti}: f32 {f32_value} vs {exact}"
+                    );
+                }
+            }
+        }
+    }
+    println!(
+        "d'Eon M: worst |integral - 1| {worst_norm:.1e}; f32 twin worst relative difference {worst_twin:.1e}"
+    );
+}

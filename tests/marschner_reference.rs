@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::{PI, TAU};
 use strandlight::scattering::marschner::{
-    AzimuthalLobe, caustic_offset, longitudinal_m_p_normalized, phi_p,
+    AzimuthalLobe, caustic_offset, lobe_centre, longitudinal_m_p_normalized, phi_p,
 };
 use strandlight::scattering::numeric::integrate_piecewise_relative;
 use strandlight::scattering::reference::{
@@ -172,7 +172,7 @@ fn higher_orders_energy(p: &HairParams, variant: ModelVariant, theta_o: f64) -> 
                 .sum::<f64>();
         longitudinal_m_p_normalized(p, Lobe::TRT, theta_i, theta_o) * theta_i.cos() * rest
     };
-    let c = 2.0 * p.alpha(Lobe::TRT) - theta_o;
+    let c = lobe_centre(p, variant, Lobe::TRT, theta_o);
     let w = 2.0 * p.beta(Lobe::TRT);
     let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
     breaks.extend(
@@ -348,8 +348,8 @@ fn white_furnace_published_model_band_and_absorbing_limit() {
             "theta_o {to}: deviations {dev:?}"
         );
     }
-    // With strong absorption only R survives (both forms).
-    for v in [v, ModelVariant::UNSMOOTHED] {
+    // With strong absorption only R survives (both forms; the normalised R is about half the published).
+    for (v, lower) in [(v, 0.05), (ModelVariant::UNSMOOTHED, 0.03)] {
         let mut p = HairParams::with_sigma_a([40.0; 3]);
         p.beta_r = 5f64.to_radians();
         let er = directional_albedo(&p, v, Lobe::R, 0.3, 0);
@@ -360,7 +360,7 @@ fn white_furnace_published_model_band_and_absorbing_limit() {
             v.longitudinal
         );
         assert!(ett < 1e-12 * er && etrt < 1e-12 * er);
-        assert!(er > 0.03 && er < 0.2, "E_R = {er}");
+        assert!(er > lower && er < 0.2, "E_R = {er}");
     }
 }
 

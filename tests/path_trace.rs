@@ -229,16 +229,17 @@ fn white_furnace_lossless_hair() {
 /// the project's sunny and studio environments: relative error of the mean colour per channel and the
 /// MS share of both, for single scattering with shadows (the R + TT + TRT components of both frames:
 /// the renderer's are its shadowed single scattering, the path tracer's its order 0 with shadow rays)
-/// and full transport (the beauty). Full transport must be within 10 % per channel.
+/// and full transport (the beauty).
 ///
-/// Measured (2026-11-29, d'Eon's longitudinal function in both): single scattering within 4.4 %
-/// everywhere; full transport brown within 4.1 %, blond 17 % (sunny) and 20 % (studio) too bright in
-/// red: the renderer's MS share is 11-14 % against the path tracer's 4-5 % on this sparse bob (dual
-/// scattering's back-scattering assumes hair behind every point). On a 1500-strand bob the MS shares
-/// agree (0.16 / 0.16 sunny) but the renderer's volume shadows are 7-9 % too light, worst 12.3 %.
-/// Each case also costs 22-40 s of lavapipe for the dual-scattering shadow grid.
+/// Asserted: single scattering within 5 % everywhere, brown full transport within 10 %. Blond full
+/// transport is NOT within the 10 %: measured (2026-11-29) 17 % (sunny) and 20 % (studio) too
+/// bright in red, the renderer's MS share 11-14 % against the path tracer's 4-5 % on this sparse bob
+/// (dual scattering's back-scattering assumes hair behind every point). On a 1500-strand bob at the
+/// default volume and shadow-grid resolution the MS shares agree in sunny light (0.168 / 0.165) but
+/// single scattering is 7.6 % too bright (the volume's shadows are lighter than the explicit fibers'),
+/// and studio's MS share is 0.189 / 0.144: 11-12 % in red either way. The blond bound below only keeps
+/// that known gap from growing.
 #[test]
-#[ignore = "the renderer's blond full transport is 17-20 % brighter than the path tracer (see the doc comment); run with --ignored"]
 fn renderer_is_close_to_the_path_tracer_on_bobs() {
     let t0 = Instant::now();
     let ctx = context();
@@ -247,7 +248,7 @@ fn renderer_is_close_to_the_path_tracer_on_bobs() {
         samples_per_pixel: 32,
         ..Default::default()
     };
-    let mut worst = 0.0f64;
+    let (mut worst_single, mut worst_brown, mut worst_blond) = (0.0f64, 0.0f64, 0.0f64);
     println!(
         "{:<6} {:<7} {:<6} {:>26} {:>26} {:>24} {:>15}",
         "hair", "env", "light", "renderer mean", "path tracer mean", "relative error", "MS share"
@@ -257,11 +258,7 @@ fn renderer_is_close_to_the_path_tracer_on_bobs() {
             let lights = SrbfSet::read(&envmaps().join(format!("{name}.srbf.json"))).expect("fit");
             let (env, _) = load_env(&envmaps().join(format!("{name}.exr"))).expect("env");
             let t = Instant::now();
-            let strands = std::env::var("BOB")
-                .ok()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(300);
-            let scene = common::bob_scene(strands, 64, 48, preset.params(), true);
+            let scene = common::bob_scene(300, 64, 48, preset.params(), true);
             let frame = scene.render(&ctx, &luts, &lights.lights);
             let t_gpu = t.elapsed().as_secs_f64();
             let t = Instant::now();
@@ -296,9 +293,12 @@ fn renderer_is_close_to_the_path_tracer_on_bobs() {
                     format!("{err:+.3?}"),
                     share
                 );
-                if !single {
-                    for e in err {
-                        worst = worst.max(e.abs());
+                for e in err {
+                    let e = e.abs();
+                    match (single, preset) {
+                        (true, _) => worst_single = worst_single.max(e),
+                        (false, Preset::Brown) => worst_brown = worst_brown.max(e),
+                        (false, _) => worst_blond = worst_blond.max(e),
                     }
                 }
             }
@@ -309,13 +309,22 @@ fn renderer_is_close_to_the_path_tracer_on_bobs() {
         }
     }
     println!(
-        "worst full-transport mean-colour error {:.1}% (limit 10%); test time {:.1} s",
-        100.0 * worst,
+        "worst mean-colour error: single scattering {:.1}% (limit 5%), full transport brown {:.1}% (limit 10%), blond {:.1}% (known gap, limit 25%); test time {:.1} s",
+        100.0 * worst_single,
+        100.0 * worst_brown,
+        100.0 * worst_blond,
         t0.elapsed().as_secs_f64()
     );
     assert!(
-        worst <= 0.10,
-        "full transport mean colour off by {:.1}%",
-        100.0 * worst
+        worst_single <= 0.05,
+        "single scattering off by {worst_single}"
+    );
+    assert!(
+        worst_brown <= 0.10,
+        "brown full transport off by {worst_brown}"
+    );
+    assert!(
+        worst_blond <= 0.25,
+        "blond full transport off by {worst_blond}"
     );
 }

@@ -370,6 +370,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         ("lights".to_string(), env.lights.lights.len().to_string()),
         ("params".to_string(), serde_json::to_string(&params)?),
         (
+            "longitudinal".to_string(),
+            serde_json::to_string(&look.longitudinal())?,
+        ),
+        (
             "absorption".to_string(),
             format!(
                 "dye {:?}, root {:?}, tip {:?}, strand variation {}, seed {}, paint {:?}",

@@ -6,7 +6,8 @@
 //!
 //! Estimator, per visible point and path (unbiased up to the depth cut-off):
 //! - the kernel is the exact model, K(omega_i, omega_o) = S(omega_i, omega_o) cos(theta_i) per lobe
-//!   ([`scattering_s`] with [`REFERENCE_VARIANT`]); radiance L_o = integral K L_i d omega_i;
+//!   ([`scattering_s`] with [`REFERENCE_VARIANT`] and the look's longitudinal function); radiance
+//!   L_o = integral K L_i d omega_i;
 //! - next-event estimation with a shadow ray through the fibers (any crossing blocks). The
 //!   environment image is sampled afresh for every point and vertex (texels by luminance x solid
 //!   angle): no light set is shared between pixels, so its discretisation averages out instead of
@@ -43,8 +44,11 @@ use super::shade::{LobeRadiance, ShadingHair, ShadingPoint, distinct_samples};
 use crate::envmap::EnvMap;
 use crate::envmap::direction::{direction_from_uv, rotate_yaw, uv_from_direction};
 use crate::scattering::frame::{FiberAngles, FiberFrame, wrap_angle};
-use crate::scattering::marschner::{AzimuthalLobe, dphi_dh, phi_p, scattering_s};
-use crate::scattering::params::{HairParams, Lobe};
+use crate::scattering::marschner::{
+    AzimuthalLobe, deon_variance, dphi_dh, ln_longitudinal_deon, phi_p, scattering_s,
+    tilted_outgoing,
+};
+use crate::scattering::params::{HairParams, Lobe, ModelVariant};
 use crate::shadow::fiber_grid::{Crossing, FiberGrid};
 use glam::{DVec3, Vec3};
 use rand_core::{Rng, SeedableRng};
@@ -86,31 +90,6 @@ impl Default for PathTraceSettings {
     }
 }
 
-/// e^-x I0(x) in f64 for x >= 0: the power series up to 30, the asymptotic series beyond (relative
-/// error ~1e-12).
-pub fn bessel_i0_scaled(x: f64) -> f64 {
-    let x = x.abs();
-    if x <= 30.0 {
-        let q = 0.25 * x * x;
-        let (mut term, mut sum) = (1.0f64, 1.0f64);
-        for k in 1..200 {
-            term *= q / (k * k) as f64;
-            sum += term;
-            if term < 1e-17 * sum {
-                break;
-            }
-        }
-        return sum * (-x).exp();
-    }
-    let (mut term, mut sum) = (1.0f64, 1.0f64);
-    for k in 1..12 {
-        let m = (2 * k - 1) as f64;
-        term *= m * m / (8.0 * k as f64 * x);
-        sum += term;
-    }
-    sum / (TAU * x).sqrt()
-}
-
 /// The sampling density's longitudinal part for one lobe: variance v and the tilted outgoing
 /// inclination (sin theta'_o, |cos theta'_o|).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,26 +102,19 @@ pub struct Longitudinal {
 impl Longitudinal {
     /// v_p = (2 beta_p)^2, theta'_o = theta_o - 2 alpha_p (reflected back past the pole).
     pub fn new(params: &HairParams, lobe: Lobe, theta_o: f64) -> Self {
-        let b = params.beta(lobe);
-        let t = theta_o - 2.0 * params.alpha(lobe);
+        let (sin_o, cos_o) = tilted_outgoing(theta_o, params.alpha(lobe));
         Self {
-            v: 4.0 * b * b,
-            sin_o: t.sin(),
-            cos_o: t.cos().abs(),
+            v: deon_variance(params.beta(lobe)),
+            sin_o,
+            cos_o,
         }
     }
 
     /// d'Eon's M(theta_i; theta'_o, v) = csch(1/v)/(2v) exp(-sin theta_i sin theta'_o / v)
     /// I0(cos theta_i cos theta'_o / v), with integral M cos(theta_i) d theta_i = 1 over [-pi/2, pi/2];
-    /// evaluated as e^{(cos(theta_i + theta'_o) - 1)/v} (e^-a I0(a)) / (v (1 - e^{-2/v})), which neither
-    /// overflows nor loses precision for narrow lobes.
+    /// the exact model's own log-space form ([`ln_longitudinal_deon`]), so sampler and kernel agree.
     pub fn density(&self, theta_i: f64) -> f64 {
-        let cos_i = theta_i.cos().max(0.0);
-        let a = cos_i * self.cos_o / self.v;
-        let theta_o = self.sin_o.atan2(self.cos_o);
-        let half = (0.5 * (theta_i + theta_o)).sin();
-        (-2.0 * half * half / self.v).exp() * bessel_i0_scaled(a)
-            / (self.v * -(-2.0 / self.v).exp_m1())
+        ln_longitudinal_deon(self.v, theta_i, self.sin_o, self.cos_o).exp()
     }
 
     /// theta_i with density M(theta_i) cos(theta_i) (pbrt-v4's `SampleMp`): the cosine to the cone's
@@ -188,10 +160,18 @@ pub struct Scatterer {
     /// Probabilities of R, TT, TRT and the uniform sphere.
     pub q: [f64; 4],
     long: [Longitudinal; 3],
+    /// The exact model's variant (its longitudinal function is the look's).
+    variant: ModelVariant,
 }
 
 impl Scatterer {
-    pub fn new(base: &HairParams, sigma_a: [f32; 3], tangent: Vec3, omega_o: Vec3) -> Self {
+    pub fn new(
+        base: &HairParams,
+        variant: ModelVariant,
+        sigma_a: [f32; 3],
+        tangent: Vec3,
+        omega_o: Vec3,
+    ) -> Self {
         let mut params = *base;
         params.sigma_a = sigma_a.map(|s| s as f64);
         let mut sampler_params = params;
@@ -228,12 +208,13 @@ impl Scatterer {
             wo,
             q,
             long,
+            variant,
         }
     }
 
     /// K = S cos(theta_i) per lobe (R, TT, TRT), RGB.
     pub fn kernel(&self, wi: FiberAngles) -> [[f64; 3]; 3] {
-        let s = scattering_s(&self.params, REFERENCE_VARIANT, wi, self.wo);
+        let s = scattering_s(&self.params, self.variant, wi, self.wo);
         let c = wi.theta.cos().max(0.0);
         [s.r, s.tt, s.trt].map(|l| l.map(|x| x * c))
     }
@@ -491,6 +472,7 @@ impl<'a> LightSource<'a> {
 /// What the tracer shares between pixels.
 struct Tracer<'a> {
     params: &'a HairParams,
+    variant: ModelVariant,
     lights: LightSource<'a>,
     grid: &'a FiberGrid,
     settings: PathTraceSettings,
@@ -584,7 +566,7 @@ impl Tracer<'_> {
         let max_depth = self.settings.max_depth as usize;
         let mut out = PointEstimate::zero(max_depth + 1);
         let spp = self.settings.samples_per_pixel.max(1);
-        let primary = Scatterer::new(self.params, sp.sigma_a, sp.tangent, omega_o);
+        let primary = Scatterer::new(self.params, self.variant, sp.sigma_a, sp.tangent, omega_o);
         // Unshadowed contribution of every light at the primary point, per lobe.
         let lights = self.lights.point_lights(rng);
         let direct: Vec<[[f64; 3]; 3]> = lights
@@ -672,7 +654,13 @@ impl Tracer<'_> {
                 return;
             };
             point = crossing_point(self.grid, &x);
-            owned = Scatterer::new(self.params, point.sigma_a, point.tangent, -d.as_vec3());
+            owned = Scatterer::new(
+                self.params,
+                self.variant,
+                point.sigma_a,
+                point.tangent,
+                -d.as_vec3(),
+            );
             scatterer = &owned;
             // Next-event estimation: one light (balance heuristic against kernel sampling for
             // the environment image).
@@ -724,6 +712,7 @@ fn trace_pixels(
         settings.max_depth = 0;
     }
     let tracer = Tracer {
+        variant: REFERENCE_VARIANT.with_longitudinal(scene.look.longitudinal()),
         params: &scene.look.params,
         lights: LightSource::new(&scene.lighting),
         grid: &grid,
@@ -876,7 +865,7 @@ mod tests {
         for x in [0.0, 0.3, 2.0, 12.0, 29.9, 30.1, 80.0, 400.0] {
             // I0(x) e^-x = (1/pi) integral_0^pi e^{x (cos t - 1)} dt
             let want = integrate(|t: f64| (x * (t.cos() - 1.0)).exp(), 0.0, PI, 200_000) / PI;
-            let got = bessel_i0_scaled(x);
+            let got = crate::scattering::marschner::bessel_i0_scaled_f64(x);
             assert!((got / want - 1.0).abs() < 1e-9, "x {x}: {got} vs {want}");
         }
     }
@@ -946,7 +935,13 @@ mod tests {
         let params = Preset::Blond.params();
         let tangent = Vec3::Y;
         let omega_o = Vec3::new(0.6, 0.3, 0.74).normalize();
-        let s = Scatterer::new(&params, [0.3, 0.5, 0.9], tangent, omega_o);
+        let s = Scatterer::new(
+            &params,
+            REFERENCE_VARIANT,
+            [0.3, 0.5, 0.9],
+            tangent,
+            omega_o,
+        );
         // Quadrature over (theta, phi): cos(theta) d theta d phi.
         let (nt, np) = (600usize, 720usize);
         let (mut pdf_total, mut albedo) = (0.0, [0.0f64; 3]);

@@ -5,8 +5,10 @@
 //! inclination theta, lobe t,
 //!   a_{f,t}(theta) = L_t(theta) F_{f,t}(theta),   a_{b,t}(theta) = L_t(theta) F_{b,t}(theta),
 //!   L_t(theta) = (1/2) integral_{-pi/2}^{pi/2} M_t((theta + theta_o)/2) d theta_o
-//! (the longitudinal fraction: M_t integrates to 2 over theta_o, hence the 1/2; L_t = 1 unless the lobe is cut
-//! at a pole). The factor cos^2(theta_o) / cos^2(theta_d) that (1/2) S cos(theta_o) d omega_o carries is left
+//! (the longitudinal fraction: the published M_t integrates to 2 over theta_o, hence the 1/2; L_t = 1 unless the
+//! lobe is cut at a pole), or with d'Eon's normalised M (the default, [`LongitudinalModel`])
+//!   L_t(theta) = 1
+//! (d'Eon's M is a unit density that reflects back at the poles instead of leaving). The factor cos^2(theta_o) / cos^2(theta_d) that (1/2) S cos(theta_o) d omega_o carries is left
 //! out: it is 1 on the specular cone and departs from 1 only through the scale tilt alpha (by 4% at
 //! alpha = -7.5 deg), which is not an absorption, so a_f + a_b stays the fraction the fiber scatters. And
 //!   F_{f,t} = (1/pi) integral_{-pi}^{pi} |phi| N_t(theta, phi) d phi = (1/pi) integral_{-1}^{1} (A_t(h)/2) |phi_t(h)| dh,
@@ -28,15 +30,26 @@
 use super::frame::wrap_angle;
 use super::marschner::{AzimuthalLobe, longitudinal_m_p, phi_p};
 use super::numeric::integrate_fixed;
-use super::params::{HairParams, Lobe, ModelVariant};
+use super::params::{HairParams, Lobe, LongitudinalModel, ModelVariant};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Samples of the incident inclination theta over [-pi/2, pi/2] (sample i at -pi/2 + pi i / (N - 1)).
 pub const DUAL_SAMPLES: usize = 128;
 
-/// L_t(theta), the longitudinal energy fraction of lobe t (see the module notes): the part of the unit-area
-/// M_t that leaves into theta_o in [-pi/2, pi/2].
-pub fn longitudinal_fraction(params: &HairParams, lobe: Lobe, theta: f64) -> f64 {
+/// L_t(theta), the longitudinal energy fraction of lobe t (see the module notes): the part of the lobe that
+/// leaves into theta_o in [-pi/2, pi/2]. Published: (1/2) integral M_t((theta + theta_o)/2) d theta_o, cut at the
+/// poles. Normalised: 1, since d'Eon's M is a unit density that reflects back at the poles instead of leaving
+/// (as a function of theta_o for fixed theta, M(theta_o, theta - 2 alpha_t) cos(theta_o) integrates to 1 exactly; the
+/// tilt moves the lobe, it absorbs nothing).
+pub fn longitudinal_fraction(
+    params: &HairParams,
+    variant: ModelVariant,
+    lobe: Lobe,
+    theta: f64,
+) -> f64 {
+    if variant.longitudinal == LongitudinalModel::Normalized {
+        return 1.0;
+    }
     let centre = 2.0 * params.alpha(lobe) - theta;
     let width = 2.0 * params.beta(lobe);
     let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
@@ -130,7 +143,7 @@ pub fn dual_sample(params: &HairParams, variant: ModelVariant, theta: f64) -> Du
     let (mut wf, mut wb) = ([0f64; 3], [0f64; 3]);
     let (mut af, mut ab, mut bf, mut bb) = ([0f64; 3], [0f64; 3], [0f64; 3], [0f64; 3]);
     for lobe in Lobe::ALL {
-        let l = longitudinal_fraction(params, lobe, theta);
+        let l = longitudinal_fraction(params, variant, lobe, theta);
         let (ff, fb) = azimuthal_split(params, variant, lobe, params.alpha(lobe) - theta);
         let (alpha, beta2) = (params.alpha(lobe), params.beta(lobe).powi(2));
         for c in 0..3 {

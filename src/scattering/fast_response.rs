@@ -1,6 +1,7 @@
 //! Xu et al. 2011 Sec. 4.2: the single-scattering response of one SRBF light,
 //!   M_t(omega_j, lambda_j, omega_o) = integral G_j(omega_i) S_t(omega_i, omega_o) cos(theta_i) d omega_i   (Eq. 11)
-//!   ~ integral g(theta_i; theta_j, lambda_j) M_t(theta_h) cos^2(theta_i) / cos^2(theta_d) calN_t(lambda', phi_o - phi_j, theta_d) d theta_i,
+//!   ~ integral g(theta_i; theta_j, lambda_j) M_t(theta_h) cos^2(theta_i) / cos^2(theta_d) calN_t(lambda', phi_o - phi_j, theta_d) d theta_i
+//!   (published), or with M_t(theta_i, theta_o) cos(theta_i) in place of M_t(theta_h) cos^2(theta_i) / cos^2(theta_d) (normalised),
 //! with lambda' = lambda_j / sqrt(cos theta_i cos theta_j), and the outer integral done by the linear
 //! quadrature of Sec. 4.2.2 against the product Gaussian g(theta_i; theta_j, lambda_j) M_t.
 //!
@@ -210,7 +211,7 @@ pub fn longitudinal_factor(
         let cd = (0.5 * (theta_o - theta_i)).cos();
         return 2.0 * ci * ci / (cd * cd).max(1e-8);
     }
-    let v = 4.0 * beta * beta;
+    let v = (4.0 * beta * beta).max(1e-8);
     let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
     let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha)
         + d * d / (2.0 * v)

@@ -64,7 +64,20 @@ pub fn bessel_i0_scaled_f64(x: f64) -> f64 {
 /// The variance v_p = (2 beta_p)^2 of d'Eon's longitudinal function: Marschner's M_p(theta_h) has standard
 /// deviation beta_p in theta_h = (theta_i + theta_o)/2, so 2 beta_p in theta_i; both forms have that width.
 pub fn deon_variance(beta: f64) -> f64 {
-    4.0 * beta * beta
+    (4.0 * beta * beta).max(1e-12)
+}
+
+/// The centre in theta_i of lobe p's longitudinal function for the outgoing theta_o (where quadratures split):
+/// published, 2 alpha_p - theta_o (possibly past a pole, where the lobe is cut); normalised, -theta_o' (d'Eon's
+/// peak, reflected back inside).
+pub fn lobe_centre(params: &HairParams, variant: ModelVariant, lobe: Lobe, theta_o: f64) -> f64 {
+    match variant.longitudinal {
+        LongitudinalModel::Published => 2.0 * params.alpha(lobe) - theta_o,
+        LongitudinalModel::Normalized => {
+            let (s, c) = tilted_outgoing(theta_o, params.alpha(lobe));
+            -s.atan2(c)
+        }
+    }
 }
 
 /// The outgoing inclination tilted by the scales, theta_o' = theta_o - 2 alpha (pbrt-v4 applies the tilt to

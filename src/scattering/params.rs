@@ -211,7 +211,16 @@ impl HairParams {
             }
         }
         for lobe in Lobe::ALL {
-            finite("alpha", self.alpha(lobe))?;
+            let a = self.alpha(lobe);
+            finite("alpha", a)?;
+            // Scales tilt the lobes by a few degrees; past 30 degrees the tilted lobe would wrap at a pole.
+            if a.abs() > 30f64.to_radians() {
+                return Err(format!(
+                    "alpha_{} must be within +-30 degrees, got {:.1} degrees",
+                    lobe.name(),
+                    a.to_degrees()
+                ));
+            }
             let b = self.beta(lobe);
             finite("beta", b)?;
             if b <= 0.0 || b > 1.5 {

@@ -2,7 +2,8 @@
 //! Each works on one colour channel (`channel` in 0..3) so no work is repeated per channel.
 
 use super::marschner::{
-    AzimuthalLobe, CausticFix, azimuthal_n_p, longitudinal_m_p, longitudinal_m_p_normalized,
+    AzimuthalLobe, CausticFix, azimuthal_n_p, lobe_centre, longitudinal_m_p,
+    longitudinal_m_p_normalized,
 };
 use super::numeric::integrate_piecewise_relative;
 use super::params::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
@@ -86,8 +87,8 @@ pub fn directional_albedo(
     let mut p = *params;
     p.eccentricity = 1.0;
     let beta = p.beta(lobe);
-    // Split theta_i around the lobe centre theta_i* = 2 alpha_p - theta_o (std 2 beta in theta_i).
-    let centre = 2.0 * p.alpha(lobe) - theta_o;
+    // Split theta_i around the lobe centre (std 2 beta in theta_i).
+    let centre = lobe_centre(&p, variant, lobe, theta_o);
     let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
     for k in [-8.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
         let x = centre + 2.0 * k * beta;

@@ -17,7 +17,8 @@
 
 use super::frame::{FiberAngles, wrap_angle};
 use super::marschner::{
-    AzimuthalLobe, caustic_offset, longitudinal_m_p, longitudinal_m_p_normalized, phi_p,
+    AzimuthalLobe, caustic_offset, lobe_centre, longitudinal_m_p, longitudinal_m_p_normalized,
+    phi_p,
 };
 use super::numeric::integrate_piecewise;
 use super::params::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
@@ -153,7 +154,7 @@ pub fn srbf_response_reference(
         ..fresnel_variant
     };
     let (theta_o, phi_o) = (wo.theta, wo.phi);
-    let centre = 2.0 * params.alpha(lobe) - theta_o;
+    let centre = lobe_centre(params, variant, lobe, theta_o);
     let width = 2.0 * params.beta(lobe);
     let mut breaks = Vec::new();
     for k in [-4.0, -1.5, 0.0, 1.5, 4.0] {
