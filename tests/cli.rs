@@ -107,6 +107,37 @@ fn bad_input_is_a_one_line_error_with_nonzero_exit() {
             r#"[{"theta_i": 0, "theta_o": 0, "params": {"sigma_a": [1, 2]}}]"#,
             "sigma_a",
         ),
+        // Limits in the units the user typed (degrees), and a missing file's error said once.
+        (
+            vec![
+                "bsdf",
+                "--theta-i",
+                "0",
+                "--theta-o",
+                "0",
+                "--beta-r",
+                "1000",
+            ],
+            "",
+            "got 1000 degrees",
+        ),
+        (
+            vec![
+                "render",
+                "--hair",
+                "/nonexistent/strandlight.hair",
+                "-o",
+                "/tmp/x.exr",
+            ],
+            "",
+            "/nonexistent/strandlight.hair: No such file",
+        ),
+        // An output folder that does not exist fails before any rendering.
+        (
+            vec!["render", "-o", "/nonexistent/strandlight/x.exr"],
+            "",
+            "does not exist",
+        ),
     ] {
         let mut child = strandlight()
             .args(&args)
@@ -129,7 +160,36 @@ fn bad_input_is_a_one_line_error_with_nonzero_exit() {
             "{err}"
         );
         assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(
+            err.matches("os error").count() <= 1,
+            "{args:?}: the cause repeated: {err}"
+        );
     }
+}
+
+#[test]
+fn stdin_presets_are_spelled_as_on_the_command_line() {
+    let mut child = strandlight()
+        .args(["bsdf", "--stdin"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(
+            br#"[{"theta_i": 10, "theta_o": -5, "phi_o": 160, "params": {"preset": "dark-brown"}}]"#,
+        )
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

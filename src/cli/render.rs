@@ -190,10 +190,30 @@ fn absorption(
     Ok((sigma_a, params))
 }
 
+/// Fails before any rendering when an output could not be written: its folder must exist.
+fn check_outputs(outputs: &[&PathBuf]) -> anyhow::Result<()> {
+    for path in outputs {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if !dir.is_dir() {
+            bail!(
+                "{}: the folder {} does not exist (nothing was rendered)",
+                path.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.output.is_none() && args.png.is_none() {
         bail!("nothing to write: give -o still.exr and/or --png preview.png");
     }
+    let outputs: Vec<&PathBuf> = args.output.iter().chain(args.png.iter()).collect();
+    check_outputs(&outputs)?;
     let params = args.params.resolve()?;
     let (hair, hair_name) = match &args.hair {
         Some(path) => {

@@ -216,17 +216,19 @@ impl HairParams {
             // Scales tilt the lobes by a few degrees; past 30 degrees the tilted lobe would wrap at a pole.
             if a.abs() > 30f64.to_radians() {
                 return Err(format!(
-                    "alpha_{} must be within +-30 degrees, got {:.1} degrees",
+                    "alpha_{} must be within +-30 degrees, got {} degrees",
                     lobe.name(),
-                    a.to_degrees()
+                    degrees(a)
                 ));
             }
             let b = self.beta(lobe);
             finite("beta", b)?;
             if b <= 0.0 || b > 1.5 {
                 return Err(format!(
-                    "beta_{} must be in (0, 1.5] rad, got {b}",
-                    lobe.name()
+                    "beta_{} must be in (0, {:.0}] degrees, got {} degrees",
+                    lobe.name(),
+                    1.5f64.to_degrees(),
+                    degrees(b)
                 ));
             }
         }
@@ -238,8 +240,8 @@ impl HairParams {
         }
         if !(self.caustic_width.is_finite() && self.caustic_width > 0.0) {
             return Err(format!(
-                "caustic width must be > 0, got {}",
-                self.caustic_width
+                "caustic width must be > 0 degrees, got {} degrees",
+                degrees(self.caustic_width)
             ));
         }
         for (name, x) in [
@@ -253,6 +255,12 @@ impl HairParams {
         }
         Ok(())
     }
+}
+
+/// An angle in radians as the degrees a user typed (rounded to 1e-6, trailing zeros dropped).
+fn degrees(x: f64) -> String {
+    let d = (x.to_degrees() * 1e6).round() / 1e6;
+    format!("{d}")
 }
 
 /// Absorption per unit radius of eumelanin and pheomelanin at unit concentration, RGB.
@@ -270,6 +278,7 @@ pub fn sigma_a_from_melanin(eumelanin: f64, pheomelanin: f64) -> [f64; 3] {
 /// Named looks. Concentrations are our choices, placed on the scale pbrt-v4's documentation
 /// describes (about 0.3 blond, 1.3 brown, 8 black for eumelanin; pheomelanin for red tones).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Preset {
     DarkBrown,
     Brown,
@@ -330,6 +339,24 @@ mod tests {
         // Auburn absorbs blue much more than red: it looks red.
         let a = Preset::Auburn.params().sigma_a;
         assert!(a[2] > 2.0 * a[0]);
+    }
+
+    #[test]
+    fn presets_read_as_the_command_line_spells_them() {
+        let p: Preset = serde_json::from_str("\"dark-brown\"").unwrap();
+        assert_eq!(p, Preset::DarkBrown);
+        let p: Preset = serde_json::from_str("\"blond\"").unwrap();
+        assert_eq!(p, Preset::Blond);
+    }
+
+    #[test]
+    fn limits_are_reported_in_degrees() {
+        let p = HairParams {
+            beta_r: 1000f64.to_radians(),
+            ..Default::default()
+        };
+        let e = p.validate().unwrap_err();
+        assert!(e.contains("1000 degrees"), "{e}");
     }
 
     #[test]
