@@ -7,6 +7,22 @@ fn strandlight() -> Command {
     Command::new(env!("CARGO_BIN_EXE_strandlight"))
 }
 
+/// Runs the binary with `args`, writing `stdin` to it; stdout and stderr captured.
+fn run_with_stdin<A: AsRef<std::ffi::OsStr>>(
+    args: impl IntoIterator<Item = A>,
+    stdin: &[u8],
+) -> std::process::Output {
+    let mut child = strandlight()
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(stdin).unwrap();
+    child.wait_with_output().unwrap()
+}
+
 #[test]
 fn no_subcommand_lists_the_subcommands() {
     let out = strandlight().output().unwrap();
@@ -57,22 +73,8 @@ fn bsdf_answers_json_that_matches_the_library() {
 
 #[test]
 fn bsdf_batch_from_stdin_and_overrides() {
-    let mut child = strandlight()
-        .args(["bsdf", "--stdin", "--beta-r", "4"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(
-            br#"[{"theta_i": 20, "theta_o": -10, "phi_o": 30},
-                 {"theta_i": 20, "theta_o": -10, "phi_o": 30, "params": {"beta_r": 8, "variant": "xu", "sigma_a": [0.1, 0.2, 0.3]}}]"#,
-        )
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = run_with_stdin(["bsdf", "--stdin", "--beta-r", "4"], br#"[{"theta_i": 20, "theta_o": -10, "phi_o": 30},
+                 {"theta_i": 20, "theta_o": -10, "phi_o": 30, "params": {"beta_r": 8, "variant": "xu", "sigma_a": [0.1, 0.2, 0.3]}}]"#);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let arr = v.as_array().unwrap();
@@ -139,20 +141,7 @@ fn bad_input_is_a_one_line_error_with_nonzero_exit() {
             "does not exist",
         ),
     ] {
-        let mut child = strandlight()
-            .args(&args)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(stdin.as_bytes())
-            .unwrap();
-        let out = child.wait_with_output().unwrap();
+        let out = run_with_stdin(&args, stdin.as_bytes());
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
         assert!(
@@ -169,22 +158,10 @@ fn bad_input_is_a_one_line_error_with_nonzero_exit() {
 
 #[test]
 fn stdin_presets_are_spelled_as_on_the_command_line() {
-    let mut child = strandlight()
-        .args(["bsdf", "--stdin"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(
-            br#"[{"theta_i": 10, "theta_o": -5, "phi_o": 160, "params": {"preset": "dark-brown"}}]"#,
-        )
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = run_with_stdin(
+        ["bsdf", "--stdin"],
+        br#"[{"theta_i": 10, "theta_o": -5, "phi_o": 160, "params": {"preset": "dark-brown"}}]"#,
+    );
     assert!(
         out.status.success(),
         "{}",
@@ -318,20 +295,7 @@ fn srbf_response_fast_against_reference_and_batch() {
         assert!(total > 0.0);
     }
     // Batch from stdin; an impossible query names itself.
-    let mut child = strandlight()
-        .args(["srbf-response", "--stdin"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(br#"[{"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10}, {"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10, "params": {"sigma_a": [5]}}]"#)
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = run_with_stdin(["srbf-response", "--stdin"], br#"[{"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10}, {"theta_j": 20, "phi_j": 160, "lambda": 0.3, "theta_o": -10, "params": {"sigma_a": [5]}}]"#);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let arr = v.as_array().unwrap();

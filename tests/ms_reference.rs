@@ -5,10 +5,8 @@
 mod common;
 
 use glam::{DVec3, Vec3};
-use rand_core::{Rng, SeedableRng};
 use strandlight::envmap::SrbfLight;
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::hair::{Hair, RawStrand};
 use strandlight::render::reference::{
     REFERENCE_VARIANT, ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
@@ -22,53 +20,12 @@ use strandlight::shadow::forward::{ForwardTable, forward_scattering};
 use strandlight::shadow::ray_shooting::shoot_forward;
 
 /// Uniform numbers from a seeded PCG.
-struct Uniform(rand_pcg::Pcg64Mcg);
-
-impl Uniform {
-    fn new(seed: u64) -> Self {
-        Self(rand_pcg::Pcg64Mcg::seed_from_u64(seed))
-    }
-
-    fn random_range(&mut self, r: std::ops::Range<f32>) -> f32 {
-        let u = (self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
-        r.start + (r.end - r.start) * u
-    }
-}
-
-/// A disciplined clump: `n` straight fibers along +y (root at the top), 8 cm long, roots uniform over
-/// x in [-2, 2], z in [-1, 1], each tilted by up to 3 degrees, 12 segments, diameter 80 um.
-fn clump(n: usize, seed: u64) -> Hair {
-    let mut rng = Uniform::new(seed);
-    let strands = (0..n)
-        .map(|_| {
-            let root = Vec3::new(
-                rng.random_range(-2.0..2.0),
-                4.0,
-                rng.random_range(-1.0..1.0),
-            );
-            let tilt = Vec3::new(
-                rng.random_range(-0.05..0.05),
-                -1.0,
-                rng.random_range(-0.05..0.05),
-            )
-            .normalize();
-            RawStrand {
-                points: (0..13)
-                    .map(|j| root + tilt * (8.0 * j as f32 / 12.0))
-                    .collect(),
-                ..Default::default()
-            }
-        })
-        .collect();
-    Hair::from_strands(strands, 0.008).0
-}
-
 #[test]
 fn fiber_grid_finds_every_crossing_that_brute_force_finds() {
-    let hair = clump(600, 3);
+    let hair = common::clump(600, 3);
     let sigma = vec![[0.1f32; 3]; hair.point_count()];
     let grid = FiberGrid::build(&hair, &sigma);
-    let mut rng = Uniform::new(9);
+    let mut rng = common::Uniform::new(9);
     let (mut total, mut rays) = (0usize, 0usize);
     for _ in 0..400 {
         let o = Vec3::new(
@@ -135,14 +92,14 @@ fn srbf_samples_carry_the_lobe_power_and_follow_its_shape() {
 /// points inside a blond clump, for three directions.
 #[test]
 fn volume_direct_fraction_matches_the_fraction_of_free_rays() {
-    let hair = clump(3000, 5);
+    let hair = common::clump(3000, 5);
     let params = Preset::Blond.params();
     let sigma = vec![params.sigma_a.map(|s| s as f32); hair.point_count()];
     let grid = FiberGrid::build(&hair, &sigma);
     let volume = FiberDensity::build(&hair, &sigma, 0.0625);
     let pyramid = DensityPyramid::build(&volume);
     let table = ForwardTable::build(&params, REFERENCE_VARIANT);
-    let mut rng = Uniform::new(11);
+    let mut rng = common::Uniform::new(11);
     for (name, dir, normal) in [
         ("front", Vec3::new(0.0, 0.3, 1.0).normalize(), Vec3::Z),
         ("side", Vec3::new(1.0, 0.3, 0.0).normalize(), Vec3::X),
@@ -216,7 +173,7 @@ fn ms_rmse(a: &Frame, b: &Frame) -> f64 {
 fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
     let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
     let luts = Luts::default_tables();
-    let hair = clump(3000, 1);
+    let hair = common::clump(3000, 1);
     let look = HairLook::new(Preset::Blond.params());
     let (lo, hi) = hair.bounds();
     let camera = Camera::framing(lo, hi, 0.0, 0.0, 0.75, 0.95);

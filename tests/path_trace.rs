@@ -6,13 +6,11 @@
 
 mod common;
 
-use glam::Vec3;
-use rand_core::{Rng, SeedableRng};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandlight::envmap::{EnvMap, SrbfLight, SrbfSet, load_env};
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::hair::{Hair, RawStrand};
+use strandlight::hair::Hair;
 use strandlight::render::path_trace::{
     PathTraceSettings, path_trace_frame, path_trace_frame_with_stats,
 };
@@ -35,27 +33,6 @@ const FURNACE_SPP: u32 = 64;
 
 fn envmaps() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps")
-}
-
-/// A dense clump: `n` straight fibers along -y, 8 cm long, roots uniform over x in [-2, 2], z in
-/// [-1, 1], each tilted by up to 3 degrees, 12 segments, diameter 80 um (tests/ms_reference.rs's).
-fn clump(n: usize, seed: u64) -> Hair {
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let mut uniform =
-        |lo: f32, hi: f32| lo + (hi - lo) * ((rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32);
-    let strands = (0..n)
-        .map(|_| {
-            let root = Vec3::new(uniform(-2.0, 2.0), 4.0, uniform(-1.0, 1.0));
-            let tilt = Vec3::new(uniform(-0.05, 0.05), -1.0, uniform(-0.05, 0.05)).normalize();
-            RawStrand {
-                points: (0..13)
-                    .map(|j| root + tilt * (8.0 * j as f32 / 12.0))
-                    .collect(),
-                ..Default::default()
-            }
-        })
-        .collect();
-    Hair::from_strands(strands, 0.008).0
 }
 
 /// What one furnace run measured.
@@ -186,7 +163,7 @@ fn white_furnace_lossless_hair() {
         &bob.camera,
         &bob.settings,
     );
-    let hair = clump(CLUMP_STRANDS, 1);
+    let hair = common::clump(CLUMP_STRANDS, 1);
     let (lo, hi) = hair.bounds();
     let camera = Camera::framing(lo, hi, 0.0, 0.0, 0.75, 0.95);
     let settings = RenderSettings {

@@ -38,9 +38,8 @@
 //! azimuth follows the offset h, uniform in (-1, 1), through phi = phi(p, h). Whatever form the model's
 //! own longitudinal function takes, this is only a density: the weight is the true kernel over it.
 
-use super::camera::pixel_ray;
 use super::reference::{DirectionalLight, REFERENCE_VARIANT, ReferenceLighting, ReferenceScene};
-use super::shade::{LobeRadiance, ShadingHair, ShadingPoint, distinct_samples};
+use super::shade::{LobeRadiance, ShadingHair, ShadingPoint, fold_visible_points};
 use crate::envmap::EnvMap;
 use crate::envmap::direction::{direction_from_uv, rotate_yaw, uv_from_direction};
 use crate::scattering::frame::{FiberAngles, FiberFrame, wrap_angle};
@@ -52,7 +51,6 @@ use crate::scattering::params::{HairParams, Lobe, ModelVariant};
 use crate::shadow::fiber_grid::{Crossing, FiberGrid};
 use glam::{DVec3, Vec3};
 use rand_core::{Rng, SeedableRng};
-use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 
 /// Default bounce limit. Measured on the white furnace of tests/path_trace.rs with lossless hair
@@ -719,26 +717,18 @@ fn trace_pixels(
         settings,
     };
     let orders = settings.max_depth as usize + 1;
-    pixels
-        .par_iter()
-        .map(|&i| {
-            let samples = frame.samples.min(4) as usize;
-            let ids = &frame.sample_ids[i][..samples];
-            let (x, y) = (
-                (i % frame.width as usize) as f32,
-                (i / frame.width as usize) as f32,
-            );
-            let (origin, dir) = pixel_ray(&cam, x + 0.5, y + 0.5);
-            let mut acc = PointEstimate::zero(orders);
-            for (id, count) in distinct_samples(ids) {
-                let sp = hair.shading_point(id - 1, origin, dir);
-                let mut rng = Sampler::new(settings.seed, i as u64, id as u64);
-                let e = tracer.trace_point(&sp, -dir, &mut rng);
-                acc.add_scaled(&e, count as f64 / frame.samples as f64);
-            }
-            acc
-        })
-        .collect()
+    fold_visible_points(
+        frame,
+        &cam,
+        &hair,
+        pixels,
+        || PointEstimate::zero(orders),
+        |acc, pixel, sp, omega_o, weight| {
+            let mut rng = Sampler::new(settings.seed, pixel as u64, sp.segment as u64 + 1);
+            let e = tracer.trace_point(sp, omega_o, &mut rng);
+            acc.add_scaled(&e, weight);
+        },
+    )
 }
 
 /// The path-traced shading of the points the GPU frame sees (same coverage, depth and ids); its

@@ -172,16 +172,17 @@ pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
     out
 }
 
-/// The pixel loop of the shading pass on the CPU (rayon over the given pixels): for each pixel, the
-/// coverage-weighted sum of `shade` over the distinct segments of its samples. Returns per pixel of
-/// `pixels` the radiance per lobe (before exposure).
-pub fn shade_pixels(
+/// The pixel loop of the CPU shading passes (rayon over the given pixels): for each pixel, `fold` is
+/// called on a fresh `init()` for every distinct segment among its visibility samples, with the pixel
+/// index, the shading point, omega_o and the segment's coverage weight (its share of the samples).
+pub fn fold_visible_points<T: Send>(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
-    shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
-) -> Vec<LobeRadiance> {
+    init: impl Fn() -> T + Sync,
+    fold: impl Fn(&mut T, usize, &ShadingPoint, Vec3, f64) + Sync,
+) -> Vec<T> {
     pixels
         .par_iter()
         .map(|&i| {
@@ -192,18 +193,39 @@ pub fn shade_pixels(
                 (i / frame.width as usize) as f32,
             );
             let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
-            let mut acc = [[0.0; 3]; 5];
+            let mut acc = init();
             for (id, count) in distinct_samples(ids) {
                 let sp = hair.shading_point(id - 1, origin, dir);
-                let l = shade(&sp, -dir);
-                let w = count as f32 / frame.samples as f32;
-                for t in 0..5 {
-                    for c in 0..3 {
-                        acc[t][c] += w * l[t][c];
-                    }
-                }
+                fold(&mut acc, i, &sp, -dir, count as f64 / frame.samples as f64);
             }
             acc
         })
         .collect()
+}
+
+/// The pixel loop of the shading pass on the CPU: for each pixel of `pixels`, the coverage-weighted
+/// sum of `shade` over the distinct segments of its samples, the radiance per lobe (before exposure).
+pub fn shade_pixels(
+    frame: &Frame,
+    camera: &CameraUniform,
+    hair: &ShadingHair,
+    pixels: &[usize],
+    shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
+) -> Vec<LobeRadiance> {
+    fold_visible_points(
+        frame,
+        camera,
+        hair,
+        pixels,
+        || [[0.0; 3]; 5],
+        |acc: &mut LobeRadiance, _, sp, omega_o, weight| {
+            let l = shade(sp, omega_o);
+            let w = weight as f32;
+            for t in 0..5 {
+                for c in 0..3 {
+                    acc[t][c] += w * l[t][c];
+                }
+            }
+        },
+    )
 }

@@ -292,3 +292,45 @@ pub fn mean_components(
             / alpha.max(1e-30)
     })
 }
+
+/// A seeded uniform f32 generator for test scenes.
+pub struct Uniform(rand_pcg::Pcg64Mcg);
+
+impl Uniform {
+    pub fn new(seed: u64) -> Self {
+        Self(<rand_pcg::Pcg64Mcg as rand_core::SeedableRng>::seed_from_u64(seed))
+    }
+
+    pub fn random_range(&mut self, r: std::ops::Range<f32>) -> f32 {
+        let u = (rand_core::Rng::next_u64(&mut self.0) >> 40) as f32 / (1u64 << 24) as f32;
+        r.start + (r.end - r.start) * u
+    }
+}
+
+/// A disciplined clump: `n` straight fibers along +y (root at the top), 8 cm long, roots uniform over
+/// x in [-2, 2], z in [-1, 1], each tilted by up to 3 degrees, 12 segments, diameter 80 um.
+pub fn clump(n: usize, seed: u64) -> strandlight::hair::Hair {
+    let mut rng = Uniform::new(seed);
+    let strands = (0..n)
+        .map(|_| {
+            let root = glam::Vec3::new(
+                rng.random_range(-2.0..2.0),
+                4.0,
+                rng.random_range(-1.0..1.0),
+            );
+            let tilt = glam::Vec3::new(
+                rng.random_range(-0.05..0.05),
+                -1.0,
+                rng.random_range(-0.05..0.05),
+            )
+            .normalize();
+            strandlight::hair::RawStrand {
+                points: (0..13)
+                    .map(|j| root + tilt * (8.0 * j as f32 / 12.0))
+                    .collect(),
+                ..Default::default()
+            }
+        })
+        .collect();
+    strandlight::hair::Hair::from_strands(strands, 0.008).0
+}
