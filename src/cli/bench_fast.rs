@@ -1,5 +1,6 @@
 //! `strandlight bench-fast`: CPU cost of the Xu 2011 preprocessing (LUT build, dual-scattering tables)
-//! and of the fast single-scattering response for one shading point under a 40-light SRBF set, as JSON.
+//! and of the fast single-scattering response, alone and with dual scattering, for one shading point under
+//! a 40-light SRBF set, as JSON.
 
 use clap::Args;
 use glam::DVec3;
@@ -7,12 +8,17 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 use strandlight::envmap::SrbfSet;
+use strandlight::scattering::dual_response::{
+    dual_scattering_components, global_response_lobe, local_response,
+};
 use strandlight::scattering::dual_terms::DualTables;
 use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::tables::build_all;
-use strandlight::scattering::{CausticModel, FiberFrame, HairParams, ModelVariant};
+use strandlight::scattering::{
+    CausticModel, FiberFrame, HairParams, LongitudinalModel, ModelVariant,
+};
 
 #[derive(Args, Debug)]
 pub struct BenchFastArgs {
@@ -25,6 +31,9 @@ pub struct BenchFastArgs {
     /// Shading points (random fiber tangents and views) per repeat of the response timing.
     #[arg(long, default_value_t = 200)]
     pub points: usize,
+    /// Longitudinal function of the fast form.
+    #[arg(long, value_enum, default_value_t = LongitudinalModel::Normalized)]
+    pub longitudinal: LongitudinalModel,
 }
 
 #[derive(Serialize)]
@@ -39,6 +48,12 @@ struct Report {
     /// One thread: all lights' R, TT and TRT responses (RGB) at one shading point.
     response_microseconds_per_point_median: f64,
     response_microseconds_per_light: f64,
+    /// One thread: per light, single scattering plus dual scattering as the shading pass evaluates it
+    /// (M^G of the three lobes, M^L with the path's spread and without, Zinke's combination).
+    single_multiple_microseconds_per_point_median: f64,
+    single_multiple_microseconds_per_light: f64,
+    /// The longitudinal function measured ("normalized": d'Eon et al. 2011).
+    longitudinal: LongitudinalModel,
     /// Sum over lights and points of the response's total (a checksum that the work was done).
     checksum: f64,
 }
@@ -77,7 +92,8 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
     });
     let set = SrbfSet::read(&path)?;
     let luts = Luts::default_tables();
-    let fp = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS);
+    let fp = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS)
+        .with_longitudinal(args.longitudinal);
     // Deterministic shading points: tangents and views spread over the sphere (golden spiral).
     let dir = |k: usize, n: usize, twist: f64| {
         let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
@@ -118,6 +134,39 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
         })
         .collect();
     let per_point_median = median(&mut per_point);
+    let tables = DualTables::build(&params, variant.with_longitudinal(args.longitudinal));
+    let mut per_point_ms: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            for (lights, theta_o, phi_o) in &points {
+                for l in lights {
+                    let (to, po) = (*theta_o, *phi_o);
+                    let r = srbf_response(&luts, &fp, *l, to, po);
+                    // A shadow-grid value: half the light forward-scattered, spread 0.05 rad^2.
+                    let (direct, t_f, s2) = (0.5, [0.7f32; 3], 0.05);
+                    let mut global = [0.0f32; 3];
+                    for lobe in 0..3 {
+                        let g = global_response_lobe(&fp, lobe, *l, to, po, s2);
+                        for c in 0..3 {
+                            global[c] += g[c];
+                        }
+                    }
+                    let local = local_response(&fp, &tables, *l, to, po, s2);
+                    let local_direct = local_response(&fp, &tables, *l, to, po, 0.0);
+                    let ms =
+                        dual_scattering_components(&fp, direct, t_f, local_direct, global, local);
+                    checksum += r.iter().flatten().map(|v| *v as f64).sum::<f64>()
+                        + ms.0
+                            .iter()
+                            .chain(ms.1.iter())
+                            .map(|v| *v as f64)
+                            .sum::<f64>();
+                }
+            }
+            t.elapsed().as_secs_f64() * 1e6 / points.len() as f64
+        })
+        .collect();
+    let per_point_ms_median = median(&mut per_point_ms);
     let report = Report {
         machine_threads: rayon::current_num_threads(),
         lut_build_seconds_median: lut_median,
@@ -128,7 +177,11 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
         quadrature_segments: fp.quadrature_segments,
         response_microseconds_per_point_median: per_point_median,
         response_microseconds_per_light: per_point_median / set.lights.len().max(1) as f64,
-        checksum: checksum / repeats as f64,
+        single_multiple_microseconds_per_point_median: per_point_ms_median,
+        single_multiple_microseconds_per_light: per_point_ms_median
+            / set.lights.len().max(1) as f64,
+        longitudinal: args.longitudinal,
+        checksum: checksum / (2 * repeats) as f64,
     };
     println!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
