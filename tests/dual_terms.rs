@@ -9,7 +9,7 @@ use strandlight::scattering::marschner::{
     AzimuthalLobe, azimuthal_n_p, deon_variance, ln_longitudinal_deon, longitudinal_m_p,
     tilted_outgoing,
 };
-use strandlight::scattering::numeric::integrate_piecewise_relative;
+use strandlight::scattering::numeric::{integrate_piecewise_relative, lobe_breaks};
 use strandlight::scattering::reference::{azimuthal_energy, scatter_fraction};
 use strandlight::scattering::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
 
@@ -30,16 +30,11 @@ fn brute_force_split(
 ) -> f64 {
     let mut total = 0.0;
     for lobe in Lobe::ALL {
-        let centre = 2.0 * params.alpha(lobe) - theta;
-        let width = 2.0 * params.beta(lobe);
-        let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
-        for k in [-6.0, -3.0, -1.0, 0.0, 1.0, 3.0, 6.0] {
-            let x = centre + k * width;
-            if x > -FRAC_PI_2 && x < FRAC_PI_2 {
-                breaks.push(x);
-            }
-        }
-        breaks.sort_by(f64::total_cmp);
+        let breaks = lobe_breaks(
+            2.0 * params.alpha(lobe) - theta,
+            2.0 * params.beta(lobe),
+            &[-6.0, -3.0, -1.0, 0.0, 1.0, 3.0, 6.0],
+        );
         // a_f, a_b are energy fractions of light arriving from theta, split over the outgoing sphere: a unit
         // density over theta_o times N_t (which integrates to the scattered fraction over phi), front/back
         // weighted. Published: M_t(theta_h) / 2 (dual_terms.rs). Normalised: d'Eon's M with the roles of the
@@ -52,8 +47,8 @@ fn brute_force_split(
                     0.5 * longitudinal_m_p(params, lobe, 0.5 * (theta + theta_o))
                 }
                 LongitudinalModel::Normalized => {
-                    let (s, c) = tilted_outgoing(theta, params.alpha(lobe));
-                    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_o, s, c).exp()
+                    let t = tilted_outgoing(theta, params.alpha(lobe));
+                    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_o, t).exp()
                         * theta_o.cos()
                 }
             };
@@ -308,8 +303,8 @@ fn global_and_local_terms_against_direct_quadrature() {
                 let back = if published {
                     2.0 * gauss(ti - (delta_b - theta_o), sb) * ti.cos().powi(2) / td.cos().powi(2)
                 } else {
-                    let (so, co) = tilted_outgoing(theta_o, 0.5 * delta_b);
-                    ln_longitudinal_deon(sb * sb, ti, so, co).exp() * ti.cos()
+                    let t = tilted_outgoing(theta_o, 0.5 * delta_b);
+                    ln_longitudinal_deon(sb * sb, ti, t).exp() * ti.cos()
                 };
                 azim / theta_j.cos() * gauss(ti - theta_j, sigma) * back * s.big_a_b[ch] as f64
             };

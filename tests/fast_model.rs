@@ -344,7 +344,7 @@ fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
     use strandlight::scattering::marschner::{
         deon_variance, ln_longitudinal_deon, tilted_outgoing,
     };
-    use strandlight::scattering::numeric::integrate_piecewise_relative;
+    use strandlight::scattering::numeric::{integrate_piecewise_relative, lobe_breaks};
     let (mut worst_norm, mut worst_twin) = (0.0f64, 0.0f64);
     for beta_deg in [0.5f64, 5.0, 20.0] {
         for alpha_deg in [-10.0f64, 0.0, 10.0] {
@@ -355,18 +355,10 @@ fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
                     theta_o_deg.to_radians(),
                 );
                 let v = deon_variance(beta);
-                let (s, c) = tilted_outgoing(theta_o, alpha);
-                let m = |ti: f64| ln_longitudinal_deon(v, ti, s, c).exp();
-                let peak = -s.atan2(c);
-                let w = v.sqrt();
-                let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
-                breaks.extend(
-                    [-8.0, -3.0, -1.0, 0.0, 1.0, 3.0, 8.0]
-                        .iter()
-                        .map(|k| peak + k * w)
-                        .filter(|x| x.abs() < FRAC_PI_2),
-                );
-                breaks.sort_by(f64::total_cmp);
+                let t = tilted_outgoing(theta_o, alpha);
+                let m = |ti: f64| ln_longitudinal_deon(v, ti, t).exp();
+                let peak = -t;
+                let breaks = lobe_breaks(peak, v.sqrt(), &[-8.0, -3.0, -1.0, 0.0, 1.0, 3.0, 8.0]);
                 let total = integrate_piecewise_relative(&|ti| m(ti) * ti.cos(), &breaks, 1e-10);
                 worst_norm = worst_norm.max((total - 1.0).abs());
                 assert!(

@@ -2,12 +2,11 @@
 //! Each test prints what it measured; run with `--nocapture` to see the tables.
 
 use rayon::prelude::*;
-use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::{PI, TAU};
 use strandlight::scattering::marschner::{
     AzimuthalLobe, caustic_offset, lobe_centre, longitudinal_m_p_normalized, phi_p,
 };
-use strandlight::scattering::numeric::integrate_piecewise_relative;
+use strandlight::scattering::numeric::{integrate_piecewise_relative, lobe_breaks};
 use strandlight::scattering::reference::{
     azimuthal_energy, directional_albedo, directional_albedo_narrow_limit, scatter_fraction,
 };
@@ -172,16 +171,11 @@ fn higher_orders_energy(p: &HairParams, variant: ModelVariant, theta_o: f64) -> 
                 .sum::<f64>();
         longitudinal_m_p_normalized(p, Lobe::TRT, theta_i, theta_o) * theta_i.cos() * rest
     };
-    let c = lobe_centre(p, variant, Lobe::TRT, theta_o);
-    let w = 2.0 * p.beta(Lobe::TRT);
-    let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
-    breaks.extend(
-        [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0]
-            .iter()
-            .map(|k| c + k * w)
-            .filter(|x| x.abs() < FRAC_PI_2),
+    let breaks = lobe_breaks(
+        lobe_centre(p, variant, Lobe::TRT, theta_o),
+        2.0 * p.beta(Lobe::TRT),
+        &[-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0],
     );
-    breaks.sort_by(f64::total_cmp);
     integrate_piecewise_relative(&f, &breaks, 1e-6)
 }
 

@@ -89,22 +89,19 @@ impl Default for PathTraceSettings {
 }
 
 /// The sampling density's longitudinal part for one lobe: variance v and the tilted outgoing
-/// inclination (sin theta'_o, |cos theta'_o|).
+/// inclination theta'_o ([`tilted_outgoing`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Longitudinal {
     pub v: f64,
-    pub sin_o: f64,
-    pub cos_o: f64,
+    pub theta_o: f64,
 }
 
 impl Longitudinal {
     /// v_p = (2 beta_p)^2, theta'_o = theta_o - 2 alpha_p (reflected back past the pole).
     pub fn new(params: &HairParams, lobe: Lobe, theta_o: f64) -> Self {
-        let (sin_o, cos_o) = tilted_outgoing(theta_o, params.alpha(lobe));
         Self {
             v: deon_variance(params.beta(lobe)),
-            sin_o,
-            cos_o,
+            theta_o: tilted_outgoing(theta_o, params.alpha(lobe)),
         }
     }
 
@@ -112,7 +109,7 @@ impl Longitudinal {
     /// I0(cos theta_i cos theta'_o / v), with integral M cos(theta_i) d theta_i = 1 over [-pi/2, pi/2];
     /// the exact model's own log-space form ([`ln_longitudinal_deon`]), so sampler and kernel agree.
     pub fn density(&self, theta_i: f64) -> f64 {
-        ln_longitudinal_deon(self.v, theta_i, self.sin_o, self.cos_o).exp()
+        ln_longitudinal_deon(self.v, theta_i, self.theta_o).exp()
     }
 
     /// theta_i with density M(theta_i) cos(theta_i) (pbrt-v4's `SampleMp`): the cosine to the cone's
@@ -123,7 +120,8 @@ impl Longitudinal {
             (-self.v * (u1 + (1.0 - u1) * (-2.0 / self.v).exp()).ln()).clamp(0.0, 2.0);
         let cos_t = 1.0 - one_minus_cos;
         let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
-        let sin_i = -cos_t * self.sin_o + sin_t * (TAU * u2).cos() * self.cos_o;
+        let (sin_o, cos_o) = self.theta_o.sin_cos();
+        let sin_i = -cos_t * sin_o + sin_t * (TAU * u2).cos() * cos_o;
         sin_i.clamp(-1.0, 1.0).asin()
     }
 }

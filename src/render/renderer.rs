@@ -23,9 +23,7 @@ use crate::gpu::forward::{forward_table_texels, upload_forward_table};
 use crate::hair::Hair;
 use crate::render::reference::REFERENCE_VARIANT;
 use crate::scattering::dual_terms::DualTables;
-use crate::scattering::fast_params::{
-    DEFAULT_QUADRATURE_SEGMENTS, FastHairParams, LONGITUDINAL_PUBLISHED,
-};
+use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use crate::scattering::lut::Luts;
 use crate::scattering::params::{HairParams, LongitudinalModel};
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
@@ -88,11 +86,7 @@ impl HairLook {
 
     /// The exact model's form of this look's longitudinal function, for the references.
     pub fn longitudinal(&self) -> LongitudinalModel {
-        if self.fast.longitudinal == LONGITUDINAL_PUBLISHED {
-            LongitudinalModel::Published
-        } else {
-            LongitudinalModel::Normalized
-        }
+        self.fast.longitudinal_model()
     }
 }
 

@@ -29,7 +29,7 @@
 
 use super::frame::wrap_angle;
 use super::marschner::{AzimuthalLobe, longitudinal_m_p, phi_p};
-use super::numeric::integrate_fixed;
+use super::numeric::{integrate_fixed, lobe_breaks};
 use super::params::{HairParams, Lobe, LongitudinalModel, ModelVariant};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -50,16 +50,11 @@ pub fn longitudinal_fraction(
     if variant.longitudinal == LongitudinalModel::Normalized {
         return 1.0;
     }
-    let centre = 2.0 * params.alpha(lobe) - theta;
-    let width = 2.0 * params.beta(lobe);
-    let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
-    for k in [-6.0, -3.0, -1.5, 0.0, 1.5, 3.0, 6.0] {
-        let x = centre + k * width;
-        if x > -FRAC_PI_2 && x < FRAC_PI_2 {
-            breaks.push(x);
-        }
-    }
-    breaks.sort_by(f64::total_cmp);
+    let breaks = lobe_breaks(
+        2.0 * params.alpha(lobe) - theta,
+        2.0 * params.beta(lobe),
+        &[-6.0, -3.0, -1.5, 0.0, 1.5, 3.0, 6.0],
+    );
     let [v] = integrate_fixed(
         |theta_o| [0.5 * longitudinal_m_p(params, lobe, 0.5 * (theta + theta_o))],
         &breaks,

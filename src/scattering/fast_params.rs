@@ -82,6 +82,15 @@ impl FastHairParams {
         }
     }
 
+    /// The exact model's form of [`Self::longitudinal`].
+    pub fn longitudinal_model(&self) -> LongitudinalModel {
+        if self.longitudinal == LONGITUDINAL_PUBLISHED {
+            LongitudinalModel::Published
+        } else {
+            LongitudinalModel::Normalized
+        }
+    }
+
     pub fn sigma_a_rgb(&self) -> [f32; 3] {
         [self.sigma_a[0], self.sigma_a[1], self.sigma_a[2]]
     }

@@ -18,7 +18,7 @@ use super::params::{
     CausticModel, FresnelModel, HairParams, Lobe, LongitudinalModel, ModelVariant,
 };
 use serde::Serialize;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// RGB triple.
 pub type Rgb = [f64; 3];
@@ -73,31 +73,33 @@ pub fn deon_variance(beta: f64) -> f64 {
 pub fn lobe_centre(params: &HairParams, variant: ModelVariant, lobe: Lobe, theta_o: f64) -> f64 {
     match variant.longitudinal {
         LongitudinalModel::Published => 2.0 * params.alpha(lobe) - theta_o,
-        LongitudinalModel::Normalized => {
-            let (s, c) = tilted_outgoing(theta_o, params.alpha(lobe));
-            -s.atan2(c)
-        }
+        LongitudinalModel::Normalized => -tilted_outgoing(theta_o, params.alpha(lobe)),
     }
 }
 
 /// The outgoing inclination tilted by the scales, theta_o' = theta_o - 2 alpha (pbrt-v4 applies the tilt to
-/// theta_o alone), as (sin, cos) with cos >= 0: past the pole the angle is reflected back, as pbrt's
-/// absolute value of cos(theta_o') does, so M stays normalised over theta_i.
-pub fn tilted_outgoing(theta_o: f64, alpha: f64) -> (f64, f64) {
+/// theta_o alone), reflected back into [-pi/2, pi/2] past a pole as pbrt's absolute value of cos(theta_o')
+/// does, so M stays normalised over theta_i.
+pub fn tilted_outgoing(theta_o: f64, alpha: f64) -> f64 {
     let t = theta_o - 2.0 * alpha;
-    (t.sin(), t.cos().abs())
+    if t > FRAC_PI_2 {
+        PI - t
+    } else if t < -FRAC_PI_2 {
+        -PI - t
+    } else {
+        t
+    }
 }
 
-/// ln M_p(theta_i, theta_o') of d'Eon et al. 2011 (Eq. 6 of their paper; pbrt-v4's `Mp`), with variance v:
+/// ln M_p(theta_i, theta_o') of d'Eon et al. 2011 (Eq. 6 of their paper; pbrt-v4's `Mp`), with variance v and
+/// theta_o' from [`tilted_outgoing`]:
 /// M = csch(1/v) / (2v) exp(-sin theta_i sin theta_o' / v) I0(cos theta_i cos theta_o' / v),
 /// in log space so narrow lobes (v -> 0, 1/v in the hundreds) neither overflow nor lose precision:
 /// ln M = ln(I0(a) e^-a) + (cos(theta_i + theta_o') - 1)/v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v,
 /// with cos(x) - 1 = -2 sin^2(x/2).
-pub fn ln_longitudinal_deon(v: f64, theta_i: f64, sin_o: f64, cos_o: f64) -> f64 {
-    let a = theta_i.cos().max(0.0) * cos_o / v;
-    // cos(theta_i + theta_o') - 1 from the angle of the tilted outgoing direction.
-    let theta_o = sin_o.atan2(cos_o);
-    let half = (0.5 * (theta_i + theta_o)).sin();
+pub fn ln_longitudinal_deon(v: f64, theta_i: f64, theta_o_tilted: f64) -> f64 {
+    let a = theta_i.cos().max(0.0) * theta_o_tilted.cos() / v;
+    let half = (0.5 * (theta_i + theta_o_tilted)).sin();
     bessel_i0_scaled_f64(a).ln() - 2.0 * half * half / v - v.ln() - (-(-2.0 / v).exp()).ln_1p()
 }
 
@@ -109,8 +111,8 @@ pub fn longitudinal_m_p_normalized(
     theta_i: f64,
     theta_o: f64,
 ) -> f64 {
-    let (s, c) = tilted_outgoing(theta_o, params.alpha(lobe));
-    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_i, s, c).exp()
+    let t = tilted_outgoing(theta_o, params.alpha(lobe));
+    ln_longitudinal_deon(deon_variance(params.beta(lobe)), theta_i, t).exp()
 }
 
 /// Marschner's eccentric index eta*(phi_h) (Marschner Sec. 4.4; Xu Eq. 24).

@@ -84,6 +84,21 @@ pub fn integrate_piecewise<F: Fn(f64) -> f64>(
         .sum()
 }
 
+/// Break points for integrating a lobe over [-pi/2, pi/2]: the two ends and `centre + k width` for every k
+/// of `multiples` that falls strictly inside, sorted.
+pub fn lobe_breaks(centre: f64, width: f64, multiples: &[f64]) -> Vec<f64> {
+    let half = std::f64::consts::FRAC_PI_2;
+    let mut breaks = vec![-half, half];
+    breaks.extend(
+        multiples
+            .iter()
+            .map(|k| centre + k * width)
+            .filter(|x| x.abs() < half),
+    );
+    breaks.sort_by(f64::total_cmp);
+    breaks
+}
+
 /// Fixed composite Gauss-Legendre (20 points on each of `panels` equal panels per piece) of a
 /// vector-valued integrand, split at `breaks`. For smooth pieces where all components share the
 /// expensive part of the integrand (tables of moments).

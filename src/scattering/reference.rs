@@ -5,9 +5,9 @@ use super::marschner::{
     AzimuthalLobe, CausticFix, azimuthal_n_p, lobe_centre, longitudinal_m_p,
     longitudinal_m_p_normalized,
 };
-use super::numeric::integrate_piecewise_relative;
+use super::numeric::{integrate_piecewise_relative, lobe_breaks};
 use super::params::{CausticModel, HairParams, Lobe, LongitudinalModel, ModelVariant};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// Relative accuracy of the reference integrals.
 pub const REFERENCE_REL_TOL: f64 = 1e-9;
@@ -88,15 +88,11 @@ pub fn directional_albedo(
     p.eccentricity = 1.0;
     let beta = p.beta(lobe);
     // Split theta_i around the lobe centre (std 2 beta in theta_i).
-    let centre = lobe_centre(&p, variant, lobe, theta_o);
-    let mut breaks = vec![-FRAC_PI_2, FRAC_PI_2];
-    for k in [-8.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
-        let x = centre + 2.0 * k * beta;
-        if x > -FRAC_PI_2 && x < FRAC_PI_2 {
-            breaks.push(x);
-        }
-    }
-    breaks.sort_by(f64::total_cmp);
+    let breaks = lobe_breaks(
+        lobe_centre(&p, variant, lobe, theta_o),
+        2.0 * beta,
+        &[-8.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0],
+    );
     let integrand = |theta_i: f64| -> f64 {
         let theta_d = 0.5 * (theta_o - theta_i);
         // M_p times the factor that turns S cos(theta_i) d omega_i into d theta_i d phi.
