@@ -54,16 +54,15 @@ struct DualIntegrand {
     channel: u32,
     theta_o: f32,
     dphi: f32,
-    // The longitudinal function's tilt and width in longitudinal_factor's terms.
-    alpha: f32,
-    beta: f32,
+    // The lobe's longitudinal function (Zinke's back lobe for the local term).
+    longitudinal: LongitudinalLobe,
 }
 
-// The smooth factors of Eq. 27 (global: longitudinal_factor calN_t^G) and Eq. 29 (local:
+// The smooth factors of Eq. 27 (global: longitudinal factor x calN_t^G) and Eq. 29 (local:
 // A_b longitudinal_factor, one channel in all three components).
 fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
     let theta_d = 0.5 * (d.theta_o - ti);
-    let w = longitudinal_factor(p.longitudinal, ti, d.theta_o, d.alpha, d.beta);
+    let w = longitudinal_factor(d.longitudinal, ti);
     if (d.kind == DUAL_GLOBAL) {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_window_integral(d.lobe, p.eta, p.sigma_a.xyz, theta_d, d.dphi, 0.0, FRAC_PI_2) / PI;
@@ -115,12 +114,13 @@ fn dual_quadrature(p: FastHairParams, d: DualIntegrand, mu: f32, l: f32) -> vec3
 // M_t^G per unit light power (Xu Eq. 27).
 fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32) -> vec3<f32> {
     let sigma = forward_spread(sigma_f2, light.lambda);
-    let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal_centre(p.longitudinal, theta_o, p.alpha[lobe]), 2.0 * SQRT_2 * p.beta[lobe]);
+    let longitudinal = longitudinal_lobe(p.longitudinal, theta_o, p.alpha[lobe], p.beta[lobe]);
+    let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal.mu, 2.0 * SQRT_2 * p.beta[lobe]);
     let c = g.x / (2.0 * PI * sigma * 2.0 * p.beta[lobe] * max(cos(light.theta), 1e-3));
     if (c < 1e-30) {
         return vec3<f32>(0.0);
     }
-    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, p.alpha[lobe], p.beta[lobe]);
+    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, longitudinal);
     return max(c * dual_quadrature(p, d, g.y, g.z), vec3<f32>(0.0));
 }
 
@@ -132,13 +132,14 @@ fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f3
     var out = vec3<f32>(0.0);
     for (var c = 0u; c < 3u; c++) {
         let sb = max(ds.sigma[c], 1e-3);
-        let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal_centre(p.longitudinal, theta_o, 0.5 * ds.delta[c]), SQRT_2 * sb);
+        // Zinke's back lobe as M with tilt Delta_b / 2 and width sigma_b / 2 (dual_response.rs).
+        let back = longitudinal_lobe(p.longitudinal, theta_o, 0.5 * ds.delta[c], 0.5 * sb);
+        let g = gaussian_product(light.theta, SQRT_2 * sigma, back.mu, SQRT_2 * sb);
         let k = azimuthal * g.x / (2.0 * PI * sigma * sb * max(cos(light.theta), 1e-3));
         if (k < 1e-30) {
             continue;
         }
-        // Zinke's back lobe as M with tilt Delta_b / 2 and width sigma_b / 2 (dual_response.rs).
-        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, 0.5 * ds.delta[c], 0.5 * sb);
+        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, back);
         out[c] = max(k * dual_quadrature(p, d, g.y, g.z).x, 0.0);
     }
     return out;

@@ -76,42 +76,58 @@ fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
     return t;
 }
 
-// The centre of the quadrature's Gaussian: published 2 alpha - theta_o, normalised -theta_o'.
-fn longitudinal_centre(longitudinal: u32, theta_o: f32, alpha: f32) -> f32 {
+// One lobe's longitudinal function for one view (twin of LongitudinalLobe in fast_response.rs): what does
+// not depend on theta_i, computed once per lobe and light instead of at every quadrature sample.
+struct LongitudinalLobe {
+    longitudinal: u32,
+    theta_o: f32,
+    tilted: f32,
+    v: f32,
+    // Centre of the quadrature's Gaussian: published 2 alpha - theta_o, normalised -theta_o'.
+    mu: f32,
+    // -ln v - ln(1 - e^(-2/v)), and ln sqrt(2 pi v).
+    ln_m_norm: f32,
+    ln_gaussian_norm: f32,
+}
+
+fn longitudinal_lobe_with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> LongitudinalLobe {
+    let tilted = tilted_outgoing(theta_o, alpha);
+    var mu = -tilted;
     if (longitudinal == LONGITUDINAL_PUBLISHED) {
-        return 2.0 * alpha - theta_o;
+        mu = 2.0 * alpha - theta_o;
     }
-    return -tilted_outgoing(theta_o, alpha);
+    return LongitudinalLobe(longitudinal, theta_o, tilted, v, mu, -log(v) - log(1.0 - exp(-2.0 / v)), 0.5 * log(2.0 * PI * v));
 }
 
-// ln M_p(theta_i, theta_o) of d'Eon et al. 2011, variance v, tilt 2 alpha on the outgoing inclination
-// (reflected back at the poles).
-fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f32 {
-    let t = tilted_outgoing(theta_o, alpha);
-    let a = max(cos(theta_i), 0.0) * cos(t) / v;
-    let half = sin(0.5 * (theta_i + t));
-    return log(bessel_i0_scaled(a)) - 2.0 * half * half / v - log(v) - log(1.0 - exp(-2.0 / v));
+fn longitudinal_lobe(longitudinal: u32, theta_o: f32, alpha: f32, beta: f32) -> LongitudinalLobe {
+    return longitudinal_lobe_with_variance(longitudinal, theta_o, alpha, max(4.0 * beta * beta, 1e-8));
 }
 
-// The longitudinal factor relative to the unit-area Gaussian of std 2 beta around longitudinal_centre:
-// published 2 cos^2(theta_i) / cos^2(theta_d); normalised cos(theta_i) M^dEon / Gaussian.
-fn longitudinal_factor(longitudinal: u32, theta_i: f32, theta_o: f32, alpha: f32, beta: f32) -> f32 {
+// ln M(theta_i) of d'Eon et al. 2011.
+fn longitudinal_ln_m(l: LongitudinalLobe, theta_i: f32) -> f32 {
+    let a = max(cos(theta_i), 0.0) * cos(l.tilted) / l.v;
+    let half = sin(0.5 * (theta_i + l.tilted));
+    return log(bessel_i0_scaled(a)) - 2.0 * half * half / l.v + l.ln_m_norm;
+}
+
+// The longitudinal factor relative to the Gaussian: published 2 cos^2(theta_i) / cos^2(theta_d); normalised
+// cos(theta_i) M^dEon / Gaussian.
+fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
     let ci = max(cos(theta_i), 0.0);
-    if (longitudinal == LONGITUDINAL_PUBLISHED) {
-        let cd = cos(0.5 * (theta_o - theta_i));
+    if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
+        let cd = cos(0.5 * (l.theta_o - theta_i));
         return 2.0 * ci * ci / max(cd * cd, 1e-8);
     }
-    let v = max(4.0 * beta * beta, 1e-8);
-    let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
-    let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha) + d * d / (2.0 * v) + 0.5 * log(2.0 * PI * v);
+    let d = theta_i - l.mu;
+    let ln_ratio = longitudinal_ln_m(l, theta_i) + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
     return ci * exp(clamp(ln_ratio, -80.0, 20.0));
 }
 
 // longitudinal_factor x calN_t at theta_i.
-fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, theta_i: f32) -> vec3<f32> {
+fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, longitudinal: LongitudinalLobe, theta_i: f32) -> vec3<f32> {
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let w = longitudinal_factor(params.longitudinal, theta_i, theta_o, params.alpha[lobe], params.beta[lobe]);
+    let w = longitudinal_factor(longitudinal, theta_i);
     let dphi = phi_o - light.phi;
     let sigma = params.sigma_a.xyz;
     if (lobe == 0u) {
@@ -171,10 +187,10 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
     return w;
 }
 
-fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
     let d = (ti - w.peak) / w.lambda;
     let ratio = exp(clamp(longitudinal_ln_w(w, ti) - w.ln_w_peak + d * d, -80.0, 20.0));
-    return ratio * outer_integrand(params, lobe, light, theta_o, phi_o, ti);
+    return ratio * outer_integrand(params, lobe, light, theta_o, phi_o, longitudinal, ti);
 }
 
 fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f32, lambda: f32) -> vec3<f32> {
@@ -194,9 +210,9 @@ fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f
 fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
     let alpha = params.alpha[lobe];
     let beta = params.beta[lobe];
-    let mu_m = longitudinal_centre(params.longitudinal, theta_o, alpha);
+    let longitudinal = longitudinal_lobe(params.longitudinal, theta_o, alpha, beta);
     let lambda_m = 2.0 * SQRT_2 * beta;
-    let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
+    let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * 2.0 * beta);
     if (scale < 1e-30) {
         return vec3<f32>(0.0);
@@ -206,17 +222,17 @@ fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
     let l = w.lambda;
     var out = vec3<f32>(0.0);
     var x0 = quadrature_sample(0u, m, mu, l);
-    var f0 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x0);
+    var f0 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x0);
     var s = 1u;
     loop {
         if (s > m) {
             break;
         }
         let x1 = quadrature_sample(s, m, mu, l);
-        let f1 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x1);
+        let f1 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x1);
         if (s < m) {
             let x2 = quadrature_sample(s + 1u, m, mu, l);
-            let f2 = weighted_integrand(params, lobe, light, theta_o, phi_o, w, x2);
+            let f2 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x2);
             if (x2 > x0 && x1 > x0 && x2 > x1) {
                 for (var c = 0u; c < 3u; c++) {
                     let q1 = (f1[c] - f0[c]) / (x1 - x0);

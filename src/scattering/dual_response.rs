@@ -13,9 +13,7 @@ use super::dual_terms::DualTables;
 use super::fast_azimuthal::Rgb32;
 use super::fast_exact_azimuthal::azimuthal_window_integral;
 use super::fast_params::FastHairParams;
-use super::fast_response::{
-    SrbfInFrame, gaussian_product, linear_quadrature, longitudinal_centre, longitudinal_factor,
-};
+use super::fast_response::{LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature};
 use super::lut::wrap_angle_f32;
 use std::f32::consts::{FRAC_PI_2, PI, SQRT_2};
 
@@ -33,7 +31,7 @@ pub fn inner_integral_global(p: &FastHairParams, lobe: u32, theta_d: f32, dphi: 
 
 /// M_t^G per unit light power (Xu Eq. 27): (1/cos theta_j) integral g^u(theta_i; theta_j, sigma) M_t(theta_h)
 /// cos^2(theta_i) / cos^2(theta_d) calN_t^G d theta_i as published, or with d'Eon's M_t(theta_i, theta_o) cos(theta_i)
-/// normalised ([`longitudinal_factor`]), by the quadrature of Sec. 4.2.2 against the product of the two
+/// normalised ([`LongitudinalLobe::factor`]), by the quadrature of Sec. 4.2.2 against the product of the two
 /// Gaussians.
 pub fn global_response_lobe(
     p: &FastHairParams,
@@ -45,14 +43,15 @@ pub fn global_response_lobe(
 ) -> Rgb32 {
     let sigma = forward_spread(sigma_f2, light.lambda);
     let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
+    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, alpha, beta);
     // g^u with std sigma is Xu's g with bandwidth sqrt(2) sigma, over sqrt(2 pi) sigma.
     let (scale, mu, l) = gaussian_product(
         light.theta,
         SQRT_2 * sigma,
-        longitudinal_centre(p.longitudinal, theta_o, alpha),
+        longitudinal.mu,
         2.0 * SQRT_2 * beta,
     );
-    // The two unit-area Gaussians (std sigma and 2 beta); longitudinal_factor holds the rest of M_t.
+    // The two unit-area Gaussians (std sigma and 2 beta); the longitudinal factor holds the rest of M_t.
     let c = scale / (2.0 * PI * sigma * 2.0 * beta * light.theta.cos().max(1e-3));
     if c < 1e-30 {
         return [0.0; 3];
@@ -60,7 +59,7 @@ pub fn global_response_lobe(
     let dphi = phi_o - light.phi;
     linear_quadrature(p.quadrature_segments, mu, l, |ti| {
         let theta_d = 0.5 * (theta_o - ti);
-        let w = longitudinal_factor(p.longitudinal, ti, theta_o, alpha, beta);
+        let w = longitudinal.factor(ti);
         inner_integral_global(p, lobe, theta_d, dphi).map(|n| w * n)
     })
     .map(|v| (c * v).max(0.0))
@@ -88,11 +87,11 @@ pub fn local_response(
     let mut out = [0.0; 3];
     for c in 0..3 {
         let sb = sig_b[c].max(1e-3);
-        let centre = longitudinal_centre(p.longitudinal, theta_o, 0.5 * delta[c]);
-        let (scale, mu, l) = gaussian_product(light.theta, SQRT_2 * sigma, centre, SQRT_2 * sb);
-        // Zinke's back lobe g(theta_i + theta_o - Delta_b; sigma_b) is M with tilt Delta_b / 2 and width sigma_b / 2
-        // in longitudinal_factor's terms: published, its explicit factor 2 (Eq. 10) and cos^2/cos^2(theta_d);
-        // normalised, d'Eon's M of variance sigma_b^2.
+        // Zinke's back lobe g(theta_i + theta_o - Delta_b; sigma_b) is M with tilt Delta_b / 2 and width sigma_b / 2:
+        // published, its explicit factor 2 (Eq. 10) and cos^2/cos^2(theta_d); normalised, d'Eon's M of variance
+        // sigma_b^2.
+        let back = LongitudinalLobe::new(p.longitudinal, theta_o, 0.5 * delta[c], 0.5 * sb);
+        let (scale, mu, l) = gaussian_product(light.theta, SQRT_2 * sigma, back.mu, SQRT_2 * sb);
         let k = azimuthal * scale / (2.0 * PI * sigma * sb * light.theta.cos().max(1e-3));
         if k < 1e-30 {
             continue;
@@ -100,8 +99,7 @@ pub fn local_response(
         let v = linear_quadrature(p.quadrature_segments, mu, l, |ti| {
             let theta_d = 0.5 * (theta_o - ti);
             let a = tables.lookup(theta_d).big_a_b[c];
-            let w = longitudinal_factor(p.longitudinal, ti, theta_o, 0.5 * delta[c], 0.5 * sb);
-            [a * w; 3]
+            [a * back.factor(ti); 3]
         });
         out[c] = (k * v[0]).max(0.0);
     }

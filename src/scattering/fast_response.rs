@@ -7,7 +7,7 @@
 //!
 //! The longitudinal function is d'Eon et al. 2011's normalised M_p(theta_i, theta_o) by default (then
 //! S cos(theta_i) = M_p calN_p and the weight is cos(theta_i), not cos^2(theta_i)/cos^2(theta_d)); the quadrature
-//! still integrates against the Gaussian of M_p's peak and width, and [`longitudinal_factor`] carries the
+//! still integrates against the Gaussian of M_p's peak and width, and [`LongitudinalLobe::factor`] carries the
 //! ratio of the true M_p to that Gaussian into the interpolated factor.
 //!
 //! Angles are in the fiber frame ([`super::frame`]); f32 as in the WGSL twin.
@@ -171,56 +171,84 @@ pub fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
     }
 }
 
-/// The centre in theta_i of the Gaussian the quadrature integrates against: published, 2 alpha - theta_o
-/// (M_t(theta_h)'s peak, possibly past a pole); normalised, -theta_o' (d'Eon's peak, always inside).
-pub fn longitudinal_centre(longitudinal: u32, theta_o: f32, alpha: f32) -> f32 {
-    if longitudinal == LONGITUDINAL_PUBLISHED {
-        2.0 * alpha - theta_o
-    } else {
-        -tilted_outgoing(theta_o, alpha)
+/// One lobe's longitudinal function for one view, with everything that does not depend on theta_i computed
+/// once: it is evaluated at every quadrature sample of every light. Holds the centre of the Gaussian the
+/// quadrature integrates against, g(theta_i; mu, 2 sqrt(2) beta) / (sqrt(2 pi) 2 beta) (unit area, standard deviation
+/// 2 beta in theta_i), and, normalised, d'Eon's variance, the tilted inclination and the log normalisations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LongitudinalLobe {
+    pub longitudinal: u32,
+    pub theta_o: f32,
+    /// theta_o' ([`tilted_outgoing`]).
+    pub tilted: f32,
+    /// d'Eon's variance v = (2 beta)^2.
+    pub v: f32,
+    /// The Gaussian's centre: published, 2 alpha - theta_o (M_t(theta_h)'s peak, possibly past a pole);
+    /// normalised, -theta_o' (d'Eon's peak, always inside).
+    pub mu: f32,
+    /// ln(csch(1/v) / (2v)) + 1/v = -ln v - ln(1 - e^(-2/v)): what ln M adds to its shape.
+    pub ln_m_norm: f32,
+    /// ln(sqrt(2 pi v)): the log of the Gaussian's normalisation.
+    pub ln_gaussian_norm: f32,
+}
+
+impl LongitudinalLobe {
+    /// Lobe with shift alpha and width beta (d'Eon's v = (2 beta)^2) seen from theta_o.
+    pub fn new(longitudinal: u32, theta_o: f32, alpha: f32, beta: f32) -> Self {
+        Self::with_variance(longitudinal, theta_o, alpha, (4.0 * beta * beta).max(1e-8))
+    }
+
+    pub fn with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> Self {
+        let tilted = tilted_outgoing(theta_o, alpha);
+        Self {
+            longitudinal,
+            theta_o,
+            tilted,
+            v,
+            mu: if longitudinal == LONGITUDINAL_PUBLISHED {
+                2.0 * alpha - theta_o
+            } else {
+                -tilted
+            },
+            ln_m_norm: -v.ln() - (1.0 - (-2.0 / v).exp()).ln(),
+            ln_gaussian_norm: 0.5 * (2.0 * PI * v).ln(),
+        }
+    }
+
+    /// ln M(theta_i) of d'Eon et al. 2011:
+    /// ln M = ln(I0(a) e^-a) - 2 sin^2((theta_i + theta_o')/2) / v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v.
+    pub fn ln_m(&self, theta_i: f32) -> f32 {
+        let a = theta_i.cos().max(0.0) * self.tilted.cos() / self.v;
+        let half = (0.5 * (theta_i + self.tilted)).sin();
+        bessel_i0_scaled(a).ln() - 2.0 * half * half / self.v + self.ln_m_norm
+    }
+
+    /// The longitudinal factor of an outer integrand at theta_i, relative to the Gaussian:
+    /// - published: M(theta_h) = 2 x the Gaussian (it has unit area in theta_h, Xu Eq. 7), and S cos(theta_i)
+    ///   d omega_i brings cos^2(theta_i) / cos^2(theta_d): the factor is 2 cos^2(theta_i) / cos^2(theta_d);
+    /// - normalised: cos(theta_i) M^dEon(theta_i, theta_o) / Gaussian, smooth (about sqrt(cos theta_i / cos theta_o')
+    ///   near the peak), its log clamped as the light's ratio is.
+    pub fn factor(&self, theta_i: f32) -> f32 {
+        let ci = theta_i.cos().max(0.0);
+        if self.longitudinal == LONGITUDINAL_PUBLISHED {
+            let cd = (0.5 * (self.theta_o - theta_i)).cos();
+            return 2.0 * ci * ci / (cd * cd).max(1e-8);
+        }
+        let d = theta_i - self.mu;
+        let ln_ratio = self.ln_m(theta_i) + d * d / (2.0 * self.v) + self.ln_gaussian_norm;
+        ci * ln_ratio.clamp(-80.0, 20.0).exp()
     }
 }
 
-/// ln M_p(theta_i, theta_o) of d'Eon et al. 2011 with variance v and the tilt 2 alpha on the outgoing
-/// inclination, theta_o' = theta_o - 2 alpha reflected back at the poles (f32 twin of
-/// [`crate::scattering::marschner::ln_longitudinal_deon`]):
-/// ln M = ln(I0(a) e^-a) - 2 sin^2((theta_i + theta_o')/2) / v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v.
+/// ln M_p(theta_i, theta_o) of d'Eon et al. 2011 with variance v and the tilt 2 alpha on the outgoing inclination
+/// (f32 twin of [`crate::scattering::marschner::ln_longitudinal_deon`]).
 pub fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f32 {
-    let t = tilted_outgoing(theta_o, alpha);
-    let a = theta_i.cos().max(0.0) * t.cos() / v;
-    let half = (0.5 * (theta_i + t)).sin();
-    bessel_i0_scaled(a).ln() - 2.0 * half * half / v - v.ln() - (1.0 - (-2.0 / v).exp()).ln()
+    LongitudinalLobe::with_variance(0, theta_o, alpha, v).ln_m(theta_i)
 }
 
-/// The longitudinal factor of an outer integrand at theta_i, relative to the Gaussian the quadrature
-/// integrates against, g(theta_i; mu, 2 sqrt(2) beta) / (sqrt(2 pi) 2 beta) (unit area, standard deviation 2 beta
-/// in theta_i, centred at mu = [`longitudinal_centre`]):
-/// - published: M(theta_h) = 2 x that Gaussian (it has unit area in theta_h, Xu Eq. 7), and S cos(theta_i)
-///   d omega_i brings cos^2(theta_i) / cos^2(theta_d): the factor is 2 cos^2(theta_i) / cos^2(theta_d);
-/// - normalised: cos(theta_i) M^dEon(theta_i, theta_o; v = (2 beta)^2) / Gaussian, smooth (about
-///   sqrt(cos theta_i / cos theta_o') near the peak), its log clamped as the light's ratio is.
-pub fn longitudinal_factor(
-    longitudinal: u32,
-    theta_i: f32,
-    theta_o: f32,
-    alpha: f32,
-    beta: f32,
-) -> f32 {
-    let ci = theta_i.cos().max(0.0);
-    if longitudinal == LONGITUDINAL_PUBLISHED {
-        let cd = (0.5 * (theta_o - theta_i)).cos();
-        return 2.0 * ci * ci / (cd * cd).max(1e-8);
-    }
-    let v = (4.0 * beta * beta).max(1e-8);
-    let d = theta_i - longitudinal_centre(longitudinal, theta_o, alpha);
-    let ln_ratio = ln_longitudinal_deon(v, theta_i, theta_o, alpha)
-        + d * d / (2.0 * v)
-        + 0.5 * (2.0 * PI * v).ln();
-    ci * ln_ratio.clamp(-80.0, 20.0).exp()
-}
-
-/// The smooth factor of the outer integral at theta_i: the longitudinal factor ([`longitudinal_factor`])
+/// The smooth factor of the outer integral at theta_i: the longitudinal factor ([`LongitudinalLobe::factor`])
 /// times calN_t.
+#[allow(clippy::too_many_arguments)]
 pub fn outer_integrand(
     luts: &Luts,
     p: &FastHairParams,
@@ -228,12 +256,12 @@ pub fn outer_integrand(
     light: SrbfInFrame,
     theta_o: f32,
     phi_o: f32,
+    longitudinal: &LongitudinalLobe,
     theta_i: f32,
 ) -> Rgb32 {
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let l = lobe as usize;
-    let w = longitudinal_factor(p.longitudinal, theta_i, theta_o, p.alpha[l], p.beta[l]);
+    let w = longitudinal.factor(theta_i);
     let dphi = phi_o - light.phi;
     if lobe == 0 {
         let n = inner_integral_r(luts, p.eta, theta_d, lp, dphi);
@@ -255,8 +283,8 @@ pub fn outer_integrand(
 
 /// The longitudinal weight w(theta_i) = M_t(theta_h) g^c(theta_i; theta_j, lambda_j) of one lobe, in Laplace
 /// form: its peak theta*, the bandwidth lambda* of the Gaussian with the same curvature there, and ln w(theta*).
-/// M_t is taken as the Gaussian g(theta_i; mu_M, 2 sqrt(2) beta_t) around [`longitudinal_centre`] (published:
-/// exactly M_t(theta_h) = g / (sqrt(2 pi) beta_t), Xu Eq. 7); [`longitudinal_factor`] carries the rest.
+/// M_t is taken as the Gaussian g(theta_i; mu_M, 2 sqrt(2) beta_t) around [`LongitudinalLobe::mu`] (published:
+/// exactly M_t(theta_h) = g / (sqrt(2 pi) beta_t), Xu Eq. 7); [`LongitudinalLobe::factor`] carries the rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LongitudinalWeight {
     pub kappa_j: f32,
@@ -344,12 +372,10 @@ pub fn srbf_response_lobe(
     phi_o: f32,
 ) -> Rgb32 {
     let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
-    let (mu_m, lambda_m) = (
-        longitudinal_centre(p.longitudinal, theta_o, alpha),
-        2.0 * std::f32::consts::SQRT_2 * beta,
-    );
-    let w = longitudinal_weight(light.theta, light.lambda, mu_m, lambda_m);
-    // The unit-area Gaussian of standard deviation 2 beta in theta_i; longitudinal_factor holds the rest.
+    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, alpha, beta);
+    let lambda_m = 2.0 * std::f32::consts::SQRT_2 * beta;
+    let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
+    // The unit-area Gaussian of standard deviation 2 beta in theta_i; the longitudinal factor holds the rest.
     let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * 2.0 * beta);
     if scale < 1e-30 {
         return [0.0; 3];
@@ -357,7 +383,7 @@ pub fn srbf_response_lobe(
     linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
         let d = (ti - w.peak) / w.lambda;
         let ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0).exp();
-        outer_integrand(luts, p, lobe, light, theta_o, phi_o, ti).map(|v| ratio * v)
+        outer_integrand(luts, p, lobe, light, theta_o, phi_o, &longitudinal, ti).map(|v| ratio * v)
     })
     // The parabolas may dip below zero where f vanishes; the response cannot.
     .map(|v| (scale * v).max(0.0))
