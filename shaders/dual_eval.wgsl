@@ -1,5 +1,5 @@
 // Batch evaluation of the dual-scattering responses (shaders/dual_response.wgsl) for the tests: per
-// query M_R^G, M_TT^G, M_TRT^G and M^L, RGB. The query's first padding float carries sigma_f^2.
+// query M_R^G, M_TT^G, M_TRT^G and M^L, RGB. The query's first padding float carries sigma_f^2, the second the optical depth behind the point.
 
 struct DualQuery {
     params: FastHairParams,
@@ -9,7 +9,7 @@ struct DualQuery {
     theta_o: f32,
     phi_o: f32,
     sigma_f2: f32,
-    _pad1: f32,
+    depth_behind: f32,
     _pad2: f32,
 }
 
@@ -33,5 +33,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     dual_results[4u * i] = vec4<f32>(global_response_lobe(q.params, 0u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
     dual_results[4u * i + 1u] = vec4<f32>(global_response_lobe(q.params, 1u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
     dual_results[4u * i + 2u] = vec4<f32>(global_response_lobe(q.params, 2u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
-    dual_results[4u * i + 3u] = vec4<f32>(local_response(q.params, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
+    dual_results[4u * i + 3u] = vec4<f32>(local_response(q.params, light, q.theta_o, q.phi_o, q.sigma_f2, q.depth_behind), 0.0);
 }

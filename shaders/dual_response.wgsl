@@ -1,7 +1,7 @@
 // Multiple scattering per SRBF light by dual scattering (Xu 2011 Sec. 4.3, Zinke 2008): twin of
 // src/scattering/dual_response.rs and of DualTables::lookup / mean_delta_sigma in dual_terms.rs.
 // Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response. The includer
-// binds `dual_tables`: DUAL_SAMPLES x 3 vec4 (A_b, Delta_b, sigma_b per sample, RGB) followed by
+// binds `dual_tables`: DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample, RGB) followed by
 // (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b).
 
 const DUAL_SAMPLES: u32 = 128u;
@@ -12,18 +12,18 @@ fn dual_position(theta: f32) -> f32 {
     return clamp((theta + FRAC_PI_2) / PI, 0.0, 1.0) * f32(DUAL_SAMPLES - 1u);
 }
 
-// DualTables::lookup, term k (0 = A_b, 1 = Delta_b, 2 = sigma_b).
+// DualTables::lookup, term k (0 = A_b, 1 = Delta_b, 2 = sigma_b, 3 = a_f).
 fn dual_lookup(k: u32, theta: f32) -> vec3<f32> {
     let x = dual_position(theta);
     let i = min(u32(x), DUAL_SAMPLES - 2u);
     let w = x - f32(i);
-    return mix(dual_tables[3u * i + k].xyz, dual_tables[3u * (i + 1u) + k].xyz, w);
+    return mix(dual_tables[4u * i + k].xyz, dual_tables[4u * (i + 1u) + k].xyz, w);
 }
 
 fn dual_sat(k: u32, x: f32) -> vec3<f32> {
     let i = min(u32(x), DUAL_SAMPLES - 1u);
     let w = x - f32(i);
-    let base = 3u * DUAL_SAMPLES;
+    let base = 4u * DUAL_SAMPLES;
     return mix(dual_tables[base + 2u * i + k].xyz, dual_tables[base + 2u * (i + 1u) + k].xyz, w);
 }
 
@@ -56,6 +56,18 @@ struct DualIntegrand {
     dphi: f32,
     // The lobe's longitudinal function (Zinke's back lobe for the local term).
     longitudinal: LongitudinalLobe,
+    // Optical depth of the hair behind the point (local term).
+    depth_behind: f32,
+}
+
+// Optical depth that stands for Zinke's unbounded hair behind the point.
+const DEPTH_UNBOUNDED: f32 = 1e30;
+
+// backscatter_depth_fraction (dual_terms.rs): the part of A_b that hair of optical depth `depth` behind
+// the point returns, 1 - exp(-depth (1 - a_f^2)).
+fn backscatter_depth_fraction(a_f: f32, depth: f32) -> f32 {
+    let k = max(1.0 - a_f * a_f, 1e-6);
+    return 1.0 - exp(-min(max(depth, 0.0) * k, 80.0));
 }
 
 // The smooth factors of Eq. 27 (global: longitudinal factor x calN_t^G) and Eq. 29 (local:
@@ -67,7 +79,8 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_window_integral(d.lobe, p.eta, p.sigma_a.xyz, theta_d, d.dphi, 0.0, FRAC_PI_2) / PI;
     }
-    return vec3<f32>(w * dual_lookup(0u, theta_d)[d.channel]);
+    let a = dual_lookup(0u, theta_d)[d.channel] * backscatter_depth_fraction(dual_lookup(3u, theta_d)[d.channel], d.depth_behind);
+    return vec3<f32>(w * a);
 }
 
 // linear_quadrature of fast_response.rs over dual_integrand (parabolas on paired segments).
@@ -120,12 +133,13 @@ fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
     if (c < 1e-30) {
         return vec3<f32>(0.0);
     }
-    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, longitudinal);
+    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, longitudinal, 0.0);
     return max(c * dual_quadrature(p, d, g.y, g.z), vec3<f32>(0.0));
 }
 
 // M^L per unit light power (Xu Eq. 29-31).
-fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32) -> vec3<f32> {
+// depth_behind: optical depth of the hair behind the point along the light's travel (DEPTH_UNBOUNDED: Zinke's).
+fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32, depth_behind: f32) -> vec3<f32> {
     let sigma = forward_spread(sigma_f2, light.lambda);
     let azimuthal = (PI - abs(wrap_angle(light.phi - phi_o))) / (PI * PI);
     let ds = mean_delta_sigma(0.5 * (theta_o - (light.theta + sigma)), 0.5 * (theta_o - (light.theta - sigma)));
@@ -139,7 +153,7 @@ fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f3
         if (k < 1e-30) {
             continue;
         }
-        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, back);
+        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, back, depth_behind);
         out[c] = max(k * dual_quadrature(p, d, g.y, g.z).x, 0.0);
     }
     return out;

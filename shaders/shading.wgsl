@@ -4,7 +4,8 @@
 // of the shadow grid, read trilinearly), and accumulated per lobe
 // weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
-// (global M^G and local M^L, from the light's T_f and sigma_f^2 on the grid) to MS.global and MS.local.
+// (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
+// the grid) to MS.global and MS.local.
 // Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response,
 // dual_response, shadow_grid, camera.
 
@@ -17,11 +18,15 @@ struct ShadeBatch {
     flags: u32,
     samples: u32,
     slot: u32,
-    _p0: u32,
-    _p1: u32,
+    // Rows [row0, row0 + rows) of the image (all of them for a whole frame, a band per unit of
+    // progressive refinement).
+    row0: u32,
+    rows: u32,
     _p2: u32,
 }
 
+// Read as storage, not uniforms: lavapipe recompiles a shader whose loops and branches depend on small
+// uniforms, with their values inlined, at every new bind group (tens of ms for this shader, per batch).
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<uniform> params: FastHairParams;
 @group(0) @binding(2) var<uniform> batch: ShadeBatch;
@@ -76,7 +81,7 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
     for (var j = first; j < first + count; j++) {
         let l = lights[j];
         let ang = fiber_angles(frame, l.direction);
-        var sh = GridShadow(1.0, vec3<f32>(1.0), vec3<f32>(0.0));
+        var sh = GridShadow(1.0, vec3<f32>(1.0), vec3<f32>(0.0), DEPTH_UNBOUNDED);
         if (shadows) {
             sh = grid_shadow(shadow_grid, sp.position, j);
         }
@@ -89,8 +94,8 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
             // One spread for the three channels: their mean sigma_f^2.
             let s2 = (sh.sigma_f2.x + sh.sigma_f2.y + sh.sigma_f2.z) / 3.0;
             let global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
-            let local = local_response(p, light, o.x, o.y, s2);
-            let local_direct = local_response(p, light, o.x, o.y, 0.0);
+            let local = local_response(p, light, o.x, o.y, s2, sh.depth_behind);
+            let local_direct = local_response(p, light, o.x, o.y, 0.0, sh.depth_behind);
             let ms = dual_scattering_components(p, sh.transmittance, sh.transmittance_f, local_direct, global, local);
             let power = srbf_integral(l.lambda) * l.rgb;
             out.ms_global = out.ms_global + power * ms.ms_global;
@@ -102,21 +107,23 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
 
 @compute @workgroup_size(8, 8)
 fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= camera.size.x || id.y >= camera.size.y) {
+    let y = batch.row0 + id.y;
+    if (id.x >= camera.size.x || id.y >= batch.rows || y >= camera.size.y) {
         return;
     }
-    let pixel = id.y * camera.size.x + id.x;
+    let xy = vec2<u32>(id.x, y);
+    let pixel = y * camera.size.x + id.x;
     // This dispatch handles visibility sample `batch.slot` of every pixel: its segment is shaded if no
     // earlier sample of the pixel holds the same segment, weighted by the fraction of samples it
     // covers. (One shading call per invocation: looping over a pixel's segments inside one invocation
     // gave wrong sums on lavapipe.)
-    let v = u32(textureLoad(visibility, vec2<i32>(id.xy), i32(batch.slot)).x);
+    let v = u32(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
     if (v == 0u) {
         return;
     }
     var count = 0u;
     for (var s = 0u; s < batch.samples; s++) {
-        let other = u32(textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x);
+        let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
         if (other == v) {
             if (s < batch.slot) {
                 return;
@@ -124,7 +131,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
             count = count + 1u;
         }
     }
-    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
+    let ray = pixel_ray(camera, f32(xy.x) + 0.5, f32(xy.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
     let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
     let w = f32(count) / f32(batch.samples);

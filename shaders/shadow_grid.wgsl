@@ -1,7 +1,7 @@
 // Per-light shadows on a coarse grid (twin of src/shadow/grid.rs): `build_shadow_grid` evaluates, at
 // every grid point for every light, the cone-marched transmittance and the forward-scattering terms;
 // `grid_shadow` reads them trilinearly. Two vec4 per (point, light), light-major:
-// (ln transmittance, ln T_f RGB), (sigma_f^2 RGB, direct fraction of the forward march).
+// (ln transmittance, ln T_f RGB), (sigma_f^2 RGB, optical depth behind the point along the light's travel).
 
 // One SRBF light (twin of GpuLight in src/render/shading.rs); read by the grid build and shading.
 struct GpuLight {
@@ -29,6 +29,7 @@ struct GridShadow {
     transmittance: f32,
     transmittance_f: vec3<f32>,
     sigma_f2: vec3<f32>,
+    depth_behind: f32,
 }
 
 fn grid_point(g: ShadowGridInfo, i: u32) -> vec3<f32> {
@@ -53,5 +54,5 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
         v0 = v0 + w * shadow_values[2u * (light * n + i)];
         v1 = v1 + w * shadow_values[2u * (light * n + i) + 1u];
     }
-    return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz);
+    return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz, v1.w);
 }

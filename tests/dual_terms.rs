@@ -2,8 +2,8 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use strandlight::scattering::dual_terms::{
-    DualTables, backscatter_attenuation, backscatter_shift, backscatter_width, dual_sample,
-    dual_theta,
+    DualTables, backscatter_attenuation, backscatter_depth_fraction, backscatter_shift,
+    backscatter_width, dual_sample, dual_theta,
 };
 use strandlight::scattering::marschner::{
     AzimuthalLobe, azimuthal_n_p, deon_variance, ln_longitudinal_deon, longitudinal_m_p,
@@ -162,6 +162,60 @@ fn backscatter_closed_forms_equal_their_sums() {
     assert!(worst_a < 1e-4, "{worst_a}");
 }
 
+/// The finite-depth fraction of A_b against the sums it stands for: Zinke's Eq. 11 and 13 with the
+/// layers behind the point stopped at n (i, k <= n), averaged over a Poisson number of layers of mean
+/// tau. A_1's fraction is exact; A_3 falls faster (it needs three back-scatterings behind the point),
+/// so the one fraction applied to the whole A_b overstates it a little on thin hair: printed, bounded.
+#[test]
+fn backscatter_depth_fraction_equals_the_truncated_sums() {
+    let (mut worst_1, mut worst_total): (f64, f64) = (0.0, 0.0);
+    for &(af, ab) in &[(0.6f64, 0.1f64), (0.85, 0.08), (0.95, 0.03)] {
+        let a1 = |n: i32| -> f64 { (1..=n).map(|i| ab * af.powi(2 * i)).sum() };
+        let a3 = |n: i32| -> f64 {
+            let mut sum = 0.0;
+            for i in 1..=n {
+                for j in 0..i {
+                    for k in (j + 1)..=n {
+                        sum += ab.powi(3) * af.powi(2 * (i - j - 1 + k));
+                    }
+                }
+            }
+            sum
+        };
+        let full = backscatter_attenuation(af as f32, ab as f32) as f64;
+        for tau in [0.0f64, 0.3, 1.0, 3.0, 10.0] {
+            // Poisson(tau) weights of n layers.
+            let (mut e1, mut etotal, mut pmf) = (0.0, 0.0, (-tau).exp());
+            let a1_inf = ab * af * af / (1.0 - af * af);
+            for n in 0..200 {
+                if n > 0 {
+                    pmf *= tau / n as f64;
+                }
+                if pmf < 1e-300 && n as f64 > tau {
+                    break;
+                }
+                let m = n.min(140);
+                e1 += pmf * a1(m) / a1_inf;
+                etotal += pmf * (a1(m) + if m <= 60 { a3(m) } else { a3(60) }) / full;
+            }
+            let f = backscatter_depth_fraction(af as f32, tau as f32) as f64;
+            worst_1 = worst_1.max((f - e1).abs());
+            worst_total = worst_total.max(f - etotal);
+            println!(
+                "a_f {af} a_b {ab} tau {tau}: fraction {f:.5}, A_1 sums {e1:.5}, A_1 + A_3 sums {etotal:.5}"
+            );
+        }
+    }
+    assert_eq!(
+        backscatter_depth_fraction(0.9, f32::INFINITY),
+        1.0,
+        "unbounded hair is Zinke's A_b"
+    );
+    println!("worst: A_1 {worst_1:.2e}, overstatement of A_1 + A_3 {worst_total:.3}");
+    assert!(worst_1 < 1e-4, "A_1 fraction off by {worst_1}");
+    assert!(worst_total < 0.1, "A_b overstated by {worst_total}");
+}
+
 #[test]
 fn tables_interpolate_and_their_sats_average() {
     let p = HairParams::with_sigma_a([0.3, 0.6, 1.2]);
@@ -214,15 +268,16 @@ fn global_and_local_terms_against_direct_quadrature() {
     let tables = DualTables::build(&p, XU_ROOTS);
     let gauss = |x: f64, s: f64| (-x * x / (2.0 * s * s)).exp() / ((2.0 * PI).sqrt() * s);
     let (mut worst_g, mut worst_l): (f64, f64) = (0.0, 0.0);
-    for (longitudinal, &(theta_j, dphi, lambda, sigma_f2, theta_o)) in
+    // The last column: the optical depth of hair behind the point (infinite: Zinke's unbounded hair).
+    for (longitudinal, &(theta_j, dphi, lambda, sigma_f2, theta_o, depth)) in
         [LongitudinalModel::Normalized, LongitudinalModel::Published]
             .iter()
             .flat_map(|l| {
                 [
-                    (0.3f64, 2.8f64, 0.2f64, 0.01f64, -0.2f64),
-                    (-0.4, 3.1, 0.6, 0.05, 0.5),
-                    (0.1, 1.2, 0.1, 0.002, -0.1),
-                    (0.6, 2.2, 0.3, 0.03, -0.7),
+                    (0.3f64, 2.8f64, 0.2f64, 0.01f64, -0.2f64, f32::INFINITY),
+                    (-0.4, 3.1, 0.6, 0.05, 0.5, 0.5),
+                    (0.1, 1.2, 0.1, 0.002, -0.1, 2.0),
+                    (0.6, 2.2, 0.3, 0.03, -0.7, f32::INFINITY),
                 ]
                 .iter()
                 .map(move |c| (*l, c))
@@ -290,8 +345,15 @@ fn global_and_local_terms_against_direct_quadrature() {
             let eg = fast / direct - 1.0;
             worst_g = worst_g.max(eg.abs());
             // Local.
-            let fast_l = local_response(&fp, &tables, light, theta_o as f32, 0.4, sigma_f2 as f32)
-                [ch] as f64;
+            let fast_l = local_response(
+                &fp,
+                &tables,
+                light,
+                theta_o as f32,
+                0.4,
+                sigma_f2 as f32,
+                depth,
+            )[ch] as f64;
             let azim = (PI - dphi.abs()) / (PI * PI);
             let fl = |ti: f64| {
                 let td = 0.5 * (theta_o - ti);
@@ -306,13 +368,15 @@ fn global_and_local_terms_against_direct_quadrature() {
                     let t = tilted_outgoing(theta_o, 0.5 * delta_b);
                     ln_longitudinal_deon(sb * sb, ti, t).exp() * ti.cos()
                 };
-                azim / theta_j.cos() * gauss(ti - theta_j, sigma) * back * s.big_a_b[ch] as f64
+                let a_b =
+                    s.big_a_b[ch] as f64 * backscatter_depth_fraction(s.a_f[ch], depth) as f64;
+                azim / theta_j.cos() * gauss(ti - theta_j, sigma) * back * a_b
             };
             let direct_l = integrate_piecewise_relative(&fl, &[lo, theta_j, hi], 1e-6);
             let el = fast_l / direct_l - 1.0;
             worst_l = worst_l.max(el.abs());
             println!(
-                "{longitudinal:?} theta_j {theta_j:+.1} dphi {dphi:.1} lambda {lambda} sigma_f^2 {sigma_f2} ch {ch}: M^G {fast:.4e} vs {direct:.4e} ({eg:+.2e}); M^L {fast_l:.4e} vs {direct_l:.4e} ({el:+.2e})"
+                "{longitudinal:?} theta_j {theta_j:+.1} dphi {dphi:.1} lambda {lambda} sigma_f^2 {sigma_f2} depth {depth} ch {ch}: M^G {fast:.4e} vs {direct:.4e} ({eg:+.2e}); M^L {fast_l:.4e} vs {direct_l:.4e} ({el:+.2e})"
             );
         }
     }

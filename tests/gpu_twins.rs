@@ -429,6 +429,8 @@ fn wgsl_dual_scattering_responses_equal_the_rust_twins() {
                 fast
             };
             q._pad[0] = 0.02 * ((i * 7 + k) % 11) as f32; // sigma_f^2 in 0..0.2 rad^2
+            // Optical depth behind the point: none, thin, a few fibers, Zinke's unbounded hair.
+            q._pad[1] = [0.0, 0.3, 1.0, 3.0, 1e30][(i * 3 + k) % 5];
         }
         let gpu = evaluate_dual(&ctx, &buffer, &qs).expect("GPU evaluation");
         for (i, q) in qs.iter().enumerate() {
@@ -442,7 +444,9 @@ fn wgsl_dual_scattering_responses_equal_the_rust_twins() {
                 *v =
                     global_response_lobe(&q.params, t as u32, light, q.theta_o, q.phi_o, q._pad[0]);
             }
-            cpu[3] = local_response(&q.params, &tables, light, q.theta_o, q.phi_o, q._pad[0]);
+            cpu[3] = local_response(
+                &q.params, &tables, light, q.theta_o, q.phi_o, q._pad[0], q._pad[1],
+            );
             let scale = cpu.iter().flatten().fold(0f32, |a, b| a.max(*b));
             for t in 0..4 {
                 for c in 0..3 {

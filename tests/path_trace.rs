@@ -202,20 +202,19 @@ fn white_furnace_lossless_hair() {
     assert!(c.single[1] < 0.5, "the clump shadows itself");
 }
 
-/// Renderer (SRBF, GPU) against the path tracer on a 300-strand bob (64x48), blond and brown, under
-/// the project's sunny and studio environments: relative error of the mean colour per channel and the
-/// MS share of both, for single scattering with shadows (the R + TT + TRT components of both frames:
-/// the renderer's are its shadowed single scattering, the path tracer's its order 0 with shadow rays)
-/// and full transport (the beauty).
+/// Renderer (SRBF, GPU) against the path tracer on a sparse (300-strand) and a denser (1500-strand) bob
+/// (64x48), blond and brown, under the project's sunny and studio environments: relative error of the
+/// mean colour per channel and the MS share of both, for single scattering with shadows (the R + TT +
+/// TRT components of both frames: the renderer's are its shadowed single scattering, the path tracer's
+/// its order 0 with shadow rays) and full transport (the beauty).
 ///
-/// Asserted: single scattering within 5 % everywhere, brown full transport within 10 %. Blond full
-/// transport is NOT within the issue's 10 %: measured (2026-11-29) 17 % (sunny) and 20 % (studio) too
-/// bright in red, the renderer's MS share 11-14 % against the path tracer's 4-5 % on this sparse bob
-/// (dual scattering's back-scattering assumes hair behind every point). On a 1500-strand bob at the
-/// default volume and shadow-grid resolution the MS shares agree in sunny light (0.168 / 0.165) but
-/// single scattering is 7.6 % too bright (the volume's shadows are lighter than the explicit fibers'),
-/// and studio's MS share is 0.189 / 0.144: 11-12 % in red either way. The blond bound below only keeps
-/// that known gap from growing.
+/// Asserted: full transport within 10 % everywhere (the issue's bound). Single scattering within 5 %
+/// on the sparse bob and 10 % on the denser one, where the fiber-density volume's shadows are lighter
+/// than the explicit fibers' in sunny light (measured +9 % blond, +8 % brown; the light-space shadows
+/// of the real-time renderer issue are the place to close that). Measured (2026-11-29, d_f = d_b =
+/// 0.7): full transport within 2 % on the sparse bob and 5 % on the denser one; the renderer's MS share
+/// is about half the path tracer's on both (0.024 / 0.045 and 0.089 / 0.165 blond sunny), which the
+/// lighter shadows offset on the denser bob.
 #[test]
 fn renderer_is_close_to_the_path_tracer_on_bobs() {
     let t0 = Instant::now();
@@ -225,83 +224,101 @@ fn renderer_is_close_to_the_path_tracer_on_bobs() {
         samples_per_pixel: 32,
         ..Default::default()
     };
-    let (mut worst_single, mut worst_brown, mut worst_blond) = (0.0f64, 0.0f64, 0.0f64);
+    let mut worst_single = [0.0f64; 2];
+    let mut worst_full = [[0.0f64; 2]; 2];
     println!(
-        "{:<6} {:<7} {:<6} {:>26} {:>26} {:>24} {:>15}",
-        "hair", "env", "light", "renderer mean", "path tracer mean", "relative error", "MS share"
+        "{:<7} {:<6} {:<7} {:<6} {:>26} {:>26} {:>24} {:>15}",
+        "strands",
+        "hair",
+        "env",
+        "light",
+        "renderer mean",
+        "path tracer mean",
+        "relative error",
+        "MS share"
     );
-    for preset in [Preset::Blond, Preset::Brown] {
-        for name in ["sunny", "studio"] {
-            let lights = SrbfSet::read(&envmaps().join(format!("{name}.srbf.json"))).expect("fit");
-            let (env, _) = load_env(&envmaps().join(format!("{name}.exr"))).expect("env");
-            let t = Instant::now();
-            let scene = common::bob_scene(300, 64, 48, preset.params(), true);
-            let frame = scene.render(&ctx, &luts, &lights.lights);
-            let t_gpu = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let traced = path_trace_frame(&frame, &scene.reference(&env, lights.yaw), &settings);
-            let t_path = t.elapsed().as_secs_f64();
-            for (what, single) in [("single", true), ("full", false)] {
-                let mean = |f: &Frame| {
-                    if single {
-                        common::mean_components(f, 0..3)
+    for (b, strands) in [300, 1500].into_iter().enumerate() {
+        for (h, preset) in [Preset::Blond, Preset::Brown].into_iter().enumerate() {
+            for name in ["sunny", "studio"] {
+                let lights =
+                    SrbfSet::read(&envmaps().join(format!("{name}.srbf.json"))).expect("fit");
+                let (env, _) = load_env(&envmaps().join(format!("{name}.exr"))).expect("env");
+                let t = Instant::now();
+                let scene = common::bob_scene(strands, 64, 48, preset.params(), true);
+                let frame = scene.render(&ctx, &luts, &lights.lights);
+                let t_gpu = t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                let traced =
+                    path_trace_frame(&frame, &scene.reference(&env, lights.yaw), &settings);
+                let t_path = t.elapsed().as_secs_f64();
+                for (what, single) in [("single", true), ("full", false)] {
+                    let mean = |f: &Frame| {
+                        if single {
+                            common::mean_components(f, 0..3)
+                        } else {
+                            common::mean_radiance(f)
+                        }
+                    };
+                    let (m, r) = (mean(&frame), mean(&traced));
+                    let err: [f64; 3] = std::array::from_fn(|c| m[c] / r[c] - 1.0);
+                    let share = if single {
+                        String::new()
                     } else {
-                        common::mean_radiance(f)
-                    }
-                };
-                let (m, r) = (mean(&frame), mean(&traced));
-                let err: [f64; 3] = std::array::from_fn(|c| m[c] / r[c] - 1.0);
-                let share = if single {
-                    String::new()
-                } else {
-                    format!(
-                        "{:.3} / {:.3}",
-                        common::ms_share(&frame),
-                        common::ms_share(&traced)
-                    )
-                };
-                println!(
-                    "{:<6} {:<7} {:<6} {:>26} {:>26} {:>24} {:>15}",
-                    format!("{preset:?}"),
-                    name,
-                    what,
-                    format!("{m:.4?}"),
-                    format!("{r:.4?}"),
-                    format!("{err:+.3?}"),
-                    share
-                );
-                for e in err {
-                    let e = e.abs();
-                    match (single, preset) {
-                        (true, _) => worst_single = worst_single.max(e),
-                        (false, Preset::Brown) => worst_brown = worst_brown.max(e),
-                        (false, _) => worst_blond = worst_blond.max(e),
+                        format!(
+                            "{:.3} / {:.3}",
+                            common::ms_share(&frame),
+                            common::ms_share(&traced)
+                        )
+                    };
+                    println!(
+                        "{:<7} {:<6} {:<7} {:<6} {:>26} {:>26} {:>24} {:>15}",
+                        strands,
+                        format!("{preset:?}"),
+                        name,
+                        what,
+                        format!("{m:.4?}"),
+                        format!("{r:.4?}"),
+                        format!("{err:+.3?}"),
+                        share
+                    );
+                    for e in err {
+                        let e = e.abs();
+                        if single {
+                            worst_single[b] = worst_single[b].max(e);
+                        } else {
+                            worst_full[b][h] = worst_full[b][h].max(e);
+                        }
                     }
                 }
+                println!(
+                    "   ({} hair pixels; GPU render {t_gpu:.1} s, path tracer {t_path:.1} s)",
+                    frame.covered().count()
+                );
             }
-            println!(
-                "   ({} hair pixels; GPU render {t_gpu:.1} s, path tracer {t_path:.1} s)",
-                frame.covered().count()
-            );
         }
     }
     println!(
-        "worst mean-colour error: single scattering {:.1}% (limit 5%), full transport brown {:.1}% (limit 10%), blond {:.1}% (known gap, limit 25%); test time {:.1} s",
-        100.0 * worst_single,
-        100.0 * worst_brown,
-        100.0 * worst_blond,
+        "worst mean-colour error: single scattering {:.1}% (300 strands, limit 5%), {:.1}% (1500, limit 10%); \
+         full transport blond {:.1}% / {:.1}%, brown {:.1}% / {:.1}% (300 / 1500 strands, limit 10%); test time {:.1} s",
+        100.0 * worst_single[0],
+        100.0 * worst_single[1],
+        100.0 * worst_full[0][0],
+        100.0 * worst_full[1][0],
+        100.0 * worst_full[0][1],
+        100.0 * worst_full[1][1],
         t0.elapsed().as_secs_f64()
     );
     assert!(
-        worst_single <= 0.05,
-        "single scattering off by {worst_single}"
+        worst_single[0] <= 0.05 && worst_single[1] <= 0.10,
+        "single scattering off by {worst_single:?}"
     );
-    assert!(
-        worst_brown <= 0.10,
-        "brown full transport off by {worst_brown}"
-    );
-    assert!(
-        worst_blond <= 0.25,
-        "blond full transport off by {worst_blond}"
-    );
+    for (b, strands) in [300, 1500].into_iter().enumerate() {
+        for (h, hair) in ["blond", "brown"].into_iter().enumerate() {
+            assert!(
+                worst_full[b][h] <= 0.10,
+                "{hair} full transport on the {strands}-strand bob off by {}",
+                worst_full[b][h]
+            );
+        }
+    }
 }

@@ -38,6 +38,12 @@ pub struct BenchArgs {
     /// Use a software adapter (lavapipe).
     #[arg(long)]
     pub software: bool,
+    /// Skip the progressive-refinement run (one more frame, refined in bounded units).
+    #[arg(long)]
+    pub no_progressive: bool,
+    /// Progressive refinement's time budget per unit, milliseconds.
+    #[arg(long, default_value_t = 30.0)]
+    pub unit_budget_ms: f64,
     /// Write the JSON here as well as to stdout.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -59,6 +65,19 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
+    /// The same frame by progressive refinement (volume and grid rebuilt unless --keep-volume).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    progressive: Option<ProgressiveReport>,
+}
+
+#[derive(Serialize)]
+struct ProgressiveReport {
+    unit_budget_ms: f64,
+    units: u32,
+    /// The longest unit, submission to completion (wall clock).
+    longest_unit_ms: f64,
+    /// From the change to the converged image (wall clock, including the CPU between units).
+    converged_ms: f64,
 }
 
 #[derive(Serialize)]
@@ -152,6 +171,33 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 per_pass.entry(name).or_default().push(ms);
             }
         }
+        let progressive = if args.no_progressive {
+            None
+        } else {
+            renderer.set_unit_budget(std::time::Duration::from_secs_f64(
+                args.unit_budget_ms.max(0.1) * 1e-3,
+            ));
+            if args.keep_volume {
+                renderer.set_camera(&ctx, &camera);
+            } else {
+                renderer.mark_volume_dirty();
+            }
+            let t = Instant::now();
+            let stats = renderer.refine_to_convergence(&ctx)?;
+            let converged_ms = t.elapsed().as_secs_f64() * 1e3;
+            eprintln!(
+                "{} progressive: {} units, longest {:.1} ms, converged in {converged_ms:.0} ms",
+                scene.name,
+                stats.units,
+                stats.longest.as_secs_f64() * 1e3
+            );
+            Some(ProgressiveReport {
+                unit_budget_ms: args.unit_budget_ms,
+                units: stats.units,
+                longest_unit_ms: stats.longest.as_secs_f64() * 1e3,
+                converged_ms,
+            })
+        };
         reports.push(SceneReport {
             scene,
             segments: hair.point_count() - hair.strand_count(),
@@ -163,6 +209,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             gpu_ms_total_min: totals.iter().copied().fold(f64::INFINITY, f64::min),
             gpu_ms_total_median: median(totals),
             wall_ms_median: median(walls),
+            progressive,
         });
     }
     let json = serde_json::to_string_pretty(&Report {

@@ -142,8 +142,9 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
                 for l in lights {
                     let (to, po) = (*theta_o, *phi_o);
                     let r = srbf_response(&luts, &fp, *l, to, po);
-                    // A shadow-grid value: half the light forward-scattered, spread 0.05 rad^2.
-                    let (direct, t_f, s2) = (0.5, [0.7f32; 3], 0.05);
+                    // A shadow-grid value: half the light forward-scattered, spread 0.05 rad^2,
+                    // two fibers behind the point.
+                    let (direct, t_f, s2, behind) = (0.5, [0.7f32; 3], 0.05, 2.0);
                     let mut global = [0.0f32; 3];
                     for lobe in 0..3 {
                         let g = global_response_lobe(&fp, lobe, *l, to, po, s2);
@@ -151,8 +152,8 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
                             global[c] += g[c];
                         }
                     }
-                    let local = local_response(&fp, &tables, *l, to, po, s2);
-                    let local_direct = local_response(&fp, &tables, *l, to, po, 0.0);
+                    let local = local_response(&fp, &tables, *l, to, po, s2, behind);
+                    let local_direct = local_response(&fp, &tables, *l, to, po, 0.0, behind);
                     let ms =
                         dual_scattering_components(&fp, direct, t_f, local_direct, global, local);
                     checksum += r.iter().flatten().map(|v| *v as f64).sum::<f64>()

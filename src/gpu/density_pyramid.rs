@@ -104,7 +104,8 @@ impl GpuDensityPyramid {
             info_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("pyramid info"),
                 contents: bytemuck::bytes_of(&info),
-                usage: wgpu::BufferUsages::UNIFORM,
+                // Also storage: the shadow-grid build reads it so (shadow_grid_build.wgsl).
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE,
             }),
             pyramid: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("density pyramid"),

@@ -8,14 +8,14 @@ use super::shaders;
 use crate::scattering::dual_terms::DualTables;
 use wgpu::util::DeviceExt;
 
-/// A_b, Delta_b, sigma_b per sample (3 vec4), then the prefix sums of Delta_b and sigma_b (2 vec4 per
+/// A_b, Delta_b, sigma_b, a_f per sample (4 vec4), then the prefix sums of Delta_b and sigma_b (2 vec4 per
 /// entry), as `dual_response.wgsl` reads them.
 pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
     let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
     let mut out: Vec<[f32; 4]> = t
         .samples
         .iter()
-        .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b)])
+        .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b), v4(s.a_f)])
         .collect();
     for (d, s) in t.sat_delta.iter().zip(&t.sat_sigma) {
         out.push(v4(*d));
@@ -32,7 +32,8 @@ pub fn upload_dual_tables(device: &wgpu::Device, t: &DualTables) -> wgpu::Buffer
     })
 }
 
-/// M_R^G, M_TT^G, M_TRT^G, M^L (RGB) per query; the query's `_pad[0]` is sigma_f^2.
+/// M_R^G, M_TT^G, M_TRT^G, M^L (RGB) per query; the query's `_pad[0]` is sigma_f^2, `_pad[1]` the
+/// optical depth of hair behind the point (M^L's finite-depth fraction).
 pub fn evaluate_dual(
     ctx: &GpuContext,
     tables: &wgpu::Buffer,

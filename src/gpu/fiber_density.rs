@@ -93,7 +93,8 @@ impl GpuFiberDensity {
             info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume info"),
                 contents: bytemuck::bytes_of(&info),
-                usage: wgpu::BufferUsages::UNIFORM,
+                // Also storage: the shadow-grid build reads it so (shadow_grid_build.wgsl).
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE,
             }),
             sums: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("volume sums"),

@@ -4,6 +4,7 @@
 pub mod camera;
 pub mod frame;
 pub mod path_trace;
+pub mod progressive;
 pub mod reference;
 pub mod reference_lights;
 pub mod renderer;

@@ -29,7 +29,7 @@ use crate::scattering::params::{CausticModel, HairParams, ModelVariant};
 use crate::shadow::fiber_density::FiberDensity;
 use crate::shadow::fiber_grid::FiberGrid;
 use crate::shadow::forward::{ForwardScattering, ForwardTable};
-use crate::shadow::ray_shooting::shoot_forward;
+use crate::shadow::ray_shooting::{crossings_behind, shoot_forward};
 use glam::Vec3;
 
 pub use super::reference_lights::{DirectionalLight, importance_sample_env, sample_srbf_lights};
@@ -87,10 +87,13 @@ pub fn reference_shade(
                 vol.transmittance(sp.position, dir, *skip) as f64
             }
             ReferenceShadows::Dual(d) => {
-                let f = d.fibers.map_or(FREE_RAY, |g| {
-                    shoot_forward(g, d.forward, sp.position, dir, sp.segment)
+                let (f, behind) = d.fibers.map_or((FREE_RAY, f32::INFINITY), |g| {
+                    (
+                        shoot_forward(g, d.forward, sp.position, dir, sp.segment),
+                        crossings_behind(g, sp.position, dir, sp.segment) as f32,
+                    )
                 });
-                let ms = dual_directional(d, sp, omega_o, dir, &f);
+                let ms = dual_directional(d, sp, omega_o, dir, &f, behind);
                 for c in 0..3 {
                     out[3][c] += l.weight[c] * ms.0[c] as f64;
                     out[4][c] += l.weight[c] * ms.1[c] as f64;
@@ -118,13 +121,17 @@ const FREE_RAY: ForwardScattering = ForwardScattering {
     sigma_f2: [0.0; 3],
 };
 
-/// (MS.global, MS.local) per unit irradiance-weight from one direction whose shadow ray found `f`.
+/// (MS.global, MS.local) per unit irradiance-weight from one direction whose shadow ray found `f`,
+/// with `behind` fibers behind the point along the light's travel (taken as the optical depth of
+/// [`crate::scattering::dual_terms::backscatter_depth_fraction`]: the renderer's volume gives the
+/// mean of that count).
 fn dual_directional(
     d: &DualReference,
     sp: &ShadingPoint,
     omega_o: Vec3,
     dir: Vec3,
     f: &ForwardScattering,
+    behind: f32,
 ) -> ([f32; 3], [f32; 3]) {
     let mut fp = d.fast;
     fp.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
@@ -139,7 +146,7 @@ fn dual_directional(
     };
     // The direct part's local term weighs with the direct fraction (0 or 1 per ray).
     let local_direct = if f.direct_fraction > 0.0 {
-        local_response(&fp, d.dual, light, theta_o, phi_o, 0.0)
+        local_response(&fp, d.dual, light, theta_o, phi_o, 0.0, behind)
     } else {
         [0.0; 3]
     };
@@ -151,7 +158,7 @@ fn dual_directional(
             for t in 0..3 {
                 global[c] += global_response_lobe(&fp, t, light, theta_o, phi_o, s2)[c];
             }
-            local[c] = local_response(&fp, d.dual, light, theta_o, phi_o, s2)[c];
+            local[c] = local_response(&fp, d.dual, light, theta_o, phi_o, s2, behind)[c];
         }
     }
     dual_scattering_components(

@@ -5,6 +5,7 @@
 
 use super::camera::Camera;
 use super::frame::Frame;
+use super::progressive::Refinement;
 use super::resolve::{ResolveInfo, ResolvePass};
 use super::shading::{
     FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass,
@@ -169,32 +170,34 @@ impl RenderSettings {
 
 pub struct Renderer {
     pub settings: RenderSettings,
-    hair: GpuHair,
-    point_count: usize,
-    skip: f32,
-    volume: GpuFiberDensity,
-    pyramid: GpuDensityPyramid,
-    shadow_grid: GpuShadowGrid,
-    luts: GpuLuts,
-    look: HairLook,
-    params: wgpu::Buffer,
-    forward_table: wgpu::Buffer,
-    dual_tables: wgpu::Buffer,
-    camera: wgpu::Buffer,
-    lights: wgpu::Buffer,
-    light_count: u32,
-    resolve_info: wgpu::Buffer,
-    targets: FrameTargets,
-    density_pass: FiberDensityPass,
-    pyramid_pass: DensityPyramidPass,
-    shadow_grid_pass: ShadowGridPass,
-    visibility_pass: VisibilityPass,
-    shading_pass: ShadingPass,
-    resolve_pass: ResolvePass,
-    volume_dirty: bool,
-    shadow_grid_dirty: bool,
-    timer: Option<PassTimer>,
-    last_ran: Vec<&'static str>,
+    pub(super) hair: GpuHair,
+    pub(super) point_count: usize,
+    pub(super) skip: f32,
+    pub(super) volume: GpuFiberDensity,
+    pub(super) pyramid: GpuDensityPyramid,
+    pub(super) shadow_grid: GpuShadowGrid,
+    pub(super) luts: GpuLuts,
+    pub(super) look: HairLook,
+    pub(super) params: wgpu::Buffer,
+    pub(super) forward_table: wgpu::Buffer,
+    pub(super) dual_tables: wgpu::Buffer,
+    pub(super) camera: wgpu::Buffer,
+    pub(super) lights: wgpu::Buffer,
+    pub(super) light_count: u32,
+    pub(super) resolve_info: wgpu::Buffer,
+    pub(super) targets: FrameTargets,
+    pub(super) density_pass: FiberDensityPass,
+    pub(super) pyramid_pass: DensityPyramidPass,
+    pub(super) shadow_grid_pass: ShadowGridPass,
+    pub(super) visibility_pass: VisibilityPass,
+    pub(super) shading_pass: ShadingPass,
+    pub(super) resolve_pass: ResolvePass,
+    pub(super) volume_dirty: bool,
+    pub(super) shadow_grid_dirty: bool,
+    pub(super) timer: Option<PassTimer>,
+    pub(super) last_ran: Vec<&'static str>,
+    /// Where progressive refinement ([`Renderer::refine`]) stands.
+    pub(super) refinement: Refinement,
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -316,6 +319,7 @@ impl Renderer {
             shadow_grid_dirty: true,
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
+            refinement: Refinement::default(),
             settings,
         };
         renderer.update_batches(device);
@@ -331,6 +335,7 @@ impl Renderer {
             flags |= FLAG_MULTIPLE_SCATTERING;
         }
         let samples = self.settings.samples;
+        let height = self.settings.height;
         let batches: Vec<ShadeBatch> =
             ShadingPass::batches(self.light_count, self.settings.lights_per_pass)
                 .into_iter()
@@ -341,11 +346,14 @@ impl Renderer {
                         flags,
                         samples,
                         slot,
-                        _pad: [0; 3],
+                        row0: 0,
+                        rows: height,
+                        _pad: 0,
                     })
                 })
                 .collect();
         self.shading_pass.set_batches(device, &batches);
+        self.restart_refinement();
     }
 
     /// Hair parameters changed: the uniform is rewritten; when the exact parameters changed, the
@@ -367,12 +375,15 @@ impl Renderer {
                 0,
                 bytemuck::cast_slice(&dual_tables_texels(&dual)),
             );
-            self.shadow_grid_dirty |= self.settings.multiple_scattering;
+            if self.settings.multiple_scattering {
+                self.mark_shadow_grid_dirty();
+            }
         }
         self.look = *look;
+        self.restart_refinement();
     }
 
-    pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) {
+    pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) {
         let u = camera.uniform(
             self.settings.width,
             self.settings.height,
@@ -380,6 +391,7 @@ impl Renderer {
         );
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&u));
+        self.restart_refinement();
     }
 
     /// Painted absorption (one RGB per point): rewrites the buffer and marks the volume (which carries
@@ -398,7 +410,7 @@ impl Renderer {
         let v: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
         ctx.queue
             .write_buffer(&self.hair.absorption, 0, bytemuck::cast_slice(&v));
-        self.volume_dirty = true;
+        self.mark_volume_dirty();
         Ok(())
     }
 
@@ -426,18 +438,21 @@ impl Renderer {
                 self.settings.multiple_scattering,
             );
         }
-        self.shadow_grid_dirty = true;
+        self.mark_shadow_grid_dirty();
         self.update_batches(&ctx.device);
     }
 
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
+        self.mark_shadow_grid_dirty();
     }
 
     /// The next frame rebuilds the per-light transmittance grid (benchmarks time it).
     pub fn mark_shadow_grid_dirty(&mut self) {
         self.shadow_grid_dirty = true;
+        self.refinement.grid_done = 0;
+        self.restart_refinement();
     }
 
     pub fn light_count(&self) -> u32 {
@@ -472,6 +487,7 @@ impl Renderer {
             self.shadow_grid_dirty = true;
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
+            let count = self.shadow_grid.entry_count();
             let inputs = ShadowGridInputs {
                 pyramid: &self.pyramid,
                 volume: &self.volume,
@@ -483,6 +499,8 @@ impl Renderer {
                 &mut enc,
                 &inputs,
                 &self.shadow_grid,
+                0,
+                count,
                 timer.and_then(|t| t.compute_writes("shadow_grid")),
             );
             self.last_ran.push("shadow_grid");
@@ -528,6 +546,7 @@ impl Renderer {
             t.resolve(&mut enc);
         }
         ctx.queue.submit([enc.finish()]);
+        self.refinement.complete_frame();
     }
 
     /// GPU milliseconds per pass of the last frame (None without timestamp queries).

@@ -120,6 +120,7 @@ pub fn shade_point(
                 transmittance: 1.0,
                 transmittance_f: [1.0; 3],
                 sigma_f2: [0.0; 3],
+                depth_behind: f32::INFINITY,
             },
             |(grid, src)| grid.shadow(src, sp.position, dir, lambda),
         );
@@ -141,8 +142,8 @@ pub fn shade_point(
                 global[c] += g[c];
             }
         }
-        let local = local_response(&p, tables, light, theta_o, phi_o, s2);
-        let local_direct = local_response(&p, tables, light, theta_o, phi_o, 0.0);
+        let local = local_response(&p, tables, light, theta_o, phi_o, s2, sh.depth_behind);
+        let local_direct = local_response(&p, tables, light, theta_o, phi_o, 0.0, sh.depth_behind);
         let (ms_global, ms_local) = dual_scattering_components(
             &p,
             sh.transmittance,

@@ -33,7 +33,10 @@ pub struct ShadeBatch {
     pub samples: u32,
     /// The visibility sample this dispatch shades (one dispatch per sample and batch).
     pub slot: u32,
-    pub _pad: [u32; 3],
+    /// Rows [row0, row0 + rows) of the image.
+    pub row0: u32,
+    pub rows: u32,
+    pub _pad: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
@@ -55,7 +58,15 @@ pub struct ShadingInputs<'a> {
 
 pub struct ShadingPass {
     pipeline: wgpu::ComputePipeline,
-    batches: Vec<wgpu::Buffer>,
+    batches: Vec<(ShadeBatch, wgpu::Buffer)>,
+}
+
+fn batch_uniform(device: &wgpu::Device, b: &ShadeBatch) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("shade batch"),
+        contents: bytemuck::bytes_of(b),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
 }
 
 impl ShadingPass {
@@ -70,7 +81,6 @@ impl ShadingPass {
         }
     }
 
-    /// The batches for `light_count` lights (at most `per_pass` each).
     pub fn batches(light_count: u32, per_pass: u32) -> Vec<(u32, u32)> {
         let per_pass = per_pass.clamp(1, MAX_LIGHTS_PER_PASS);
         (0..light_count)
@@ -79,21 +89,80 @@ impl ShadingPass {
             .collect()
     }
 
-    /// Rewrites the batch uniforms (lights, flags or sample count changed).
+    /// The dispatches of a whole frame, in order (each over all rows).
     pub fn set_batches(&mut self, device: &wgpu::Device, batches: &[ShadeBatch]) {
         self.batches = batches
             .iter()
-            .map(|b| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("shade batch"),
-                    contents: bytemuck::bytes_of(b),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                })
-            })
+            .map(|b| (*b, batch_uniform(device, b)))
             .collect();
     }
 
-    /// Clears the component buffers and runs every batch.
+    /// The batches `encode` dispatches, in order.
+    pub fn frame_batches(&self) -> impl Iterator<Item = &ShadeBatch> {
+        self.batches.iter().map(|(b, _)| b)
+    }
+
+    /// Zeroes the component buffers (the start of a frame's shading).
+    pub fn clear(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+        for b in &targets.components {
+            encoder.clear_buffer(b, 0, None);
+        }
+    }
+
+    fn bind(
+        &self,
+        device: &wgpu::Device,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        batch: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let buffers = [
+            inputs.camera,
+            inputs.params,
+            batch,
+            inputs.shadow_grid,
+            inputs.points,
+            inputs.segments,
+            inputs.absorption,
+            inputs.lights,
+            inputs.luts[0],
+            inputs.luts[1],
+            inputs.luts[2],
+            inputs.shadow_values,
+            inputs.dual_tables,
+        ];
+        let buffers: Vec<&wgpu::Buffer> = buffers.into_iter().chain(&targets.components).collect();
+        let visibility = wgpu::BindGroupEntry {
+            binding: buffers.len() as u32,
+            resource: wgpu::BindingResource::TextureView(&targets.visibility),
+        };
+        bind_buffers(
+            device,
+            &self.pipeline,
+            "shading",
+            &buffers,
+            vec![visibility],
+        )
+    }
+
+    fn dispatch(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        bind: &wgpu::BindGroup,
+        width: u32,
+        rows: u32,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shading batch"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
+    }
+
+    /// A whole frame's shading: clears the components, then every batch over every row.
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -102,44 +171,12 @@ impl ShadingPass {
         targets: &FrameTargets,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        for b in &targets.components {
-            encoder.clear_buffer(b, 0, None);
-        }
+        Self::clear(encoder, targets);
         let binds: Vec<wgpu::BindGroup> = self
             .batches
             .iter()
-            .map(|batch| {
-                let buffers = [
-                    inputs.camera,
-                    inputs.params,
-                    batch,
-                    inputs.shadow_grid,
-                    inputs.points,
-                    inputs.segments,
-                    inputs.absorption,
-                    inputs.lights,
-                    inputs.luts[0],
-                    inputs.luts[1],
-                    inputs.luts[2],
-                    inputs.shadow_values,
-                    inputs.dual_tables,
-                ];
-                let buffers: Vec<&wgpu::Buffer> =
-                    buffers.into_iter().chain(&targets.components).collect();
-                let visibility = wgpu::BindGroupEntry {
-                    binding: buffers.len() as u32,
-                    resource: wgpu::BindingResource::TextureView(&targets.visibility),
-                };
-                bind_buffers(
-                    device,
-                    &self.pipeline,
-                    "shading",
-                    &buffers,
-                    vec![visibility],
-                )
-            })
+            .map(|(_, batch)| self.bind(device, inputs, targets, batch))
             .collect();
-        // One compute pass per batch (Xu's passes); the timestamps bracket them all.
         let last = binds.len().saturating_sub(1);
         for (k, bind) in binds.iter().enumerate() {
             let timestamp_writes = timestamps
@@ -152,13 +189,29 @@ impl ShadingPass {
                         .filter(|_| k == 0),
                     end_of_pass_write_index: t.end_of_pass_write_index.filter(|_| k == last),
                 });
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("shading batch"),
+            self.dispatch(
+                encoder,
+                bind,
+                targets.width,
+                targets.height,
                 timestamp_writes,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups(targets.width.div_ceil(8), targets.height.div_ceil(8), 1);
+            );
         }
+    }
+
+    /// One batch over its rows `batch.row0 .. batch.row0 + batch.rows` (a unit of progressive
+    /// refinement; the components are not cleared).
+    pub fn encode_batch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        batch: &ShadeBatch,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let uniform = batch_uniform(device, batch);
+        let bind = self.bind(device, inputs, targets, &uniform);
+        self.dispatch(encoder, &bind, targets.width, batch.rows, timestamps);
     }
 }

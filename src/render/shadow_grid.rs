@@ -25,8 +25,8 @@ pub struct ShadowGridInfo {
 
 const _: () = assert!(std::mem::size_of::<ShadowGridInfo>() == 48);
 
-/// The grid's uniform and its values (two vec4 per grid point and light, light-major: transmittance,
-/// T_f RGB; sigma_f^2 RGB, direct fraction of the forward march).
+/// The grid's uniform and its values (two vec4 per grid point and light, light-major: ln transmittance,
+/// ln T_f RGB; sigma_f^2 RGB, optical depth behind the point along the light's travel).
 pub struct GpuShadowGrid {
     pub grid: ShadowGrid,
     pub info: wgpu::Buffer,
@@ -57,7 +57,8 @@ impl GpuShadowGrid {
             info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("shadow grid info"),
                 contents: bytemuck::bytes_of(&info),
-                usage: wgpu::BufferUsages::UNIFORM,
+                // Also storage: the build pass reads it so (shadow_grid_build.wgsl).
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE,
             }),
             values: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("shadow grid"),
@@ -68,6 +69,11 @@ impl GpuShadowGrid {
             light_count,
             forward,
         }
+    }
+
+    /// Entries of the grid: (grid point, light) pairs.
+    pub fn entry_count(&self) -> u32 {
+        self.grid.point_count() as u32 * self.light_count
     }
 }
 
@@ -94,14 +100,25 @@ impl ShadowGridPass {
         }
     }
 
+    /// Encodes the build of entries [first, first + count) (grid point fastest, light-major), the range
+    /// in a storage buffer (see `shadow_grid_build.wgsl`).
+    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         inputs: &ShadowGridInputs,
         target: &GpuShadowGrid,
+        first: u32,
+        count: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
+        let (x, y) = dispatch_2d(count);
+        let range = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadow grid range"),
+            contents: bytemuck::cast_slice(&[first, count, x, 0]),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         let buffers = [
             &inputs.pyramid.info_buffer,
             &inputs.pyramid.pyramid,
@@ -111,6 +128,7 @@ impl ShadowGridPass {
             &inputs.volume.info,
             &inputs.volume.volume,
             inputs.forward_table,
+            &range,
         ];
         let bind = bind_buffers(device, &self.pipeline, "shadow grid", &buffers, Vec::new());
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -119,7 +137,6 @@ impl ShadowGridPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        let (x, y) = dispatch_2d(target.grid.point_count() as u32 * target.light_count);
         pass.dispatch_workgroups(x, y, 1);
     }
 }

@@ -101,6 +101,21 @@ pub fn backscatter_attenuation(a_f: f32, a_b: f32) -> f32 {
     a_b * f2 / q + a_b * a_b * a_b * f2 / (q * q * q)
 }
 
+/// The part of A_b that hair of optical depth `depth` behind the point returns (the point's own
+/// fiber excluded). Zinke's A_b sums back-scattering over infinitely many layers behind the point:
+/// A_1 = a_b sum_{i >= 1} a_f^{2i}. With n layers the sum stops at i = n, which keeps the fraction
+/// 1 - a_f^{2n} of it; with fibers placed at random the number of layers crossed along a line of
+/// optical depth tau is Poisson with mean tau, and E[1 - a_f^{2N}] = 1 - exp(-tau (1 - a_f^2)).
+/// Applied to the whole A_b (A_3 needs three back-scatterings behind the point, so it falls faster: on
+/// thin hair this slightly overstates it). `depth = f32::INFINITY` is Zinke's unbounded hair.
+pub fn backscatter_depth_fraction(a_f: f32, depth: f32) -> f32 {
+    let k = (1.0 - a_f * a_f).max(1e-6);
+    if depth.is_infinite() {
+        return 1.0;
+    }
+    1.0 - (-depth.max(0.0) * k).exp()
+}
+
 /// Delta_b (Zinke Eq. 16).
 pub fn backscatter_shift(a_f: f32, a_b: f32, alpha_f: f32, alpha_b: f32) -> f32 {
     let f2 = a_f * a_f;

@@ -173,6 +173,39 @@ impl DensityPyramid {
         tau
     }
 
+    /// Whether any hair lies in the cube [p - r, p + r] (to the resolution of the finest level whose voxel
+    /// is at least r / 2, or the coarsest: at most 5^3 voxels): the voxels of that level overlapping the
+    /// cube, any extinction above zero. A shadow-grid point with no hair within one grid spacing is read by no shading point.
+    pub fn hair_near(&self, p: Vec3, r: f32) -> bool {
+        let Some(level) = self
+            .levels
+            .iter()
+            .find(|l| l.voxel >= 0.5 * r)
+            .or(self.levels.last())
+        else {
+            return false;
+        };
+        let lo = ((p - Vec3::splat(r) - self.origin) / level.voxel).floor();
+        let hi = ((p + Vec3::splat(r) - self.origin) / level.voxel).floor();
+        let range = |ax: usize| {
+            let top = level.dims[ax] as i64 - 1;
+            (lo[ax] as i64).max(0)..=(hi[ax] as i64).min(top)
+        };
+        for z in range(2) {
+            for y in range(1) {
+                for x in range(0) {
+                    if level
+                        .index([x, y, z])
+                        .is_some_and(|v| level.extinction[v] > 0.0)
+                    {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
     /// Distance from p along omega (unit) to where the ray leaves the pyramid's box.
     pub fn exit(&self, p: Vec3, omega: Vec3) -> f32 {
         box_exit(
@@ -233,4 +266,60 @@ pub fn srbf_cones(centre: Vec3, lambda: f32) -> Vec<(Vec3, f32, f32)> {
         cones.push((d, sub, 0.5 / 6.0));
     }
     cones
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hair::procedural::Style;
+    use crate::render::scene::generated_hair;
+
+    /// hair_near never misses hair that level 0 holds in the cube (brute force over the level-0
+    /// voxels overlapping it); it may report hair a coarser voxel holds just outside.
+    #[test]
+    fn hair_near_finds_every_voxel_of_hair_in_the_cube() {
+        let hair = generated_hair(Style::Bob, 300, 12, 3);
+        let sigma = vec![[0.5f32; 3]; hair.point_count()];
+        let volume = FiberDensity::build(&hair, &sigma, 0.4);
+        let pyramid = DensityPyramid::build(&volume);
+        let l0 = &pyramid.levels[0];
+        let extent = Vec3::new(l0.dims[0] as f32, l0.dims[1] as f32, l0.dims[2] as f32) * l0.voxel;
+        let (mut near, mut brute_near, mut extra) = (0, 0, 0);
+        let mut state = 12345u64;
+        let mut rand = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..3000 {
+            let p = pyramid.origin + Vec3::new(rand(), rand(), rand()) * extent;
+            let r = l0.voxel * (0.5 + 4.0 * rand());
+            let lo = ((p - Vec3::splat(r) - pyramid.origin) / l0.voxel).floor();
+            let hi = ((p + Vec3::splat(r) - pyramid.origin) / l0.voxel).floor();
+            let mut brute = false;
+            for z in lo.z as i64..=hi.z as i64 {
+                for y in lo.y as i64..=hi.y as i64 {
+                    for x in lo.x as i64..=hi.x as i64 {
+                        brute |= l0.index([x, y, z]).is_some_and(|v| l0.extinction[v] > 0.0);
+                    }
+                }
+            }
+            let h = pyramid.hair_near(p, r);
+            assert!(
+                h || !brute,
+                "hair at level 0 in the cube around {p} (r {r}) missed"
+            );
+            near += h as u32;
+            brute_near += brute as u32;
+            extra += (h && !brute) as u32;
+        }
+        println!(
+            "3000 cubes: hair in {brute_near} (level 0), reported in {near} ({extra} from coarser voxels)"
+        );
+        assert!(
+            brute_near > 300 && brute_near < 2700,
+            "the test samples both"
+        );
+    }
 }

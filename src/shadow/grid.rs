@@ -19,6 +19,10 @@ pub struct GridShadow {
     pub transmittance: f32,
     pub transmittance_f: [f32; 3],
     pub sigma_f2: [f32; 3],
+    /// Optical depth of the hair behind the point along the light's travel (the central cone of
+    /// [`srbf_cones`] marched away from the light): what the local back-scattering term has to work
+    /// with (`backscatter_depth_fraction`). 0 without multiple scattering.
+    pub depth_behind: f32,
 }
 
 /// forward_scattering over the cones of `srbf_transmittance` (twin of `srbf_forward` in
@@ -118,24 +122,38 @@ impl ShadowGrid {
 
     /// What the build pass stores at grid point i for a light (transmittances as logarithms, floored
     /// at [`GRID_MIN_TRANSMITTANCE`]).
+    /// A point with no hair within one spacing is read by no shading point: it is stored lit.
     pub fn value(&self, src: &GridSources, i: usize, centre: Vec3, lambda: f32) -> GridShadow {
         let x = self.point(i);
+        if !src.pyramid.hair_near(x, self.spacing) {
+            return GridShadow::default();
+        }
         let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
-        // The same transmittance with or without dual scattering (d_f = d_b = 0 is single scattering
-        // exactly).
-        let t = ln(src.pyramid.srbf_transmittance(x, centre, lambda, src.skip));
         match src.forward {
-            None => GridShadow {
-                transmittance: t,
-                transmittance_f: [t; 3],
-                sigma_f2: [0.0; 3],
-            },
-            Some((volume, table)) => {
-                let f = srbf_forward(src.pyramid, volume, table, x, centre, lambda, src.skip);
+            None => {
+                let t = ln(src.pyramid.srbf_transmittance(x, centre, lambda, src.skip));
                 GridShadow {
                     transmittance: t,
+                    transmittance_f: [t; 3],
+                    sigma_f2: [0.0; 3],
+                    depth_behind: 0.0,
+                }
+            }
+            Some((volume, table)) => {
+                // The forward march's direct fraction is srbf_transmittance (the same cones, steps
+                // and sums, in the same order): d_f = d_b = 0 is single scattering up to rounding.
+                let f = srbf_forward(src.pyramid, volume, table, x, centre, lambda, src.skip);
+                let (_, half_angle, _) = srbf_cones(-centre, lambda)[0];
+                GridShadow {
+                    transmittance: ln(f.direct_fraction),
                     transmittance_f: f.transmittance_f.map(ln),
                     sigma_f2: f.sigma_f2,
+                    depth_behind: src.pyramid.cone_optical_depth(
+                        x,
+                        -centre,
+                        half_angle.max(1e-4),
+                        src.skip,
+                    ),
                 }
             }
         }
@@ -151,6 +169,7 @@ impl ShadowGrid {
             }
             let v = self.value(src, i, centre, lambda);
             out.transmittance += w * v.transmittance;
+            out.depth_behind += w * v.depth_behind;
             for c in 0..3 {
                 out.transmittance_f[c] += w * v.transmittance_f[c];
                 out.sigma_f2[c] += w * v.sigma_f2[c];

@@ -47,3 +47,19 @@ pub fn shoot_forward(
     });
     out
 }
+
+/// Fibers crossed from p away from the light (along -omega), the segment `own` and its neighbours on
+/// the same strand left out: the hair behind the point that the local back-scattering term
+/// (`backscatter_depth_fraction`) has to work with, counted exactly.
+pub fn crossings_behind(grid: &FiberGrid, p: Vec3, omega: Vec3, own: u32) -> u32 {
+    let own_strand = grid.segments.get(own as usize).map(|s| s.strand);
+    let mut n = 0;
+    grid.crossings(p, -omega, 0.0, |x| {
+        let s = &grid.segments[x.segment as usize];
+        if Some(s.strand) == own_strand && x.segment.abs_diff(own) <= 1 {
+            return;
+        }
+        n += 1;
+    });
+    n
+}

@@ -1,0 +1,165 @@
+//! Progressive refinement (`Renderer::refine`): the frame cut into bounded units converges to exactly
+//! `render_frame`'s image; a camera move restarts at visibility and keeps the shadow grid; a parameter
+//! change rebuilds the grid (dual scattering reads the forward table) and converges to the new frame.
+
+mod common;
+
+use std::path::PathBuf;
+use std::time::Duration;
+use strandlight::envmap::SrbfSet;
+use strandlight::gpu::{GpuContext, GpuOptions};
+use strandlight::render::progressive::WorkUnit;
+use strandlight::render::{Camera, Frame, Renderer};
+use strandlight::scattering::lut::Luts;
+use strandlight::scattering::params::Preset;
+
+fn context() -> GpuContext {
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
+    println!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
+    ctx
+}
+
+/// Largest difference between two frames' beauty and components, relative to the largest value.
+fn difference(a: &Frame, b: &Frame) -> f32 {
+    let mut scale = 0f32;
+    let mut worst = 0f32;
+    for (x, y) in a.beauty.iter().zip(&b.beauty) {
+        for c in 0..4 {
+            scale = scale.max(x[c].abs());
+            worst = worst.max((x[c] - y[c]).abs());
+        }
+    }
+    for (ca, cb) in a.components.iter().zip(&b.components) {
+        for (x, y) in ca.iter().zip(cb) {
+            for c in 0..3 {
+                worst = worst.max((x[c] - y[c]).abs());
+            }
+        }
+    }
+    assert!(scale > 0.0, "the frame is not empty");
+    worst / scale
+}
+
+/// Refines to convergence, returning the units submitted.
+fn refine_all(r: &mut Renderer, ctx: &GpuContext) -> Vec<WorkUnit> {
+    let mut units = Vec::new();
+    loop {
+        let p = r.refine(ctx).expect("refine");
+        if let Some(u) = p.submitted {
+            units.push(u);
+        }
+        if p.converged {
+            println!(
+                "  {} units, longest {:.1} ms ({:?})",
+                p.stats.units,
+                p.stats.longest.as_secs_f64() * 1e3,
+                p.stats.longest_unit
+            );
+            assert_eq!(p.fraction, 1.0);
+            return units;
+        }
+        assert!((0.0..1.0).contains(&p.fraction), "fraction {}", p.fraction);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+    }
+}
+
+#[test]
+fn refinement_converges_to_render_frame_and_restarts_on_changes() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights =
+        SrbfSet::read(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"))
+            .expect("fit")
+            .lights;
+    let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
+    // A coarse grid keeps the unit count of the test small.
+    scene.settings.shadow_grid_resolution = 12;
+    let new = || {
+        Renderer::new(
+            &ctx,
+            scene.settings.clone(),
+            &luts,
+            &scene.hair,
+            &scene.sigma_a,
+            &scene.look,
+            &lights,
+            &scene.camera,
+        )
+        .expect("renderer")
+    };
+    let mut whole = new();
+    let mut progressive = new();
+    // A small budget, so that the frame is cut into many units.
+    progressive.set_unit_budget(Duration::from_millis(10));
+
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let units = refine_all(&mut progressive, &ctx);
+    let b = progressive.read_frame(&ctx).expect("read");
+    let count = |f: &dyn Fn(&WorkUnit) -> bool| units.iter().filter(|u| f(u)).count();
+    let grid = count(&|u| matches!(u, WorkUnit::ShadowGrid { .. }));
+    let shade = count(&|u| matches!(u, WorkUnit::Shade { .. }));
+    let d = difference(&a, &b);
+    println!(
+        "first frame: {} units ({grid} shadow-grid ranges, {shade} shading bands); difference to render_frame {d:.1e}",
+        units.len()
+    );
+    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    assert!(grid >= 2 && shade > 12, "the frame was cut into pieces");
+    assert_eq!(d, 0.0, "the converged image is render_frame's");
+
+    // A camera move: visibility and shading only.
+    let camera = Camera {
+        yaw: scene.camera.yaw + 40.0,
+        ..scene.camera
+    };
+    whole.set_camera(&ctx, &camera);
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    progressive.set_camera(&ctx, &camera);
+    let units = refine_all(&mut progressive, &ctx);
+    let b = progressive.read_frame(&ctx).expect("read");
+    let d = difference(&a, &b);
+    println!(
+        "after a camera move: {} units, first {:?}; difference {d:.1e}",
+        units.len(),
+        units.first()
+    );
+    assert_eq!(units.first(), Some(&WorkUnit::Visibility));
+    assert!(
+        units
+            .iter()
+            .all(|u| matches!(u, WorkUnit::Visibility | WorkUnit::Shade { .. })),
+        "a camera move rebuilds nothing"
+    );
+    assert_eq!(d, 0.0);
+
+    // A parameter change mid-refinement: the grid is rebuilt, the result is the new look's.
+    let mut params = scene.look.params;
+    params.sigma_a = [1.2, 1.6, 2.4];
+    let look = strandlight::render::HairLook::new(params);
+    progressive.set_camera(&ctx, &scene.camera);
+    for _ in 0..3 {
+        progressive.refine(&ctx).expect("refine");
+    }
+    progressive.set_params(&ctx, &look);
+    let units = refine_all(&mut progressive, &ctx);
+    let b = progressive.read_frame(&ctx).expect("read");
+    whole.set_camera(&ctx, &scene.camera);
+    whole.set_params(&ctx, &look);
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let d = difference(&a, &b);
+    println!(
+        "after a parameter change: {} units, first {:?}; difference {d:.1e}",
+        units.len(),
+        units.first()
+    );
+    assert!(matches!(
+        units.first(),
+        Some(WorkUnit::ShadowGrid { first: 0, .. })
+    ));
+    assert_eq!(d, 0.0);
+}
