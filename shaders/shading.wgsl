@@ -25,8 +25,6 @@ struct ShadeBatch {
     _p2: u32,
 }
 
-// Read as storage, not uniforms: lavapipe recompiles a shader whose loops and branches depend on small
-// uniforms, with their values inlined, at every new bind group (tens of ms for this shader, per batch).
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<uniform> params: FastHairParams;
 @group(0) @binding(2) var<uniform> batch: ShadeBatch;

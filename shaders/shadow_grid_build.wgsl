@@ -77,8 +77,9 @@ fn build_shadow_grid(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let l = grid_lights[k / n];
     let x = grid_point(g, k % n);
-    // No shading point reads a grid point with no hair within one spacing: it stays lit.
-    if (!hair_near(x, g.spacing)) {
+    // No shading point reads a grid point with no hair within one spacing (plus a level-0 voxel: hair is
+    // deposited at samples a quarter voxel apart, ShadowGrid::value): it stays lit.
+    if (!hair_near(x, g.spacing + pyramid_info.levels[0].voxel)) {
         shadow_values[2u * k] = vec4<f32>(0.0);
         shadow_values[2u * k + 1u] = vec4<f32>(0.0);
         return;

@@ -2,7 +2,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use strandlight::scattering::dual_terms::{
-    DualTables, backscatter_attenuation, backscatter_depth_fraction, backscatter_shift,
+    DualTables, HairBehind, backscatter_attenuation, backscatter_depth_fraction, backscatter_shift,
     backscatter_width, dual_sample, dual_theta,
 };
 use strandlight::scattering::marschner::{
@@ -211,6 +211,15 @@ fn backscatter_depth_fraction_equals_the_truncated_sums() {
         1.0,
         "unbounded hair is Zinke's A_b"
     );
+    // An exact count of fibers stops A_1's sum there.
+    for &af in &[0.6f64, 0.85, 0.95] {
+        let a1_inf = af * af / (1.0 - af * af);
+        for n in 0..6u32 {
+            let a1: f64 = (1..=n as i32).map(|i| af.powi(2 * i)).sum();
+            let f = HairBehind::Fibers(n).fraction(af as f32) as f64;
+            assert!((f - a1 / a1_inf).abs() < 1e-5, "a_f {af}, {n} fibers: {f}");
+        }
+    }
     println!("worst: A_1 {worst_1:.2e}, overstatement of A_1 + A_3 {worst_total:.3}");
     assert!(worst_1 < 1e-4, "A_1 fraction off by {worst_1}");
     assert!(worst_total < 0.1, "A_b overstated by {worst_total}");

@@ -46,7 +46,7 @@ pub enum Command {
     BenchFast(bench_fast::BenchFastArgs),
     /// Render a still (linear EXR, PNG preview) of a hairstyle under an environment on the GPU.
     Render(Box<render::RenderArgs>),
-    /// Benchmark the renderer on the standard scenes S1-S3: GPU time per pass (JSON).
+    /// Benchmark the renderer on the standard scenes S0-S3: GPU time per pass (JSON).
     Bench(bench::BenchArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {

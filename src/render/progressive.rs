@@ -1,7 +1,8 @@
-//! Progressive refinement, the editor's frame loop: a frame's work cut into bounded units, at most one
-//! in flight, each submitted on its own by [`Renderer::refine`] and sized from the measured cost of the
-//! units before it to a time budget, so egui, which shares the queue, never waits behind a long
-//! submission. The units run in the order `render_frame` encodes its passes: the fiber-density volume
+//! Progressive refinement, the editor's frame loop: a frame's work cut into units, at most one in
+//! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
+//! are sized from the measured cost of the units before them to a time budget, so egui, which shares the
+//! queue, does not wait behind a long submission (the volume and visibility units are whole passes, not
+//! sized; a unit of one row or one grid entry can still pass the budget). The units run in the order `render_frame` encodes its passes: the fiber-density volume
 //! (when geometry or absorption changed), the shadow grid in ranges of (grid point, light) entries
 //! (when the volume, the lights or the forward table changed), visibility, then every shading batch
 //! (a light batch at one visibility sample) in bands of rows, each band followed by a resolve so the
@@ -74,6 +75,9 @@ pub struct Refinement {
     /// Seconds per shadow-grid entry and per row of one shading batch (None: not measured yet).
     grid_cost: Option<f64>,
     shade_cost: Option<f64>,
+    /// Items of the last grid and shading units.
+    grid_last: u32,
+    shade_last: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
 }
@@ -87,6 +91,8 @@ impl Default for Refinement {
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
             shade_cost: None,
+            grid_last: 1,
+            shade_last: 1,
             in_flight: None,
             stats: RefineStats::default(),
         }
@@ -99,11 +105,14 @@ impl Refinement {
         self.stage = Stage::Converged;
     }
 
-    /// Items a unit may hold: the budget over the measured (or guessed) cost per item; at least one,
-    /// at most what remains.
-    fn items(&self, per_item: Option<f64>, guess: f64, remaining: u32) -> u32 {
+    /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
+    /// the previous unit of the kind (`last`: costs are uneven, empty rows and grid points cost almost
+    /// nothing, so one cheap unit must not size a huge next one); at least one, at most what remains.
+    fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
         let per_item = per_item.unwrap_or(guess).max(1e-12);
-        let n = (self.budget.as_secs_f64() / per_item).floor();
+        let n = (self.budget.as_secs_f64() / per_item)
+            .floor()
+            .min(2.0 * last.max(1) as f64);
         (n.min(remaining as f64) as u32)
             .max(1)
             .min(remaining.max(1))
@@ -187,6 +196,7 @@ impl Renderer {
                 }
             }
         }
+        self.last_ran.clear(); // pass_times belongs to render_frame
         let Some(unit) = self.next_unit() else {
             return Ok(self.progress(None, false));
         };
@@ -280,7 +290,13 @@ impl Renderer {
                     r.stage = Stage::Visibility;
                     return self.next_unit();
                 }
-                let count = r.items(r.grid_cost, GUESS_GRID_ENTRY_S, total - r.grid_done);
+                let count = r.items(
+                    r.grid_cost,
+                    GUESS_GRID_ENTRY_S,
+                    r.grid_last,
+                    total - r.grid_done,
+                );
+                r.grid_last = count;
                 let first = r.grid_done;
                 r.grid_done += count;
                 Some(WorkUnit::ShadowGrid { first, count })
@@ -294,12 +310,13 @@ impl Renderer {
                 Some(WorkUnit::Visibility)
             }
             Stage::Shade { batch, row } => {
-                let mut rows = r.items(r.shade_cost, GUESS_SHADE_ROW_S, height - row);
+                let mut rows = r.items(r.shade_cost, GUESS_SHADE_ROW_S, r.shade_last, height - row);
                 // Whole workgroups (8 rows) where the budget allows.
                 if rows >= 8 && rows < height - row {
                     rows -= rows % 8;
                 }
                 r.rows_done += rows as u64;
+                r.shade_last = rows;
                 r.stage = if row + rows < height {
                     Stage::Shade {
                         batch,

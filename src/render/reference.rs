@@ -18,9 +18,10 @@
 use super::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
 use crate::envmap::EnvMap;
 use crate::scattering::dual_response::{
-    dual_scattering_components, global_response_lobe, local_response,
+    dual_scattering_components, global_response_lobe, local_response_behind,
 };
 use crate::scattering::dual_terms::DualTables;
+use crate::scattering::dual_terms::HairBehind;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::fast_response::SrbfInFrame;
 use crate::scattering::frame::{FiberAngles, FiberFrame};
@@ -87,12 +88,19 @@ pub fn reference_shade(
                 vol.transmittance(sp.position, dir, *skip) as f64
             }
             ReferenceShadows::Dual(d) => {
-                let (f, behind) = d.fibers.map_or((FREE_RAY, f32::INFINITY), |g| {
-                    (
-                        shoot_forward(g, d.forward, sp.position, dir, sp.segment),
-                        crossings_behind(g, sp.position, dir, sp.segment) as f32,
-                    )
-                });
+                let (f, behind) =
+                    d.fibers
+                        .map_or((FREE_RAY, HairBehind::OpticalDepth(f32::INFINITY)), |g| {
+                            (
+                                shoot_forward(g, d.forward, sp.position, dir, sp.segment),
+                                HairBehind::Fibers(crossings_behind(
+                                    g,
+                                    sp.position,
+                                    dir,
+                                    sp.segment,
+                                )),
+                            )
+                        });
                 let ms = dual_directional(d, sp, omega_o, dir, &f, behind);
                 for c in 0..3 {
                     out[3][c] += l.weight[c] * ms.0[c] as f64;
@@ -122,16 +130,15 @@ const FREE_RAY: ForwardScattering = ForwardScattering {
 };
 
 /// (MS.global, MS.local) per unit irradiance-weight from one direction whose shadow ray found `f`,
-/// with `behind` fibers behind the point along the light's travel (taken as the optical depth of
-/// [`crate::scattering::dual_terms::backscatter_depth_fraction`]: the renderer's volume gives the
-/// mean of that count).
+/// with `behind` the fibers behind the point along the light's travel (counted: A_b's sum stopped
+/// there; the renderer's volume gives the Poisson mean of that count instead).
 fn dual_directional(
     d: &DualReference,
     sp: &ShadingPoint,
     omega_o: Vec3,
     dir: Vec3,
     f: &ForwardScattering,
-    behind: f32,
+    behind: HairBehind,
 ) -> ([f32; 3], [f32; 3]) {
     let mut fp = d.fast;
     fp.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
@@ -146,7 +153,7 @@ fn dual_directional(
     };
     // The direct part's local term weighs with the direct fraction (0 or 1 per ray).
     let local_direct = if f.direct_fraction > 0.0 {
-        local_response(&fp, d.dual, light, theta_o, phi_o, 0.0, behind)
+        local_response_behind(&fp, d.dual, light, theta_o, phi_o, 0.0, behind)
     } else {
         [0.0; 3]
     };
@@ -158,7 +165,7 @@ fn dual_directional(
             for t in 0..3 {
                 global[c] += global_response_lobe(&fp, t, light, theta_o, phi_o, s2)[c];
             }
-            local[c] = local_response(&fp, d.dual, light, theta_o, phi_o, s2, behind)[c];
+            local[c] = local_response_behind(&fp, d.dual, light, theta_o, phi_o, s2, behind)[c];
         }
     }
     dual_scattering_components(

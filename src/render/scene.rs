@@ -1,5 +1,5 @@
 //! What a render needs besides settings: the default scene (a generated hairstyle under the project's
-//! own sunny environment), the benchmark scenes S1-S3, and environments from files (.srbf.json as is;
+//! own sunny environment), the benchmark scenes S0-S3, and environments from files (.srbf.json as is;
 //! .hdr / .exr fitted through the cache, and kept as images for the reference mode).
 
 use crate::envmap::cache::{FitError, fit_file};
@@ -92,7 +92,16 @@ pub struct StandardScene {
     pub height: u32,
 }
 
-pub const STANDARD_SCENES: [StandardScene; 3] = [
+pub const STANDARD_SCENES: [StandardScene; 4] = [
+    // A small scene for CI-sized machines (seconds per frame on lavapipe).
+    StandardScene {
+        name: "S0",
+        strands: 2_000,
+        points: 16,
+        lights: 40,
+        width: 320,
+        height: 240,
+    },
     StandardScene {
         name: "S1",
         strands: 10_000,
@@ -127,9 +136,9 @@ impl StandardScene {
             .find(|s| s.name.eq_ignore_ascii_case(name))
     }
 
-    /// S1 is wavy (Xu's animated character), S2 and S3 straight (Xu's "straight").
+    /// S0 and S1 are wavy (Xu's animated character), S2 and S3 straight (Xu's "straight").
     pub fn hair(&self) -> Hair {
-        let style = if self.name == "S1" {
+        let style = if matches!(self.name, "S0" | "S1") {
             Style::Wavy
         } else {
             Style::StraightLong

@@ -9,7 +9,7 @@
 //! directional). Responses are per unit light power; the renderer multiplies by the SRBF's power
 //! pi lambda_j^2 (1 - e^(-4 / lambda_j^2)) and radiance.
 
-use super::dual_terms::{DualTables, backscatter_depth_fraction};
+use super::dual_terms::{DualTables, HairBehind};
 use super::fast_azimuthal::Rgb32;
 use super::fast_exact_azimuthal::azimuthal_window_integral;
 use super::fast_params::FastHairParams;
@@ -72,8 +72,9 @@ pub fn global_response_lobe(
 /// A_b cos(theta_i) d theta_i, so that A_b is the energy the back-scattered light carries,
 /// with Delta_b~, sigma_b~ the means of Delta_b, sigma_b over theta_i in theta_j +- sigma (from the SATs).
 /// `depth_behind` is the optical depth of the hair behind the point along the light's direction of
-/// travel: A_b is scaled by [`backscatter_depth_fraction`] at each node (`f32::INFINITY`: Zinke's
-/// unbounded hair).
+/// travel: A_b is scaled by [`crate::scattering::dual_terms::backscatter_depth_fraction`] at each node
+/// (`f32::INFINITY`: Zinke's unbounded hair). The WGSL twin's form; [`local_response_behind`] also
+/// takes an exact fiber count.
 pub fn local_response(
     p: &FastHairParams,
     tables: &DualTables,
@@ -82,6 +83,27 @@ pub fn local_response(
     phi_o: f32,
     sigma_f2: f32,
     depth_behind: f32,
+) -> Rgb32 {
+    local_response_behind(
+        p,
+        tables,
+        light,
+        theta_o,
+        phi_o,
+        sigma_f2,
+        HairBehind::OpticalDepth(depth_behind),
+    )
+}
+
+/// [`local_response`] with the hair behind the point given either way.
+pub fn local_response_behind(
+    p: &FastHairParams,
+    tables: &DualTables,
+    light: SrbfInFrame,
+    theta_o: f32,
+    phi_o: f32,
+    sigma_f2: f32,
+    behind: HairBehind,
 ) -> Rgb32 {
     let sigma = forward_spread(sigma_f2, light.lambda);
     let azimuthal = (PI - wrap_angle_f32(light.phi - phi_o).abs()) / (PI * PI);
@@ -103,7 +125,7 @@ pub fn local_response(
         let v = linear_quadrature(p.quadrature_segments, mu, l, |ti| {
             let theta_d = 0.5 * (theta_o - ti);
             let t = tables.lookup(theta_d);
-            let a = t.big_a_b[c] * backscatter_depth_fraction(t.a_f[c], depth_behind);
+            let a = t.big_a_b[c] * behind.fraction(t.a_f[c]);
             [a * back.factor(ti); 3]
         });
         out[c] = (k * v[0]).max(0.0);

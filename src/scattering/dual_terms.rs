@@ -110,10 +110,31 @@ pub fn backscatter_attenuation(a_f: f32, a_b: f32) -> f32 {
 /// thin hair this slightly overstates it). `depth = f32::INFINITY` is Zinke's unbounded hair.
 pub fn backscatter_depth_fraction(a_f: f32, depth: f32) -> f32 {
     let k = (1.0 - a_f * a_f).max(1e-6);
-    if depth.is_infinite() {
+    if depth == f32::INFINITY {
         return 1.0;
     }
     1.0 - (-depth.max(0.0) * k).exp()
+}
+
+/// How much hair lies behind a shading point, for M^L's finite-depth fraction of A_b.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HairBehind {
+    /// The volume's optical depth tau (a Poisson number of layers of mean tau):
+    /// [`backscatter_depth_fraction`]; `f32::INFINITY` is Zinke's unbounded hair.
+    OpticalDepth(f32),
+    /// Exactly n fibers (the reference's count along its reversed shadow ray): A_1's sum stopped at
+    /// i = n, 1 - a_f^{2n}.
+    Fibers(u32),
+}
+
+impl HairBehind {
+    /// The part of A_b this hair returns, for a fiber forward-scattering a_f.
+    pub fn fraction(self, a_f: f32) -> f32 {
+        match self {
+            HairBehind::OpticalDepth(depth) => backscatter_depth_fraction(a_f, depth),
+            HairBehind::Fibers(n) => 1.0 - (a_f * a_f).powi(n.min(1 << 20) as i32),
+        }
+    }
 }
 
 /// Delta_b (Zinke Eq. 16).

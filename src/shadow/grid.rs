@@ -122,10 +122,13 @@ impl ShadowGrid {
 
     /// What the build pass stores at grid point i for a light (transmittances as logarithms, floored
     /// at [`GRID_MIN_TRANSMITTANCE`]).
-    /// A point with no hair within one spacing is read by no shading point: it is stored lit.
+    /// A point with no hair within one spacing (plus a level-0 voxel: the volume deposits a segment at
+    /// samples a quarter voxel apart, so a shading point's hair may sit in the next voxel) is read by no
+    /// shading point: it is stored lit.
     pub fn value(&self, src: &GridSources, i: usize, centre: Vec3, lambda: f32) -> GridShadow {
         let x = self.point(i);
-        if !src.pyramid.hair_near(x, self.spacing) {
+        let reach = self.spacing + src.pyramid.levels.first().map_or(0.0, |l| l.voxel);
+        if !src.pyramid.hair_near(x, reach) {
             return GridShadow::default();
         }
         let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
