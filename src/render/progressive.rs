@@ -11,8 +11,7 @@
 //! camera move keeps what the shadow grid has built.
 
 use super::renderer::{RenderError, Renderer};
-use super::shading::{ShadeBatch, ShadingInputs, ShadingPass};
-use super::shadow_grid::ShadowGridInputs;
+use super::shading::{ShadeBatch, ShadingPass};
 use crate::gpu::GpuContext;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -353,12 +352,7 @@ impl Renderer {
                 self.refinement.grid_done = 0;
             }
             WorkUnit::ShadowGrid { first, count } => {
-                let inputs = ShadowGridInputs {
-                    pyramid: &self.pyramid,
-                    volume: &self.volume,
-                    forward_table: &self.forward_table,
-                    lights: &self.lights,
-                };
+                let inputs = self.shadow_grid_inputs();
                 self.shadow_grid_pass.encode(
                     device,
                     enc,
@@ -389,18 +383,7 @@ impl Renderer {
                     return;
                 };
                 let b = ShadeBatch { row0, rows, ..*b };
-                let inputs = ShadingInputs {
-                    camera: &self.camera,
-                    params: &self.params,
-                    shadow_grid: &self.shadow_grid.info,
-                    points: &self.hair.points,
-                    segments: &self.hair.segments,
-                    absorption: &self.hair.absorption,
-                    lights: &self.lights,
-                    luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
-                    shadow_values: &self.shadow_grid.values,
-                    dual_tables: &self.dual_tables,
-                };
+                let inputs = self.shading_inputs();
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
                 self.encode_resolve(device, enc);

@@ -459,6 +459,32 @@ impl Renderer {
         self.light_count
     }
 
+    /// What the shadow-grid build reads.
+    pub(super) fn shadow_grid_inputs(&self) -> ShadowGridInputs<'_> {
+        ShadowGridInputs {
+            pyramid: &self.pyramid,
+            volume: &self.volume,
+            forward_table: &self.forward_table,
+            lights: &self.lights,
+        }
+    }
+
+    /// What the shading pass reads.
+    pub(super) fn shading_inputs(&self) -> ShadingInputs<'_> {
+        ShadingInputs {
+            camera: &self.camera,
+            params: &self.params,
+            shadow_grid: &self.shadow_grid.info,
+            points: &self.hair.points,
+            segments: &self.hair.segments,
+            absorption: &self.hair.absorption,
+            lights: &self.lights,
+            luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
+            shadow_values: &self.shadow_grid.values,
+            dual_tables: &self.dual_tables,
+        }
+    }
+
     /// Encodes and submits one frame.
     pub fn render_frame(&mut self, ctx: &GpuContext) {
         let device = &ctx.device;
@@ -488,12 +514,7 @@ impl Renderer {
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
             let count = self.shadow_grid.entry_count();
-            let inputs = ShadowGridInputs {
-                pyramid: &self.pyramid,
-                volume: &self.volume,
-                forward_table: &self.forward_table,
-                lights: &self.lights,
-            };
+            let inputs = self.shadow_grid_inputs();
             self.shadow_grid_pass.encode(
                 device,
                 &mut enc,
@@ -514,18 +535,7 @@ impl Renderer {
             &self.targets,
             timer.and_then(|t| t.render_writes("visibility")),
         );
-        let inputs = ShadingInputs {
-            camera: &self.camera,
-            params: &self.params,
-            shadow_grid: &self.shadow_grid.info,
-            points: &self.hair.points,
-            segments: &self.hair.segments,
-            absorption: &self.hair.absorption,
-            lights: &self.lights,
-            luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
-            shadow_values: &self.shadow_grid.values,
-            dual_tables: &self.dual_tables,
-        };
+        let inputs = self.shading_inputs();
         self.shading_pass.encode(
             device,
             &mut enc,
