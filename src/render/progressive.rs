@@ -156,18 +156,25 @@ impl Renderer {
         self.refinement.budget = budget.max(Duration::from_micros(100));
     }
 
+    /// Whether frames read the shadow grid at all.
+    fn grid_used(&self) -> bool {
+        self.settings.shadows && self.light_count > 0
+    }
+
+    /// Whether the grid frames read is stale.
     fn grid_needed(&self) -> bool {
-        self.settings.shadows && self.light_count > 0 && self.shadow_grid_dirty
+        self.grid_used() && self.shadow_grid_dirty
     }
 
     /// Starts the frame's plan again from the first stage that a change made stale.
     pub(super) fn restart_refinement(&mut self) {
+        let grid_needed = self.grid_needed();
         let r = &mut self.refinement;
         r.rows_done = 0;
         r.stats = RefineStats::default();
         r.stage = if self.volume_dirty {
             Stage::Volume
-        } else if self.settings.shadows && self.light_count > 0 && self.shadow_grid_dirty {
+        } else if grid_needed {
             Stage::ShadowGrid
         } else {
             Stage::Visibility
@@ -242,7 +249,7 @@ impl Renderer {
         let grid_cost = r.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
         let shade_cost = r.shade_cost.unwrap_or(GUESS_SHADE_ROW_S);
         let entries = self.shadow_grid.entry_count() as f64;
-        let grid_total = if self.settings.shadows && self.light_count > 0 {
+        let grid_total = if self.grid_used() {
             entries * grid_cost
         } else {
             0.0
@@ -275,6 +282,7 @@ impl Renderer {
     fn next_unit(&mut self) -> Option<WorkUnit> {
         let height = self.settings.height;
         let batches = self.shading_pass.frame_batches().count() as u32;
+        let grid_needed = self.grid_needed();
         let r = &mut self.refinement;
         match r.stage {
             Stage::Volume => {
@@ -283,9 +291,7 @@ impl Renderer {
             }
             Stage::ShadowGrid => {
                 let total = self.shadow_grid.entry_count();
-                let needed =
-                    self.settings.shadows && self.light_count > 0 && self.shadow_grid_dirty;
-                if !needed || r.grid_done >= total {
+                if !grid_needed || r.grid_done >= total {
                     r.stage = Stage::Visibility;
                     return self.next_unit();
                 }

@@ -239,6 +239,17 @@ impl DensityPyramid {
     }
 }
 
+/// Half-angle of the central cone of [`srbf_cones`] (the cone holding half the SRBF's weight, at least
+/// 1e-4); twin of `srbf_centre_cone` in `shaders/density_pyramid.wgsl`.
+pub fn srbf_centre_cone(lambda: f32) -> f32 {
+    let kappa = 2.0 / (lambda * lambda);
+    let e = (-2.0 * kappa).exp();
+    (1.0 + (0.5 * (1.0 - e) + e).ln() / kappa)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .max(1e-4)
+}
+
 /// The cones of [`DensityPyramid::srbf_transmittance`]: (direction, half-angle, weight). One cone of
 /// half-angle max(inner, 1e-4) when the inner half of G is narrower than 0.05 rad, else the central cone
 /// (weight 1/2) and six on the ring (1/12 each).

@@ -4,7 +4,7 @@
 //! change) and read trilinearly by the shading pass, instead of once per shaded sample and light. A
 //! camera move recomputes nothing. Twin of `shaders/shadow_grid.wgsl` and `shadow_grid_build.wgsl`.
 
-use super::cone::{DensityPyramid, srbf_cones};
+use super::cone::{DensityPyramid, srbf_centre_cone, srbf_cones};
 use super::fiber_density::{FiberDensity, VolumeGrid};
 use super::forward::{ForwardScattering, ForwardTable, forward_scattering};
 use glam::Vec3;
@@ -146,7 +146,6 @@ impl ShadowGrid {
                 // The forward march's direct fraction is srbf_transmittance (the same cones, steps
                 // and sums, in the same order): d_f = d_b = 0 is single scattering up to rounding.
                 let f = srbf_forward(src.pyramid, volume, table, x, centre, lambda, src.skip);
-                let (_, half_angle, _) = srbf_cones(-centre, lambda)[0];
                 GridShadow {
                     transmittance: ln(f.direct_fraction),
                     transmittance_f: f.transmittance_f.map(ln),
@@ -154,7 +153,7 @@ impl ShadowGrid {
                     depth_behind: src.pyramid.cone_optical_depth(
                         x,
                         -centre,
-                        half_angle.max(1e-4),
+                        srbf_centre_cone(lambda),
                         src.skip,
                     ),
                 }
