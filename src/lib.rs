@@ -4,10 +4,12 @@
 // RGB loops index several per-channel arrays in lockstep (`for c in 0..3`); indices read better there.
 #![allow(clippy::needless_range_loop)]
 
+pub mod editor;
 pub mod envmap;
 pub mod gpu;
 pub mod hair;
 pub mod paint;
 pub mod render;
 pub mod scattering;
+pub mod session;
 pub mod shadow;

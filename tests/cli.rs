@@ -24,11 +24,31 @@ fn run_with_stdin<A: AsRef<std::ffi::OsStr>>(
 }
 
 #[test]
-fn no_subcommand_lists_the_subcommands() {
-    let out = strandlight().output().unwrap();
+fn help_lists_the_subcommands() {
+    let out = strandlight().arg("--help").output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("bsdf") && text.contains("gpu-info"), "{text}");
+    assert!(
+        text.contains("bsdf") && text.contains("gpu-info") && text.contains("edit"),
+        "{text}"
+    );
+}
+
+#[test]
+fn without_a_display_the_editor_says_so_in_one_line() {
+    for args in [&[][..], &["edit"][..]] {
+        let out = strandlight()
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let text = String::from_utf8_lossy(&out.stderr);
+        println!("{text}");
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+        assert!(text.contains("no display") && text.contains("strandlight render"));
+    }
 }
 
 #[test]

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;
+pub mod edit;
 pub mod fit_env;
 pub mod gpu_info;
 pub mod info;
@@ -26,6 +27,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Open the editor (the default without a subcommand): a window where hair looks are designed live.
+    Edit(edit::EditArgs),
     /// Evaluate the exact Marschner scattering function S_R, S_TT, S_TRT for given angles (JSON).
     Bsdf(Box<bsdf::BsdfArgs>),
     /// Describe a hair file: counts, bounds, detected up axis and units, lengths, optional arrays (JSON).
@@ -58,6 +61,7 @@ pub enum Command {
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Some(Command::Edit(args)) => edit::run_editor(args),
         Some(Command::Bsdf(args)) => bsdf::run(*args),
         Some(Command::Info(args)) => info::run(args),
         Some(Command::MakeHair(args)) => make_hair::run(args),
@@ -70,12 +74,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Render(args)) => render::run(*args),
         Some(Command::Bench(args)) => bench::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
-        None => {
-            // The editor will open here once it exists; until then, say what there is.
-            use clap::CommandFactory;
-            Cli::command().print_help()?;
-            println!();
-            Ok(())
-        }
+        None => edit::run_editor(edit::EditArgs {
+            lights: 40,
+            ..Default::default()
+        }),
     }
 }

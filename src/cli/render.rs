@@ -6,23 +6,27 @@ use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::hair::load::{LoadOptions, load_hair};
 use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
-use strandlight::paint::{AbsorptionSpec, PaintLayer, sigma_a_from_colour};
 use strandlight::render::camera::CAMERA_PRESETS;
 use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
-use strandlight::render::scene::{
-    Environment, default_environment, generated_hair, load_environment,
-};
-use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
+use strandlight::render::{Camera, Renderer};
 use strandlight::scattering::lut::Luts;
+use strandlight::session::assemble::{StillHeader, still_attributes};
+use strandlight::session::{
+    Absorption, EnvironmentSource, HairSource, Look, RenderOptions, SESSION_VERSION, Scene,
+    Session, ViewCamera,
+};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
+    /// A session saved by the editor (.slsession): hair, environment, look, camera and render settings
+    /// come from it, and the scene flags below are ignored (outputs, --reference and --software apply).
+    #[arg(long)]
+    pub session: Option<PathBuf>,
     /// Hair file (.hair, .tfx, .gltf, .glb); default: a generated wavy hairstyle (10k strands).
     #[arg(long)]
     pub hair: Option<PathBuf>,
@@ -156,38 +160,95 @@ pub enum ReferenceMode {
     Path,
 }
 
-/// The per-point absorption (preset or dye, gradient, per-strand variation, paint layer) and the
-/// parameters with sigma_a set to its mean (the dual-scattering tables' absorption).
-fn absorption(
-    args: &RenderArgs,
-    hair: &strandlight::hair::Hair,
-    mut params: strandlight::scattering::HairParams,
-) -> anyhow::Result<(Vec<[f32; 3]>, strandlight::scattering::HairParams)> {
-    let base = params.sigma_a.map(|x| x as f32);
-    let dye = |c: &Option<String>| -> anyhow::Result<Option<[f32; 3]>> {
+/// The session the scene flags describe (the editor's sessions are read with `--session`).
+fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
+    let params = args.params.resolve()?;
+    let dye = |c: &Option<String>| -> anyhow::Result<Option<Absorption>> {
         c.as_deref()
             .map(|s| {
                 let colour = parse_colour(s).map_err(anyhow::Error::msg)?;
-                Ok(sigma_a_from_colour(colour, args.beta_n).map(|x| x as f32))
+                Ok(Absorption::Dye {
+                    colour,
+                    beta_n: args.beta_n,
+                })
             })
             .transpose()
     };
-    let whole = dye(&args.dye)?.unwrap_or(base);
-    let spec = AbsorptionSpec {
-        root: dye(&args.dye_root)?.unwrap_or(whole),
-        tip: dye(&args.dye_tip)?.unwrap_or(whole),
-        variation: args.strand_variation.max(0.0),
-        seed: args.seed,
-    };
-    let mut sigma_a = spec.per_point(hair);
-    if let Some(path) = &args.paint {
-        PaintLayer::read(path)?.apply(&mut sigma_a, hair.strand_count(), path)?;
+    let whole = dye(&args.dye)?.unwrap_or(Absorption::SigmaA {
+        sigma_a: params.sigma_a,
+    });
+    let (preset_yaw, preset_pitch) = Camera::preset(&args.camera).with_context(|| {
+        let names: Vec<&str> = CAMERA_PRESETS.iter().map(|p| p.0).collect();
+        format!(
+            "unknown camera preset '{}' (one of {})",
+            args.camera,
+            names.join(", ")
+        )
+    })?;
+    if !(args.fov > 1.0 && args.fov < 170.0) {
+        bail!("--fov must lie in (1, 170) degrees");
     }
-    let n = sigma_a.len().max(1) as f64;
-    for c in 0..3 {
-        params.sigma_a[c] = sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n;
+    if let Some(d) = args.distance
+        && !(d > 0.0 && d.is_finite())
+    {
+        bail!("--distance must be positive");
     }
-    Ok((sigma_a, params))
+    if !(0.0..=1.0).contains(&args.d_f) || !(0.0..=1.0).contains(&args.d_b) {
+        bail!("--d-f and --d-b lie in [0, 1]");
+    }
+    Ok(Session {
+        version: SESSION_VERSION,
+        hair: match &args.hair {
+            Some(path) => HairSource::File {
+                path: path.clone(),
+                blake3: None,
+            },
+            None => HairSource::Generated {
+                style: args.style.unwrap_or(Style::Wavy),
+                strands: args.strands,
+                points: args.points,
+                seed: 1,
+            },
+        },
+        environment: match &args.env {
+            Some(path) => EnvironmentSource::File {
+                path: path.clone(),
+                lights: args.lights,
+                blake3: None,
+                fitted: None,
+            },
+            None => EnvironmentSource::Builtin,
+        },
+        env_yaw: args.env_yaw,
+        look: Look {
+            params,
+            root: dye(&args.dye_root)?.unwrap_or(whole),
+            tip: Some(dye(&args.dye_tip)?.unwrap_or(whole)),
+            strand_variation: args.strand_variation.max(0.0),
+            variation_seed: args.seed,
+            d_f: args.d_f,
+            d_b: args.d_b,
+            longitudinal: args.params.longitudinal.unwrap_or_default(),
+        },
+        camera: ViewCamera {
+            yaw: args.yaw.unwrap_or(preset_yaw),
+            pitch: args.pitch.unwrap_or(preset_pitch),
+            fov_y: args.fov,
+            target: None,
+            distance: args.distance,
+        },
+        render: RenderOptions {
+            width: args.width,
+            height: args.height,
+            samples: args.samples,
+            exposure: args.exposure,
+            shadows: !args.no_shadows,
+            multiple_scattering: !args.single_scattering,
+            volume_resolution: args.volume_resolution,
+            shadow_grid_resolution: args.shadow_grid,
+        },
+        paint: args.paint.clone(),
+    })
 }
 
 /// Fails before any rendering when an output could not be written: its folder must exist.
@@ -214,83 +275,30 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     }
     let outputs: Vec<&PathBuf> = args.output.iter().chain(args.png.iter()).collect();
     check_outputs(&outputs)?;
-    let params = args.params.resolve()?;
-    let (hair, hair_name) = match &args.hair {
-        Some(path) => {
-            let loaded = load_hair(path, &LoadOptions::default())?;
-            (loaded.file.hair, path.display().to_string())
-        }
-        None => {
-            let style = args.style.unwrap_or(Style::Wavy);
-            (
-                generated_hair(style, args.strands, args.points, 1),
-                format!("generated {style:?} {}x{}", args.strands, args.points),
-            )
-        }
+    let session = match &args.session {
+        Some(path) => Session::read(path)?,
+        None => session_from_args(&args)?,
     };
-    if hair.strand_count() == 0 {
-        bail!("{hair_name}: no strands to render");
+    let scene = Scene::assemble(&session)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
     }
-    let mut env: Environment = match &args.env {
-        Some(p) => load_environment(p, args.lights)
-            .with_context(|| format!("loading the environment {}", p.display()))?,
-        None => default_environment(),
-    };
-    if args.env_yaw != 0.0 {
-        env.lights = env.lights.rotated(args.env_yaw.to_radians());
-    }
-    let (preset_yaw, preset_pitch) = Camera::preset(&args.camera).with_context(|| {
-        let names: Vec<&str> = CAMERA_PRESETS.iter().map(|p| p.0).collect();
-        format!(
-            "unknown camera preset '{}' (one of {})",
-            args.camera,
-            names.join(", ")
-        )
-    })?;
-    let (lo, hi) = hair.bounds();
-    let aspect = args.width as f32 / args.height.max(1) as f32;
-    let mut camera = Camera::framing(
-        lo,
-        hi,
-        args.yaw.unwrap_or(preset_yaw),
-        args.pitch.unwrap_or(preset_pitch),
-        aspect,
-        0.9,
-    );
-    if !(args.fov > 1.0 && args.fov < 170.0) {
-        bail!("--fov must lie in (1, 170) degrees");
-    }
-    camera.fov_y = args.fov;
-    if let Some(d) = args.distance {
-        if !(d > 0.0 && d.is_finite()) {
-            bail!("--distance must be positive");
-        }
-        camera.distance = d;
-    }
-    let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
-        samples: args.samples,
-        exposure: args.exposure,
-        shadows: !args.no_shadows,
-        multiple_scattering: !args.single_scattering,
-        lights_per_pass: args.lights_per_pass,
-        volume_resolution: args.volume_resolution,
-        shadow_grid_resolution: args.shadow_grid,
-        ..Default::default()
-    };
+    let Scene {
+        hair,
+        hair_name,
+        environment: env,
+        sigma_a,
+        look,
+        camera,
+        mut settings,
+        ..
+    } = scene;
+    settings.lights_per_pass = args.lights_per_pass;
     let mut options = GpuOptions::from_env();
     options.force_software |= args.software;
     let ctx = GpuContext::new_headless(&options)?;
     eprintln!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
     let luts = Luts::default_tables();
-    if !(0.0..=1.0).contains(&args.d_f) || !(0.0..=1.0).contains(&args.d_b) {
-        bail!("--d-f and --d-b lie in [0, 1]");
-    }
-    let (sigma_a, params) = absorption(&args, &hair, params)?;
-    let look = HairLook::new(params)
-        .with_dual(args.d_f, args.d_b)
-        .with_longitudinal(args.params.longitudinal.unwrap_or_default());
     let t = Instant::now();
     let mut renderer = Renderer::new(
         &ctx,
@@ -313,8 +321,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     }
     eprintln!(
         "rendered {}x{} ({} strands, {} lights) in {:.2} s",
-        args.width,
-        args.height,
+        settings.width,
+        settings.height,
         hair.strand_count(),
         env.lights.lights.len(),
         t.elapsed().as_secs_f64()
@@ -384,36 +392,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
         mode = format!("reference ({directions} directions from the {source}; {what})");
     }
-    let attributes = vec![
-        ("hair".to_string(), hair_name),
-        ("environment".to_string(), env.name.clone()),
-        ("lights".to_string(), env.lights.lights.len().to_string()),
-        ("params".to_string(), serde_json::to_string(&params)?),
-        (
-            "longitudinal".to_string(),
-            serde_json::to_string(&look.longitudinal())?,
-        ),
-        (
-            "absorption".to_string(),
-            format!(
-                "dye {:?}, root {:?}, tip {:?}, strand variation {}, seed {}, paint {:?}",
-                args.dye, args.dye_root, args.dye_tip, args.strand_variation, args.seed, args.paint
-            ),
-        ),
-        ("camera".to_string(), serde_json::to_string(&camera)?),
-        ("exposure_ev".to_string(), args.exposure.to_string()),
-        ("samples".to_string(), args.samples.to_string()),
-        ("shadows".to_string(), (!args.no_shadows).to_string()),
-        (
-            "multiple_scattering".to_string(),
-            format!(
-                "{} (d_f {}, d_b {})",
-                !args.single_scattering, args.d_f, args.d_b
-            ),
-        ),
-        ("adapter".to_string(), ctx.summary.name.clone()),
-        ("mode".to_string(), mode),
-    ];
+    let attributes = still_attributes(
+        &session,
+        &StillHeader {
+            hair_name: &hair_name,
+            environment: &env,
+            look: &look,
+            camera: &camera,
+            settings: &settings,
+            adapter: &ctx.summary.name,
+            mode: &mode,
+        },
+    );
     if let Some(o) = &args.output {
         frame.write_exr(o, &attributes, args.aovs)?;
         eprintln!("wrote {}", o.display());

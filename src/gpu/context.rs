@@ -55,6 +55,7 @@ impl AdapterSummary {
 }
 
 /// A device and queue, with the adapter they came from.
+#[derive(Clone)]
 pub struct GpuContext {
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
@@ -79,19 +80,12 @@ impl GpuContext {
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
         let summary = AdapterSummary::new(&info);
-        let wanted = wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::FLOAT32_FILTERABLE;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("strandlight device"),
-            required_features: adapter.features() & wanted,
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|source| GpuError::RequestDevice {
-            adapter: summary.name.clone(),
-            source,
-        })?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&Self::device_descriptor(&adapter)))
+                .map_err(|source| GpuError::RequestDevice {
+                    adapter: summary.name.clone(),
+                    source,
+                })?;
         Ok(Self {
             instance,
             adapter,
@@ -99,6 +93,36 @@ impl GpuContext {
             queue,
             summary,
         })
+    }
+
+    /// A context around a device someone else created (the editor's, shared with egui).
+    pub fn from_parts(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        let summary = AdapterSummary::new(&adapter.get_info());
+        Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            summary,
+        }
+    }
+
+    /// The features and limits the renderer asks of `adapter` (eframe must request the same).
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::FLOAT32_FILTERABLE;
+        wgpu::DeviceDescriptor {
+            label: Some("strandlight device"),
+            required_features: adapter.features() & wanted,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }
     }
 
     /// Copies `buffer` (which needs COPY_SRC) into a mappable buffer after the work already submitted,

@@ -2,6 +2,7 @@
 //! self-shadowing, resolve; shared by `strandlight render`, `bench` and the editor.
 
 pub mod camera;
+pub mod display;
 pub mod frame;
 pub mod path_trace;
 pub mod progressive;

@@ -2,11 +2,12 @@
 //! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
 //! are sized from the measured cost of the units before them to a time budget, so egui, which shares the
 //! queue, does not wait behind a long submission (the volume and visibility units are whole passes, not
-//! sized; a unit of one row or one grid entry can still pass the budget). The units run in the order `render_frame` encodes its passes: the fiber-density volume
-//! (when geometry or absorption changed), the shadow grid in ranges of (grid point, light) entries
-//! (when the volume, the lights or the forward table changed), visibility, then every shading batch
-//! (a light batch at one visibility sample) in bands of rows, each band followed by a resolve so the
-//! image fills in. Every pixel takes its batches in `render_frame`'s order, so the converged image is
+//! sized; a unit of one row or one grid entry can still pass the budget). The units: the fiber-density
+//! volume (when geometry or absorption changed), the shadow grid in ranges of (light, grid point)
+//! entries (when the volume, the lights or the forward table changed), visibility, then every shading
+//! batch (a light batch at one visibility sample) in bands of rows, each band followed by a resolve so
+//! the image fills in; the grid's entries for a light batch are built just before the first shading
+//! batch that reads them, so the image appears after one light batch's grid, not the whole grid. Every pixel takes its batches in `render_frame`'s order, so the converged image is
 //! `render_frame`'s bit for bit. A change (parameters, camera, lights, absorption) restarts the plan; a
 //! camera move keeps what the shadow grid has built.
 
@@ -278,36 +279,59 @@ impl Renderer {
         }
     }
 
-    /// The next unit of the plan (sized to the budget); advances the plan past it.
+    /// Shadow-grid entries that shading batch `batch` reads: the grid is light-major (entry =
+    /// light * points + point), so the lights up to the batch's last.
+    fn grid_entries_for(&self, batch: u32) -> u32 {
+        let total = self.shadow_grid.entry_count();
+        match self.shading_pass.frame_batches().nth(batch as usize) {
+            Some(b) => {
+                ((b.first + b.count) * self.shadow_grid.grid.point_count() as u32).min(total)
+            }
+            None => total,
+        }
+    }
+
+    /// A shadow-grid unit towards `target` entries, or None when they are built.
+    fn grid_unit(&mut self, target: u32) -> Option<WorkUnit> {
+        let r = &mut self.refinement;
+        if r.grid_done >= target {
+            return None;
+        }
+        let count = r.items(
+            r.grid_cost,
+            GUESS_GRID_ENTRY_S,
+            r.grid_last,
+            target - r.grid_done,
+        );
+        r.grid_last = count;
+        let first = r.grid_done;
+        r.grid_done += count;
+        Some(WorkUnit::ShadowGrid { first, count })
+    }
+
+    /// The next unit of the plan (sized to the budget); advances the plan past it. The shadow grid is
+    /// built light batch by light batch, each just before the first shading batch that reads it: the
+    /// first light batch's part before the visibility pass clears the image (the last image stays on
+    /// screen meanwhile), the others between shading batches, so the image fills in light batch by
+    /// light batch instead of after the whole grid.
     fn next_unit(&mut self) -> Option<WorkUnit> {
         let height = self.settings.height;
         let batches = self.shading_pass.frame_batches().count() as u32;
         let grid_needed = self.grid_needed();
-        let r = &mut self.refinement;
-        match r.stage {
+        match self.refinement.stage {
             Stage::Volume => {
-                r.stage = Stage::ShadowGrid;
+                self.refinement.stage = Stage::ShadowGrid;
                 Some(WorkUnit::Volume)
             }
             Stage::ShadowGrid => {
-                let total = self.shadow_grid.entry_count();
-                if !grid_needed || r.grid_done >= total {
-                    r.stage = Stage::Visibility;
-                    return self.next_unit();
+                if grid_needed && let Some(unit) = self.grid_unit(self.grid_entries_for(0)) {
+                    return Some(unit);
                 }
-                let count = r.items(
-                    r.grid_cost,
-                    GUESS_GRID_ENTRY_S,
-                    r.grid_last,
-                    total - r.grid_done,
-                );
-                r.grid_last = count;
-                let first = r.grid_done;
-                r.grid_done += count;
-                Some(WorkUnit::ShadowGrid { first, count })
+                self.refinement.stage = Stage::Visibility;
+                self.next_unit()
             }
             Stage::Visibility => {
-                r.stage = if batches == 0 {
+                self.refinement.stage = if batches == 0 {
                     Stage::Converged
                 } else {
                     Stage::Shade { batch: 0, row: 0 }
@@ -315,6 +339,13 @@ impl Renderer {
                 Some(WorkUnit::Visibility)
             }
             Stage::Shade { batch, row } => {
+                if grid_needed
+                    && row == 0
+                    && let Some(unit) = self.grid_unit(self.grid_entries_for(batch))
+                {
+                    return Some(unit);
+                }
+                let r = &mut self.refinement;
                 let mut rows = r.items(r.shade_cost, GUESS_SHADE_ROW_S, r.shade_last, height - row);
                 // Whole workgroups (8 rows) where the budget allows.
                 if rows >= 8 && rows < height - row {

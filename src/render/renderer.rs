@@ -93,7 +93,8 @@ impl HairLook {
 
 /// The tables that depend on hair parameters and are built on the CPU: the forward table (eta, alpha,
 /// beta; read per crossed fiber's absorption) and the dual-scattering tables (all parameters).
-fn build_tables(params: &HairParams) -> (ForwardTable, DualTables) {
+/// The editor builds them on a worker thread ([`Renderer::set_params_deferred`], [`Renderer::set_tables`]).
+pub fn build_tables(params: &HairParams) -> (ForwardTable, DualTables) {
     rayon::join(
         || ForwardTable::build(params, REFERENCE_VARIANT),
         || DualTables::build(params, REFERENCE_VARIANT),
@@ -178,10 +179,14 @@ pub struct Renderer {
     pub(super) shadow_grid: GpuShadowGrid,
     pub(super) luts: GpuLuts,
     pub(super) look: HairLook,
+    /// The exact parameters the forward and dual tables were built for.
+    pub(super) tables_for: HairParams,
     pub(super) params: wgpu::Buffer,
     pub(super) forward_table: wgpu::Buffer,
     pub(super) dual_tables: wgpu::Buffer,
     pub(super) camera: wgpu::Buffer,
+    /// The camera the uniform was made from (rewritten when the image size changes).
+    pub(super) camera_view: Camera,
     pub(super) lights: wgpu::Buffer,
     pub(super) light_count: u32,
     pub(super) resolve_info: wgpu::Buffer,
@@ -294,6 +299,7 @@ impl Renderer {
             shadow_grid,
             luts: GpuLuts::new(device, luts),
             look: *look,
+            tables_for: look.params,
             params: uniform("hair params", bytemuck::bytes_of(&look.fast)),
             forward_table: upload_forward_table(device, &forward),
             dual_tables: storage(
@@ -301,6 +307,7 @@ impl Renderer {
                 bytemuck::cast_slice(&dual_tables_texels(&dual)),
             ),
             camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
+            camera_view: *camera,
             lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("lights"),
                 contents: bytemuck::cast_slice(&gpu_lights(lights)),
@@ -363,8 +370,9 @@ impl Renderer {
     pub fn set_params(&mut self, ctx: &GpuContext, look: &HairLook) {
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
-        if look.params != self.look.params {
+        if look.params != self.tables_for {
             let (forward, dual) = build_tables(&look.params);
+            self.tables_for = look.params;
             ctx.queue.write_buffer(
                 &self.forward_table,
                 0,
@@ -383,7 +391,52 @@ impl Renderer {
         self.restart_refinement();
     }
 
+    /// Hair parameters changed, without waiting for the tables: the uniform is rewritten now (single
+    /// scattering shows the change in the next frame); returns true when the exact parameters changed,
+    /// and then the caller builds the tables ([`build_tables`], off the UI thread) and hands them to
+    /// [`Renderer::set_tables`]. Until then multiple scattering and forward transmittance use the old
+    /// tables.
+    pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
+        let tables_needed = look.params != self.tables_for;
+        self.look = *look;
+        self.restart_refinement();
+        tables_needed
+    }
+
+    /// Uploads tables built for `params`; ignored (false) when the look has moved on since.
+    pub fn set_tables(
+        &mut self,
+        ctx: &GpuContext,
+        params: &HairParams,
+        forward: &ForwardTable,
+        dual: &DualTables,
+    ) -> bool {
+        if *params != self.look.params {
+            return false;
+        }
+        ctx.queue.write_buffer(
+            &self.forward_table,
+            0,
+            bytemuck::cast_slice(&forward_table_texels(forward)),
+        );
+        ctx.queue.write_buffer(
+            &self.dual_tables,
+            0,
+            bytemuck::cast_slice(&dual_tables_texels(dual)),
+        );
+        self.tables_for = *params;
+        if self.settings.multiple_scattering {
+            self.mark_shadow_grid_dirty();
+        } else {
+            self.restart_refinement();
+        }
+        true
+    }
+
     pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) {
+        self.camera_view = *camera;
         let u = camera.uniform(
             self.settings.width,
             self.settings.height,
@@ -457,6 +510,79 @@ impl Renderer {
 
     pub fn light_count(&self) -> u32 {
         self.light_count
+    }
+
+    /// The image size changed (the editor's viewport): new frame targets and shading bands; the
+    /// volume and the shadow grid are kept.
+    pub fn set_size(
+        &mut self,
+        ctx: &GpuContext,
+        width: u32,
+        height: u32,
+    ) -> Result<(), RenderError> {
+        let max = ctx.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(RenderError::Size(width, height, max));
+        }
+        if (width, height) == (self.settings.width, self.settings.height) {
+            return Ok(());
+        }
+        self.settings.width = width;
+        self.settings.height = height;
+        self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
+        // The camera uniform holds the image size (projection aspect, pixel rays).
+        let camera = self.camera_view;
+        self.set_camera(ctx, &camera);
+        self.update_batches(&ctx.device);
+        Ok(())
+    }
+
+    /// Shadows and multiple scattering on or off (no rebuild of anything but the batches; the grid
+    /// is built when first needed).
+    pub fn set_toggles(&mut self, ctx: &GpuContext, shadows: bool, multiple_scattering: bool) {
+        if (shadows, multiple_scattering)
+            == (self.settings.shadows, self.settings.multiple_scattering)
+        {
+            return;
+        }
+        if multiple_scattering != self.settings.multiple_scattering {
+            // The grid's layout (and what it holds) depends on multiple scattering.
+            self.shadow_grid = GpuShadowGrid::new(
+                &ctx.device,
+                self.shadow_grid.grid,
+                self.light_count,
+                self.skip,
+                multiple_scattering,
+            );
+            self.shadow_grid_dirty = true;
+            self.refinement.grid_done = 0;
+        }
+        self.settings.shadows = shadows;
+        self.settings.multiple_scattering = multiple_scattering;
+        self.update_batches(&ctx.device);
+    }
+
+    /// Exposure in stops applied by the resolve pass (and by `read_frame`).
+    pub fn set_exposure(&mut self, ctx: &GpuContext, exposure: f32) {
+        self.settings.exposure = exposure;
+        let info = ResolveInfo {
+            exposure_scale: exposure.exp2(),
+            samples: self.settings.samples,
+            _pad: [0; 2],
+        };
+        ctx.queue
+            .write_buffer(&self.resolve_info, 0, bytemuck::bytes_of(&info));
+        self.restart_refinement();
+    }
+
+    /// The frame's targets (the display pass reads the beauty).
+    pub fn targets(&self) -> &FrameTargets {
+        &self.targets
+    }
+
+    /// The hair parameters the renderer holds.
+    pub fn look(&self) -> &HairLook {
+        &self.look
     }
 
     /// What the shadow-grid build reads.

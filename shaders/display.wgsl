@@ -1,0 +1,70 @@
+// Display pass: the resolved beauty (linear, premultiplied by coverage) through the viewport's view
+// transform into an 8-bit sRGB-encoded image over a flat background (egui samples it as Rgba8Unorm).
+// The EXR never passes here. CPU twin: render/display.rs (`display_pixel`).
+
+struct DisplayInfo {
+    width: u32,
+    height: u32,
+    // 0: standard (clamp), 1: filmic (Narkowicz's ACES fit).
+    transform: u32,
+    // 0: the beauty; 1: one component (the `component` binding: R, TT, TRT, MS.global or MS.local) alone.
+    solo: u32,
+    // 2^EV of the viewport exposure (on top of the render's).
+    exposure_scale: f32,
+    // 2^EV of the render's exposure (the beauty has it; the components do not).
+    render_scale: f32,
+    // Background, display-encoded.
+    background: vec3<f32>,
+}
+
+@group(0) @binding(0) var<uniform> info: DisplayInfo;
+@group(0) @binding(1) var<storage, read> beauty: array<vec4<f32>>;
+@group(0) @binding(2) var image: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(3) var<storage, read> component: array<vec4<f32>>;
+
+fn aces_filmic(x: f32) -> f32 {
+    let y = max(x, 0.0) * 0.6;
+    return clamp((y * (2.51 * y + 0.03)) / (y * (2.43 * y + 0.59) + 0.14), 0.0, 1.0);
+}
+
+fn srgb_encode(x: f32) -> f32 {
+    if x <= 0.0031308 {
+        return 12.92 * x;
+    }
+    return 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+}
+
+fn view_transform(x: f32, transform: u32) -> f32 {
+    if transform == 1u {
+        return srgb_encode(aces_filmic(x));
+    }
+    return srgb_encode(clamp(x, 0.0, 1.0));
+}
+
+// `beauty_px`: the beauty (its alpha is the coverage); `solo_px`: the solo component.
+fn display_pixel(beauty_px: vec4<f32>, solo_px: vec4<f32>) -> vec4<f32> {
+    var p = beauty_px;
+    if info.solo == 1u {
+        p = vec4<f32>(info.render_scale * solo_px.xyz, beauty_px.w);
+    }
+    let a = clamp(p.w, 0.0, 1.0);
+    var un = 0.0;
+    if p.w > 0.0 {
+        un = info.exposure_scale / p.w;
+    }
+    let c = vec3<f32>(
+        view_transform(p.x * un, info.transform),
+        view_transform(p.y * un, info.transform),
+        view_transform(p.z * un, info.transform),
+    );
+    return vec4<f32>(mix(info.background, c, a), 1.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn display(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= info.width || id.y >= info.height {
+        return;
+    }
+    let i = id.y * info.width + id.x;
+    textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i]));
+}

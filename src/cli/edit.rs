@@ -1,0 +1,44 @@
+//! `strandlight edit` (and `strandlight` alone): opens the editor on a session, a hair file and an
+//! environment, or the default scene.
+
+use clap::Args;
+use std::path::PathBuf;
+use strandlight::editor::{EditorOptions, run};
+use strandlight::session::{EnvironmentSource, HairSource, Session};
+
+#[derive(Args, Debug, Default)]
+pub struct EditArgs {
+    /// A session file (.slsession) to open.
+    pub session: Option<PathBuf>,
+    /// Hair file (.hair, .tfx, .gltf, .glb) instead of the generated default.
+    #[arg(long, conflicts_with = "session")]
+    pub hair: Option<PathBuf>,
+    /// Environment (.hdr, .exr, .srbf.json) instead of the built-in sunny sky.
+    #[arg(long, conflicts_with = "session")]
+    pub env: Option<PathBuf>,
+    /// SRBF lights fitted to an .hdr / .exr environment.
+    #[arg(long, default_value_t = 40)]
+    pub lights: usize,
+}
+
+pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
+    let mut session = Session::default();
+    if let Some(path) = args.hair {
+        let blake3 = strandlight::session::assemble::file_blake3(&path).ok();
+        session.hair = HairSource::File { path, blake3 };
+    }
+    if let Some(path) = args.env {
+        session.environment = EnvironmentSource::File {
+            blake3: strandlight::session::assemble::file_blake3(&path).ok(),
+            path,
+            lights: args.lights.max(1),
+            fitted: None,
+        };
+    }
+    run(EditorOptions {
+        session_path: args.session,
+        session: Some(session),
+        offer_recovery: true,
+        state_dir: None,
+    })
+}

@@ -1,0 +1,711 @@
+//! The editor's state and frame loop: the document (session, path, history), the editor state
+//! (camera, view, messages), the live scene and the background jobs. Panels read a per-frame view of
+//! this and return [`Edit`]s; [`EditorApp::perform`] is the one place edits are applied.
+
+use super::autosave::Autosave;
+use super::export::ExportJob;
+use super::jobs::Job;
+use super::live::{LiveScene, ViewSettings};
+use super::navigation;
+use super::panels;
+use crate::gpu::GpuContext;
+use crate::render::Camera;
+use crate::render::scene::Environment;
+use crate::scattering::lut::Luts;
+use crate::session::assemble::{LoadedHairSource, load_environment_source, load_hair_source};
+use crate::session::{Edit, EnvironmentSource, HairSource, History, Session, ViewCamera};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What started the editor.
+#[derive(Clone, Debug, Default)]
+pub struct EditorOptions {
+    /// A session to open.
+    pub session_path: Option<PathBuf>,
+    /// The session to start from when no file is given (the default scene, or `--hair` / `--env`).
+    pub session: Option<Session>,
+    /// Offer the recovery file when one is found (off in tests that do not want the prompt).
+    pub offer_recovery: bool,
+    /// Where recovery files go (default [`crate::session::io::state_dir`]).
+    pub state_dir: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    Info,
+    Warning,
+    Error,
+}
+
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub level: Level,
+    pub text: String,
+    pub at: Instant,
+}
+
+/// What a load job brings back.
+pub enum Loaded {
+    /// Hair and environment for a new scene.
+    Scene {
+        hair: LoadedHairSource,
+        environment: Environment,
+        warnings: Vec<String>,
+    },
+    /// A hair file that loaded: it becomes the session's hair (an edit) and the scene is rebuilt.
+    Hair {
+        hair: LoadedHairSource,
+        source: HairSource,
+    },
+    /// A new environment; applied as an edit when it arrives.
+    Environment {
+        environment: Environment,
+        source: EnvironmentSource,
+    },
+}
+
+pub struct EditorApp {
+    pub session: Session,
+    pub session_path: Option<PathBuf>,
+    pub history: History,
+    /// The session as last saved or opened ("modified" compares against it).
+    pub saved: Session,
+    pub camera: Option<Camera>,
+    pub view: ViewSettings,
+    pub live: Option<LiveScene>,
+    pub messages: Vec<Message>,
+    pub gpu: Option<GpuContext>,
+    egui_renderer: Option<Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>>,
+    luts: Arc<Luts>,
+    pub loading: Option<Job<Result<Loaded, String>>>,
+    /// The session a scene load was started for (a newer request supersedes it).
+    loading_for: Option<Session>,
+    pub autosave: Autosave,
+    pub recovery_offer: Option<(PathBuf, Session)>,
+    /// Sessions opened or saved lately, newest first (kept in the state folder).
+    pub recent: Vec<PathBuf>,
+    state_dir: PathBuf,
+    pub export: Option<ExportJob>,
+    /// The viewport's size in physical pixels and its rectangle in points (last frame).
+    pub viewport_px: [u32; 2],
+    pub viewport_rect: Option<egui::Rect>,
+    /// Smoothed UI frame time.
+    pub frame_ms: f32,
+    last_frame: Option<Instant>,
+    ctx: egui::Context,
+}
+
+impl EditorApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> Self {
+        let gpu = cc.wgpu_render_state.as_ref().map(|rs| {
+            GpuContext::from_parts(
+                rs.instance.clone(),
+                rs.adapter.clone(),
+                rs.device.clone(),
+                rs.queue.clone(),
+            )
+        });
+        let egui_renderer = cc.wgpu_render_state.as_ref().map(|rs| rs.renderer.clone());
+        install_fonts(&cc.egui_ctx);
+        let mut messages = Vec::new();
+        let mut session_path = None;
+        let mut session = options.session.clone().unwrap_or_default();
+        if let Some(path) = &options.session_path {
+            match Session::read(path) {
+                Ok(s) => {
+                    session = s;
+                    session_path = Some(path.clone());
+                }
+                Err(e) => messages.push(Message {
+                    level: Level::Error,
+                    text: e.to_string(),
+                    at: Instant::now(),
+                }),
+            }
+        }
+        if gpu.is_none() {
+            messages.push(Message {
+                level: Level::Error,
+                text: "eframe gave no wgpu device: the viewport cannot render".into(),
+                at: Instant::now(),
+            });
+        }
+        let state_dir = options
+            .state_dir
+            .clone()
+            .unwrap_or_else(crate::session::io::state_dir);
+        let autosave = Autosave::new(state_dir.clone(), session_path.as_deref());
+        let recent = read_recent(&state_dir);
+        let recovery_offer = if options.offer_recovery {
+            autosave.recovery_found()
+        } else {
+            None
+        };
+        let mut app = Self {
+            saved: session.clone(),
+            session,
+            session_path,
+            history: History::default(),
+            camera: None,
+            view: ViewSettings::default(),
+            live: None,
+            messages,
+            gpu,
+            egui_renderer,
+            luts: Arc::new(Luts::default_tables()),
+            loading: None,
+            loading_for: None,
+            autosave,
+            recovery_offer,
+            recent,
+            state_dir,
+            export: None,
+            viewport_px: [640, 400],
+            viewport_rect: None,
+            frame_ms: 0.0,
+            last_frame: None,
+            ctx: cc.egui_ctx.clone(),
+        };
+        app.load_scene();
+        app
+    }
+
+    pub fn luts(&self) -> &Luts {
+        &self.luts
+    }
+
+    pub fn message(&mut self, level: Level, text: impl Into<String>) {
+        let text = text.into();
+        match level {
+            Level::Error => eprintln!("error: {text}"),
+            Level::Warning => eprintln!("warning: {text}"),
+            Level::Info => {}
+        }
+        self.messages.push(Message {
+            level,
+            text,
+            at: Instant::now(),
+        });
+        if self.messages.len() > 50 {
+            self.messages.remove(0);
+        }
+    }
+
+    /// Whether the session differs from the file it was opened from or saved to.
+    pub fn modified(&self) -> bool {
+        self.session != self.saved
+    }
+
+    /// Applies an edit as an undo step (`gesture`: part of a drag that continues).
+    pub fn perform(&mut self, edit: Edit, gesture: bool) {
+        if self.history.perform(&mut self.session, edit, gesture) {
+            self.autosave.changed();
+        }
+    }
+
+    pub fn undo(&mut self) {
+        if self.history.undo(&mut self.session).is_some() {
+            self.autosave.changed();
+        }
+    }
+
+    pub fn redo(&mut self) {
+        if self.history.redo(&mut self.session).is_some() {
+            self.autosave.changed();
+        }
+    }
+
+    /// Loads the session's hair and environment off the UI thread; the live scene is rebuilt when
+    /// they arrive.
+    pub fn load_scene(&mut self) {
+        let hair = self.session.hair.clone();
+        let env = self.session.environment.clone();
+        let ctx = self.ctx.clone();
+        self.loading_for = Some(self.session.clone());
+        self.loading = Some(Job::spawn(
+            "loading the scene",
+            move || ctx.request_repaint(),
+            move |_| {
+                // A missing or broken source is reported and the rest of the session opens (the
+                // session keeps pointing at the file).
+                let mut warnings = Vec::new();
+                let hair = match load_hair_source(&hair) {
+                    Ok(h) => h,
+                    Err(e) => {
+                        warnings.push(format!("{e}; showing the default hairstyle instead"));
+                        load_hair_source(&Session::default().hair).map_err(|e| e.to_string())?
+                    }
+                };
+                let environment = match load_environment_source(&env) {
+                    Ok((environment, w)) => {
+                        warnings.extend(w);
+                        environment
+                    }
+                    Err(e) => {
+                        warnings.push(format!("{e}; lighting with the built-in sky instead"));
+                        crate::render::scene::default_environment()
+                    }
+                };
+                warnings.extend(hair.warning.clone());
+                Ok(Loaded::Scene {
+                    hair,
+                    environment,
+                    warnings,
+                })
+            },
+        ));
+    }
+
+    /// Loads an environment file (fitting it when it is an image) and applies it as an edit when done.
+    pub fn load_environment(&mut self, path: PathBuf, lights: usize) {
+        let ctx = self.ctx.clone();
+        self.loading = Some(Job::spawn(
+            format!("loading {}", path.display()),
+            move || ctx.request_repaint(),
+            move |_| {
+                let source = EnvironmentSource::File {
+                    path: path.clone(),
+                    lights,
+                    blake3: crate::session::assemble::file_blake3(&path).ok(),
+                    fitted: None,
+                };
+                let (environment, _) =
+                    load_environment_source(&source).map_err(|e| e.to_string())?;
+                let source = EnvironmentSource::File {
+                    path,
+                    lights,
+                    blake3: crate::session::assemble::file_blake3(&PathBuf::from(
+                        &environment.name,
+                    ))
+                    .ok(),
+                    fitted: Some(Box::new(environment.lights.clone())),
+                };
+                Ok(Loaded::Environment {
+                    environment,
+                    source,
+                })
+            },
+        ));
+    }
+
+    /// Loads a hair file on a worker; when it loads it becomes the session's hair (an edit), when it
+    /// fails the error names the file and the scene stays.
+    pub fn open_hair(&mut self, path: PathBuf) {
+        let ctx = self.ctx.clone();
+        self.loading = Some(Job::spawn(
+            format!("loading {}", path.display()),
+            move || ctx.request_repaint(),
+            move |_| {
+                let source = HairSource::File {
+                    blake3: crate::session::assemble::file_blake3(&path).ok(),
+                    path,
+                };
+                let hair = load_hair_source(&source).map_err(|e| e.to_string())?;
+                Ok(Loaded::Hair { hair, source })
+            },
+        ));
+    }
+
+    /// Files dropped on the window: hair, environments and sessions, by extension.
+    fn dropped_files(&mut self, ctx: &egui::Context) {
+        let files: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for path in files {
+            let ext = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                .unwrap_or_default();
+            match ext.as_str() {
+                "hair" | "tfx" | "gltf" | "glb" => self.open_hair(path),
+                "hdr" | "exr" | "json" => self.load_environment(path, 40),
+                "slsession" => self.open_session(&path),
+                _ => self.message(
+                    Level::Error,
+                    format!(
+                        "{}: not a hair file (.hair, .tfx, .gltf, .glb), an environment (.hdr, .exr, .srbf.json) or a session (.slsession)",
+                        path.display()
+                    ),
+                ),
+            }
+        }
+    }
+
+    /// Opens a session file; on error the current session stays.
+    pub fn open_session(&mut self, path: &Path) {
+        match Session::read(path) {
+            Ok(s) => {
+                self.session = s.clone();
+                self.saved = s;
+                self.session_path = Some(path.to_path_buf());
+                self.history.clear();
+                self.camera = None;
+                self.autosave.set_session_path(Some(path));
+                self.live = None;
+                self.load_scene();
+                self.remember(path);
+                self.message(Level::Info, format!("opened {}", path.display()));
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// Puts `path` first in the recent files (at most 10, written atomically).
+    fn remember(&mut self, path: &Path) {
+        let p = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        self.recent.retain(|r| r != &p);
+        self.recent.insert(0, p);
+        self.recent.truncate(10);
+        let file = self.state_dir.join(RECENT_FILE);
+        let text = serde_json::to_string_pretty(&self.recent).unwrap_or_default();
+        let written = std::fs::create_dir_all(&self.state_dir)
+            .and_then(|_| crate::session::write_atomic(&file, text.as_bytes()));
+        if let Err(e) = written {
+            self.message(Level::Warning, format!("{}: {e}", file.display()));
+        }
+    }
+
+    /// Saves to `path` (atomically); the session is then unmodified.
+    pub fn save_session(&mut self, path: &Path) {
+        match self.session.write(path) {
+            Ok(()) => {
+                self.saved = self.session.clone();
+                self.session_path = Some(path.to_path_buf());
+                self.autosave.saved(Some(path));
+                self.remember(path);
+                self.message(Level::Info, format!("saved {}", path.display()));
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// The camera resolved for the current hair (framed when the session has no target yet).
+    /// The aspect is the viewport render's, as `render --session` frames with the still's.
+    fn resolve_camera(&self, hair: &crate::hair::Hair) -> Camera {
+        let (lo, hi) = hair.bounds();
+        let (w, h) = self.render_size();
+        self.session
+            .camera
+            .resolve(lo, hi, w as f32 / h.max(1) as f32)
+    }
+
+    /// Frames the hair (Home).
+    pub fn frame_hair(&mut self) {
+        self.session.camera.target = None;
+        self.session.camera.distance = None;
+        if let Some(live) = &self.live {
+            let hair = live.hair.clone();
+            // The session keeps "framed" (no target, no distance): it follows the hair.
+            let c = self.resolve_camera(&hair);
+            self.camera = Some(c);
+            self.session.camera.yaw = c.yaw;
+            self.session.camera.pitch = c.pitch;
+            self.autosave.changed();
+        }
+    }
+
+    /// Moves the camera (not an edit; saved with the session).
+    pub fn set_camera(&mut self, c: Camera) {
+        self.camera = Some(c);
+        let vc = ViewCamera::from_camera(&c);
+        if vc != self.session.camera {
+            self.session.camera = vc;
+            self.autosave.changed();
+        }
+    }
+
+    /// Polls the background jobs.
+    fn poll_jobs(&mut self) {
+        // Scenes are installed once the viewport has been laid out (its size sizes the render).
+        if self.viewport_rect.is_some()
+            && let Some(job) = &mut self.loading
+            && let Some(result) = job.poll()
+        {
+            self.loading = None;
+            match result {
+                Ok(Loaded::Scene {
+                    hair,
+                    environment,
+                    warnings,
+                }) => {
+                    for w in warnings {
+                        self.message(Level::Warning, w);
+                    }
+                    self.install_scene(hair, environment);
+                }
+                Ok(Loaded::Hair { hair, source }) => {
+                    if let Some(w) = &hair.warning {
+                        let w = w.clone();
+                        self.message(Level::Warning, w);
+                    }
+                    self.perform(Edit::Hair(source), false);
+                    self.message(Level::Info, format!("opened {}", hair.name));
+                    self.session.camera.target = None;
+                    self.session.camera.distance = None;
+                    let environment = match &self.live {
+                        Some(live) => live.environment.clone(),
+                        None => crate::render::scene::default_environment(),
+                    };
+                    self.loading_for = Some(self.session.clone());
+                    self.install_scene(hair, environment);
+                }
+                Ok(Loaded::Environment {
+                    environment,
+                    source,
+                }) => {
+                    self.perform(Edit::Environment(Box::new(source.clone())), false);
+                    if let Some(live) = &mut self.live {
+                        live.set_environment(environment, source, self.session.env_yaw);
+                    }
+                }
+                Err(e) => {
+                    self.message(Level::Error, e);
+                    // The scene stays as it was: undo the source edit that asked for it.
+                    if let Some(live) = &self.live
+                        && (live.hair_source != self.session.hair
+                            || live.environment_source != self.session.environment)
+                    {
+                        self.session.hair = live.hair_source.clone();
+                        self.session.environment = live.environment_source.clone();
+                    }
+                }
+            }
+        }
+        if let Some(job) = &mut self.export
+            && let Some(msg) = job.poll(&mut self.live)
+        {
+            let (level, text) = msg;
+            self.message(level, text);
+            self.export = None;
+        }
+        if let Some(err) = self.autosave.tick(&self.session, &self.ctx) {
+            self.message(Level::Warning, err);
+        }
+    }
+
+    fn install_scene(&mut self, hair: LoadedHairSource, environment: Environment) {
+        let Some(gpu) = self.gpu.clone() else {
+            return;
+        };
+        let camera = self.resolve_camera(&hair.hair);
+        let session = self
+            .loading_for
+            .take()
+            .unwrap_or_else(|| self.session.clone());
+        let (w, h) = self.render_size();
+        match LiveScene::new(gpu, &self.luts, &session, hair, environment, &camera, w, h) {
+            Ok(live) => {
+                self.live = Some(live);
+                self.camera = Some(camera);
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// The render size for the current viewport and view scale.
+    pub fn render_size(&self) -> (u32, u32) {
+        let s = self.view.scale.clamp(0.1, 1.0);
+        (
+            ((self.viewport_px[0] as f32 * s).round() as u32).clamp(16, 4096),
+            ((self.viewport_px[1] as f32 * s).round() as u32).clamp(16, 4096),
+        )
+    }
+
+    /// The viewport's per-frame work: rebuild, sync, refine, display.
+    pub fn update_viewport(&mut self) {
+        let (w, h) = self.render_size();
+        let rebuild = self
+            .live
+            .as_ref()
+            .is_some_and(|l| l.needs_rebuild(&self.session));
+        if rebuild {
+            if self.loading.is_none() {
+                self.load_scene();
+            }
+            return;
+        }
+        // A framed camera (no explicit target or distance) follows the hair and the viewport's aspect.
+        if let Some(live) = &self.live
+            && (self.session.camera.target.is_none() || self.session.camera.distance.is_none())
+        {
+            let hair = live.hair.clone();
+            self.camera = Some(self.resolve_camera(&hair));
+        }
+        let (Some(live), Some(camera)) = (&mut self.live, self.camera) else {
+            return;
+        };
+        let mut result = Ok(());
+        if let Some(er) = &self.egui_renderer {
+            let mut er = er.write();
+            result = live.resize(w, h, &mut er);
+            live.texture(&mut er);
+        }
+        let result = result
+            .and_then(|_| live.sync(&self.session, &camera))
+            .and_then(|_| live.step(self.view));
+        match result {
+            Ok(p) => {
+                if !p.converged || live.tables_pending() {
+                    // Poll for the unit in flight about once per unit budget: on a software GPU,
+                    // egui's own frames share the CPU with the refinement.
+                    self.ctx.request_repaint_after(REFINE_POLL);
+                }
+            }
+            Err(e) => {
+                let text = e.to_string();
+                self.message(Level::Error, text);
+            }
+        }
+    }
+
+    /// Keyboard shortcuts that act on the document.
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        use egui::{Key, KeyboardShortcut, Modifiers};
+        let cmd = Modifiers::COMMAND;
+        let cmd_shift = Modifiers::COMMAND | Modifiers::SHIFT;
+        // Shift is ignored when matching (egui's logical matching): the Shift chords go first.
+        let (redo, save_as, undo, redo_y, save, open, export) = ctx.input_mut(|i| {
+            (
+                i.consume_shortcut(&KeyboardShortcut::new(cmd_shift, Key::Z)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd_shift, Key::S)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd, Key::Z)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd, Key::Y)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd, Key::S)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd, Key::O)),
+                i.consume_shortcut(&KeyboardShortcut::new(cmd, Key::E)),
+            )
+        });
+        if redo || redo_y {
+            self.redo();
+        } else if undo {
+            self.undo();
+        }
+        if save_as || (save && self.session_path.is_none()) {
+            panels::menu::save_as_dialog(self);
+        } else if save && let Some(p) = self.session_path.clone() {
+            self.save_session(&p);
+        }
+        if open {
+            panels::menu::open_dialog(self);
+        }
+        if export {
+            panels::menu::export_dialog(self);
+        }
+    }
+
+    fn frame_timing(&mut self) {
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            let ms = (now - last).as_secs_f32() * 1e3;
+            self.frame_ms = if self.frame_ms == 0.0 {
+                ms
+            } else {
+                0.9 * self.frame_ms + 0.1 * ms
+            };
+        }
+        self.last_frame = Some(now);
+    }
+
+    /// Navigation keys over the viewport.
+    pub fn navigation_keys(&mut self, ctx: &egui::Context) {
+        use egui::Key;
+        let Some(mut c) = self.camera else {
+            return;
+        };
+        let (home, one, three, seven, ctrl) = ctx.input(|i| {
+            (
+                i.key_pressed(Key::Home) || i.key_pressed(Key::Period),
+                i.key_pressed(Key::Num1),
+                i.key_pressed(Key::Num3),
+                i.key_pressed(Key::Num7),
+                i.modifiers.ctrl,
+            )
+        });
+        if home {
+            self.frame_hair();
+            return;
+        }
+        let view = if one {
+            Some(navigation::AxisView::Front)
+        } else if three {
+            Some(navigation::AxisView::Side)
+        } else if seven {
+            Some(navigation::AxisView::Top)
+        } else {
+            None
+        };
+        if let Some(v) = view {
+            navigation::axis_view(&mut c, v, ctrl);
+            self.set_camera(c);
+        }
+    }
+
+    /// When the app closes: the recovery file is written if there are unsaved changes.
+    pub fn closing(&mut self) {
+        if let Err(e) = self.autosave.on_exit(&self.session, self.modified()) {
+            eprintln!("warning: {e}");
+        }
+    }
+
+    /// How long ago the last refinement converged (tests and the status bar).
+    pub fn converged(&self) -> Option<Duration> {
+        self.live.as_ref().and_then(|l| {
+            l.progress
+                .filter(|p| p.converged && !l.tables_pending())
+                .and(l.converged_in)
+        })
+    }
+}
+
+const RECENT_FILE: &str = "recent.json";
+
+/// How often the UI wakes to poll refinement while it runs.
+const REFINE_POLL: Duration = Duration::from_millis(30);
+
+/// The recent sessions list (missing or unreadable: empty).
+fn read_recent(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_to_string(dir.join(RECENT_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default()
+}
+
+/// egui's proportional font lacks a few symbols the panels use (the reset arrow): the bundled
+/// monospace font covers them as a fallback.
+fn install_fonts(ctx: &egui::Context) {
+    let mut fonts = egui::FontDefinitions::default();
+    if let Some(list) = fonts.families.get_mut(&egui::FontFamily::Proportional)
+        && fonts.font_data.contains_key("Hack")
+        && !list.iter().any(|f| f == "Hack")
+    {
+        list.push("Hack".into());
+    }
+    ctx.set_fonts(fonts);
+}
+
+impl eframe::App for EditorApp {
+    fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
+        self.frame_timing();
+        self.poll_jobs();
+        self.dropped_files(ctx);
+        self.shortcuts(ctx);
+        if !ctx.input(|i| i.pointer.any_down()) {
+            self.history.end_gesture();
+        }
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        panels::show(self, ui);
+        self.update_viewport();
+    }
+
+    fn on_exit(&mut self) {
+        self.closing();
+    }
+}

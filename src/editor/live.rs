@@ -1,0 +1,342 @@
+//! The scene the viewport shows: the loaded hair and environment, the shared [`Renderer`] on egui's
+//! device, the display pass into the texture egui draws, and what of the session the renderer has been
+//! told. [`LiveScene::sync`] tells the renderer only what changed (it is never rebuilt for a
+//! parameter); [`LiveScene::step`] submits one bounded unit of refinement per UI frame.
+
+use super::jobs::Job;
+use crate::envmap::SrbfSet;
+use crate::gpu::GpuContext;
+use crate::hair::Hair;
+use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
+use crate::render::progressive::{Progress, WorkUnit};
+use crate::render::renderer::build_tables;
+use crate::render::scene::Environment;
+use crate::render::{Camera, RenderError, Renderer};
+use crate::scattering::HairParams;
+use crate::scattering::dual_terms::DualTables;
+use crate::scattering::lut::Luts;
+use crate::session::assemble::{LoadedHairSource, absorption, turned_lights};
+use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
+use crate::shadow::forward::ForwardTable;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How the viewport shows the linear image (never the EXR).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSettings {
+    pub transform: ViewTransform,
+    /// Viewport exposure, stops, on top of the session's.
+    pub exposure: f32,
+    /// Render resolution as a fraction of the viewport's pixels.
+    pub scale: f32,
+    /// The beauty or one component alone.
+    pub solo: Solo,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        Self {
+            transform: ViewTransform::Filmic,
+            exposure: 0.0,
+            scale: 0.5,
+            solo: Solo::Beauty,
+        }
+    }
+}
+
+/// The viewport's background (display-encoded grey).
+pub const BACKGROUND: [f32; 3] = [0.16, 0.16, 0.17];
+
+#[derive(Debug, thiserror::Error)]
+pub enum LiveError {
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error(transparent)]
+    Assemble(#[from] AssembleError),
+}
+
+type Tables = (HairParams, ForwardTable, DualTables);
+
+/// What the renderer was last told.
+#[derive(Clone, Debug, PartialEq)]
+struct Applied {
+    look: Look,
+    paint: Option<std::path::PathBuf>,
+    env_yaw: f64,
+    render: RenderOptions,
+    camera: Camera,
+}
+
+pub struct LiveScene {
+    pub ctx: GpuContext,
+    pub hair: Arc<Hair>,
+    pub hair_name: String,
+    pub hair_source: HairSource,
+    /// The environment with its lights unturned.
+    pub environment: Environment,
+    pub environment_source: EnvironmentSource,
+    pub renderer: Renderer,
+    pub display: DisplayPass,
+    pub texture: Option<egui::TextureId>,
+    applied: Applied,
+    view: Option<ViewSettings>,
+    tables: Option<Job<Tables>>,
+    pub progress: Option<Progress>,
+    /// When the current refinement started, and how long it took to converge.
+    pub refine_started: Instant,
+    pub converged_in: Option<Duration>,
+    /// When the first shading batch after the last change was complete (the first new image).
+    pub first_image_in: Option<Duration>,
+    /// The refinement whose converged image was displayed.
+    shown_converged: Option<Instant>,
+}
+
+impl LiveScene {
+    /// Builds the renderer for `session` with a loaded hair and environment at a viewport size.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: GpuContext,
+        luts: &Luts,
+        session: &Session,
+        hair: LoadedHairSource,
+        environment: Environment,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, LiveError> {
+        let (sigma_a, look) = absorption(&session.look, &hair.hair, session.paint.as_deref())?;
+        let lights = turned_lights(&environment.lights, session.env_yaw);
+        let settings = session.render.settings(width, height);
+        let renderer = Renderer::new(
+            &ctx,
+            settings,
+            luts,
+            &hair.hair,
+            &sigma_a,
+            &look,
+            &lights.lights,
+            camera,
+        )?;
+        let display = DisplayPass::new(&ctx.device, width, height);
+        Ok(Self {
+            hair: Arc::new(hair.hair),
+            hair_name: hair.name,
+            hair_source: session.hair.clone(),
+            environment,
+            environment_source: session.environment.clone(),
+            renderer,
+            display,
+            texture: None,
+            applied: Applied {
+                look: session.look,
+                paint: session.paint.clone(),
+                env_yaw: session.env_yaw,
+                render: session.render,
+                camera: *camera,
+            },
+            view: None,
+            tables: None,
+            progress: None,
+            refine_started: Instant::now(),
+            converged_in: None,
+            first_image_in: None,
+            shown_converged: None,
+            ctx,
+        })
+    }
+
+    /// Whether the renderer must be rebuilt for this session (hair or render settings it cannot
+    /// change in place); environment changes go through [`LiveScene::set_environment`].
+    pub fn needs_rebuild(&self, session: &Session) -> bool {
+        let (a, b) = (&self.applied.render, &session.render);
+        self.hair_source != session.hair
+            || a.samples != b.samples
+            || a.volume_resolution != b.volume_resolution
+            || a.shadow_grid_resolution != b.shadow_grid_resolution
+    }
+
+    /// Tells the renderer what changed in `session` and the camera (not the hair source: see
+    /// [`LiveScene::needs_rebuild`]).
+    pub fn sync(&mut self, session: &Session, camera: &Camera) -> Result<(), LiveError> {
+        let mut changed = false;
+        if session.look != self.applied.look || session.paint != self.applied.paint {
+            let (sigma_a, look) = absorption(&session.look, &self.hair, session.paint.as_deref())?;
+            let absorption_changed = session.look.root != self.applied.look.root
+                || session.look.tip != self.applied.look.tip
+                || session.look.strand_variation != self.applied.look.strand_variation
+                || session.look.variation_seed != self.applied.look.variation_seed
+                || session.paint != self.applied.paint;
+            if absorption_changed {
+                self.renderer.set_absorption(&self.ctx, &sigma_a)?;
+            }
+            if self.renderer.set_params_deferred(&self.ctx, &look) {
+                let params = look.params;
+                // A newer build replaces an older one; set_tables ignores stale tables anyway.
+                self.tables = Some(Job::spawn(
+                    "hair tables",
+                    || {},
+                    move |_| {
+                        let (f, d) = build_tables(&params);
+                        (params, f, d)
+                    },
+                ));
+            }
+            self.applied.look = session.look;
+            self.applied.paint = session.paint.clone();
+            changed = true;
+        }
+        if session.env_yaw != self.applied.env_yaw {
+            let lights = turned_lights(&self.environment.lights, session.env_yaw);
+            self.renderer.set_lights(&self.ctx, &lights.lights);
+            self.applied.env_yaw = session.env_yaw;
+            changed = true;
+        }
+        let (a, b) = (self.applied.render, session.render);
+        if (a.shadows, a.multiple_scattering) != (b.shadows, b.multiple_scattering) {
+            self.renderer
+                .set_toggles(&self.ctx, b.shadows, b.multiple_scattering);
+            changed = true;
+        }
+        if a.exposure != b.exposure {
+            self.renderer.set_exposure(&self.ctx, b.exposure);
+            changed = true;
+        }
+        self.applied.render = session.render;
+        if *camera != self.applied.camera {
+            self.renderer.set_camera(&self.ctx, camera);
+            self.applied.camera = *camera;
+            changed = true;
+        }
+        if changed {
+            self.restarted();
+        }
+        Ok(())
+    }
+
+    /// A new environment (already loaded), turned by the session's yaw.
+    pub fn set_environment(
+        &mut self,
+        environment: Environment,
+        source: EnvironmentSource,
+        env_yaw: f64,
+    ) {
+        let lights: SrbfSet = turned_lights(&environment.lights, env_yaw);
+        self.renderer.set_lights(&self.ctx, &lights.lights);
+        self.environment = environment;
+        self.environment_source = source;
+        self.applied.env_yaw = env_yaw;
+        self.restarted();
+    }
+
+    /// The render size follows the viewport.
+    pub fn resize(
+        &mut self,
+        width: u32,
+        height: u32,
+        egui_renderer: &mut egui_wgpu::Renderer,
+    ) -> Result<(), LiveError> {
+        if (width, height) == (self.display.width, self.display.height) {
+            return Ok(());
+        }
+        self.renderer.set_size(&self.ctx, width, height)?;
+        self.display = DisplayPass::new(&self.ctx.device, width, height);
+        if let Some(id) = self.texture {
+            egui_renderer.update_egui_texture_from_wgpu_texture(
+                &self.ctx.device,
+                &self.display.view,
+                wgpu::FilterMode::Linear,
+                id,
+            );
+        }
+        self.view = None;
+        self.restarted();
+        Ok(())
+    }
+
+    /// The egui texture of the display image (registered on first use).
+    pub fn texture(&mut self, egui_renderer: &mut egui_wgpu::Renderer) -> egui::TextureId {
+        *self.texture.get_or_insert_with(|| {
+            egui_renderer.register_native_texture(
+                &self.ctx.device,
+                &self.display.view,
+                wgpu::FilterMode::Linear,
+            )
+        })
+    }
+
+    fn restarted(&mut self) {
+        self.refine_started = Instant::now();
+        self.converged_in = None;
+        self.first_image_in = None;
+    }
+
+    /// One UI frame's work: takes finished tables, submits one bounded refinement unit and, when the
+    /// image or the view changed, the display pass. Never waits for the GPU.
+    pub fn step(&mut self, view: ViewSettings) -> Result<Progress, LiveError> {
+        if let Some(job) = &mut self.tables
+            && let Some((params, forward, dual)) = job.poll()
+        {
+            self.tables = None;
+            if self
+                .renderer
+                .set_tables(&self.ctx, &params, &forward, &dual)
+            {
+                self.restarted();
+            }
+        }
+        let progress = self.renderer.refine(&self.ctx)?;
+        if progress.converged && self.converged_in.is_none() {
+            self.converged_in = Some(self.refine_started.elapsed());
+        }
+        // The display keeps the last image until the first shading batch of the new one is complete
+        // (the strongest light batch at the first visibility sample: most of the picture), instead of
+        // showing the cleared image filling in band by band.
+        let first_batch_done = match progress.submitted {
+            Some(WorkUnit::Shade { batch, .. }) => batch >= 1,
+            Some(WorkUnit::ShadowGrid { .. }) => self.first_image_in.is_some(),
+            _ => false,
+        };
+        if first_batch_done && self.first_image_in.is_none() {
+            self.first_image_in = Some(self.refine_started.elapsed());
+        }
+        let converged_now = progress.converged && self.shown_converged != Some(self.refine_started);
+        if converged_now {
+            self.shown_converged = Some(self.refine_started);
+        }
+        if first_batch_done || converged_now || self.view != Some(view) {
+            let info = DisplayInfo {
+                render_scale: self.renderer.settings.exposure.exp2(),
+                ..DisplayInfo::new(
+                    self.display.width,
+                    self.display.height,
+                    view.transform,
+                    view.exposure,
+                    BACKGROUND,
+                )
+            };
+            let mut enc = self
+                .ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("display"),
+                });
+            self.display.encode(
+                &self.ctx.device,
+                &self.ctx.queue,
+                &mut enc,
+                self.renderer.targets(),
+                &info,
+                view.solo,
+            );
+            self.ctx.queue.submit([enc.finish()]);
+            self.view = Some(view);
+        }
+        self.progress = Some(progress);
+        Ok(progress)
+    }
+
+    /// Whether a table build is still running.
+    pub fn tables_pending(&self) -> bool {
+        self.tables.is_some()
+    }
+}

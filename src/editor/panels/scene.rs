@@ -1,0 +1,273 @@
+//! The scene panel: the hair (file or procedural generator, and its statistics), the environment
+//! (file, yaw), the still's render settings and the viewport's view transform.
+
+use super::widgets::{Changed, slider, slider32};
+use crate::editor::app::EditorApp;
+use crate::editor::panels::menu;
+use crate::hair::procedural::Style;
+use crate::render::display::{Solo, ViewTransform};
+use crate::render::targets::COMPONENTS;
+use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
+
+const STYLES: [(Style, &str); 5] = [
+    (Style::StraightLong, "straight long"),
+    (Style::Wavy, "wavy"),
+    (Style::Curly, "curly"),
+    (Style::Bob, "bob"),
+    (Style::Ponytail, "ponytail"),
+];
+
+pub fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
+    ui.heading("Hair");
+    hair(app, ui);
+    ui.separator();
+    ui.heading("Environment");
+    environment(app, ui);
+    ui.separator();
+    ui.heading("Render");
+    render(app, ui);
+    ui.separator();
+    ui.heading("Viewport");
+    view(app, ui);
+}
+
+fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
+    match &app.session.hair {
+        HairSource::File { path, .. } => {
+            ui.label(format!("file {}", path.display()));
+        }
+        HairSource::Generated { .. } => {
+            ui.label("procedural, on the generated head");
+        }
+    }
+    if ui.button("Open hair file…").clicked() {
+        menu::hair_dialog(app);
+    }
+    let id = ui.scope_id().with("generator");
+    let mut gen_state = ui.data_mut(|d| {
+        d.get_temp::<(usize, usize, usize, u64)>(id)
+            .unwrap_or(match app.session.hair {
+                HairSource::Generated {
+                    style,
+                    strands,
+                    points,
+                    seed,
+                } => (
+                    STYLES.iter().position(|s| s.0 == style).unwrap_or(1),
+                    strands,
+                    points,
+                    seed,
+                ),
+                _ => (1, 3000, 16, 1),
+            })
+    });
+    egui::CollapsingHeader::new("Generator")
+        .default_open(false)
+        .show(ui, |ui| {
+            let (style, strands, points, seed) = &mut gen_state;
+            egui::ComboBox::from_label("style")
+                .selected_text(STYLES[*style].1)
+                .show_ui(ui, |ui| {
+                    for (i, (_, name)) in STYLES.iter().enumerate() {
+                        ui.selectable_value(style, i, *name);
+                    }
+                });
+            ui.add(
+                egui::DragValue::new(strands)
+                    .range(1..=200_000)
+                    .prefix("strands "),
+            )
+            .on_hover_text("Number of strands");
+            ui.add(egui::DragValue::new(points).range(2..=64).prefix("points "))
+                .on_hover_text("Points per strand");
+            ui.add(egui::DragValue::new(seed).prefix("seed "));
+            if ui.button("Generate").clicked() {
+                app.perform(
+                    Edit::Hair(HairSource::Generated {
+                        style: STYLES[*style].0,
+                        strands: *strands,
+                        points: *points,
+                        seed: *seed,
+                    }),
+                    false,
+                );
+            }
+        });
+    ui.data_mut(|d| d.insert_temp(id, gen_state));
+    if let Some(live) = &app.live {
+        let (lo, hi) = live.hair.bounds();
+        let size = hi - lo;
+        ui.weak(format!(
+            "{} strands, {} points, {:.1} × {:.1} × {:.1} cm",
+            live.hair.strand_count(),
+            live.hair.point_count(),
+            size.x,
+            size.y,
+            size.z
+        ));
+    }
+}
+
+fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
+    match &app.session.environment {
+        EnvironmentSource::Builtin => ui.label("built-in sunny sky"),
+        EnvironmentSource::File { path, .. } => ui.label(path.display().to_string()),
+    };
+    ui.horizontal(|ui| {
+        if ui.button("Open…").clicked() {
+            menu::environment_dialog(app);
+        }
+        if ui
+            .add_enabled(
+                app.session.environment != EnvironmentSource::Builtin,
+                egui::Button::new("Built-in"),
+            )
+            .clicked()
+        {
+            app.perform(
+                Edit::Environment(Box::new(EnvironmentSource::Builtin)),
+                false,
+            );
+            app.load_scene();
+        }
+    });
+    let mut yaw = app.session.env_yaw;
+    let c = slider(
+        ui,
+        "yaw",
+        &mut yaw,
+        -180.0..=180.0,
+        "°",
+        0,
+        0.0,
+        "Turns the environment about the vertical axis (no refit), degrees",
+    );
+    if c.changed {
+        app.perform(Edit::EnvYaw(yaw), c.gesture);
+    }
+    if let Some(live) = &app.live {
+        ui.weak(format!(
+            "{} SRBF lights · {}",
+            live.environment.lights.lights.len(),
+            live.environment.name
+        ));
+    }
+}
+
+fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
+    let mut r: RenderOptions = app.session.render;
+    let mut c = Changed::default();
+    c.changed |= ui
+        .checkbox(&mut r.shadows, "Self-shadowing")
+        .on_hover_text("Transmittance through the fibre-density volume (Bertails 2005)")
+        .changed();
+    c.changed |= ui
+        .checkbox(&mut r.multiple_scattering, "Multiple scattering")
+        .on_hover_text(
+            "Dual scattering (Zinke 2008): global forward scattering and local back scattering",
+        )
+        .changed();
+    c = c.or(slider32(
+        ui,
+        "exposure",
+        &mut r.exposure,
+        -6.0..=6.0,
+        " EV",
+        1,
+        0.0,
+        "Exposure of the render and the exported EXR, stops",
+    ));
+    ui.horizontal(|ui| {
+        ui.label("still");
+        c.changed |= ui
+            .add(
+                egui::DragValue::new(&mut r.width)
+                    .range(16..=8192)
+                    .suffix(" px"),
+            )
+            .changed();
+        ui.label("×");
+        c.changed |= ui
+            .add(
+                egui::DragValue::new(&mut r.height)
+                    .range(16..=8192)
+                    .suffix(" px"),
+            )
+            .changed();
+    });
+    ui.horizontal(|ui| {
+        ui.label("samples");
+        for s in [2u32, 4] {
+            if ui.selectable_label(r.samples == s, s.to_string()).clicked() && r.samples != s {
+                r.samples = s;
+                c.changed = true;
+            }
+        }
+    });
+    if c.changed && r != app.session.render {
+        app.perform(Edit::Render(r), c.gesture);
+    }
+}
+
+fn view(app: &mut EditorApp, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        ui.label("view");
+        for (t, name, tip) in [
+            (
+                ViewTransform::Filmic,
+                "filmic",
+                "ACES filmic (Narkowicz's fit), as the PNG previews",
+            ),
+            (ViewTransform::Standard, "standard", "Clamped sRGB"),
+        ] {
+            if ui
+                .selectable_label(app.view.transform == t, name)
+                .on_hover_text(tip)
+                .clicked()
+            {
+                app.view.transform = t;
+            }
+        }
+    });
+    slider32(
+        ui,
+        "view exposure",
+        &mut app.view.exposure,
+        -6.0..=6.0,
+        " EV",
+        1,
+        0.0,
+        "Viewport only: never changes the EXR",
+    );
+    ui.horizontal_wrapped(|ui| {
+        ui.label("show");
+        if ui
+            .selectable_label(app.view.solo == Solo::Beauty, "beauty")
+            .on_hover_text("All scattering components")
+            .clicked()
+        {
+            app.view.solo = Solo::Beauty;
+        }
+        for (k, name) in COMPONENTS.iter().enumerate() {
+            if ui
+                .selectable_label(app.view.solo == Solo::Component(k), *name)
+                .on_hover_text("This component alone (the EXR's AOV layer of the same name)")
+                .clicked()
+            {
+                app.view.solo = Solo::Component(k);
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("resolution");
+        for s in [0.25f32, 0.5, 1.0] {
+            if ui
+                .selectable_label(app.view.scale == s, format!("{:.0}%", s * 100.0))
+                .on_hover_text("Render resolution as a fraction of the viewport's pixels")
+                .clicked()
+            {
+                app.view.scale = s;
+            }
+        }
+    });
+}

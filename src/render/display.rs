@@ -1,0 +1,243 @@
+//! The viewport's display pass (`shaders/display.wgsl`): the resolved beauty through a view transform
+//! (standard or filmic, with a viewport exposure) over a flat background, into an Rgba8Unorm texture
+//! that egui draws. Display only: stills and EXRs never pass here. [`display_pixel`] is the CPU twin.
+
+use super::frame::{aces_filmic, srgb_encode};
+use super::targets::FrameTargets;
+use crate::gpu::context::{bind_buffers, compute_pipeline};
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+use wgpu::util::DeviceExt;
+
+pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
+pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// What the viewport shows: the beauty or one scattering component alone (the AOVs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solo {
+    #[default]
+    Beauty,
+    /// Index into the components: R, TT, TRT, MS.global, MS.local.
+    Component(usize),
+}
+
+/// How linear radiance becomes a display value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ViewTransform {
+    /// Clamp to [0, 1], sRGB encode.
+    Standard,
+    /// Narkowicz's fit of the ACES filmic curve, sRGB encode (the PNG previews' curve).
+    #[default]
+    Filmic,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct DisplayInfo {
+    pub width: u32,
+    pub height: u32,
+    pub transform: u32,
+    /// 0: the beauty; 1: the bound component alone.
+    pub solo: u32,
+    pub exposure_scale: f32,
+    pub render_scale: f32,
+    pub _pad1: [f32; 2],
+    pub background: [f32; 3],
+    pub _pad2: f32,
+}
+
+const _: () = assert!(std::mem::size_of::<DisplayInfo>() == 48);
+
+impl DisplayInfo {
+    pub fn new(
+        width: u32,
+        height: u32,
+        transform: ViewTransform,
+        exposure_ev: f32,
+        background: [f32; 3],
+    ) -> Self {
+        Self {
+            width,
+            height,
+            transform: transform as u32,
+            solo: 0,
+            exposure_scale: exposure_ev.exp2(),
+            render_scale: 1.0,
+            _pad1: [0.0; 2],
+            background,
+            _pad2: 0.0,
+        }
+    }
+}
+
+/// One display value of the view transform (twin of the WGSL `view_transform`).
+pub fn view_transform(x: f32, transform: ViewTransform) -> f32 {
+    match transform {
+        ViewTransform::Filmic => srgb_encode(aces_filmic(x)),
+        ViewTransform::Standard => srgb_encode(x.clamp(0.0, 1.0)),
+    }
+}
+
+/// One displayed pixel from a premultiplied beauty pixel and the solo component (twin of the WGSL
+/// `display_pixel`).
+pub fn display_pixel(info: &DisplayInfo, beauty: [f32; 4], component: [f32; 4]) -> [f32; 4] {
+    let p = if info.solo == 1 {
+        let s = info.render_scale;
+        [
+            s * component[0],
+            s * component[1],
+            s * component[2],
+            beauty[3],
+        ]
+    } else {
+        beauty
+    };
+    let a = p[3].clamp(0.0, 1.0);
+    let un = if p[3] > 0.0 {
+        info.exposure_scale / p[3]
+    } else {
+        0.0
+    };
+    let t = if info.transform == 1 {
+        ViewTransform::Filmic
+    } else {
+        ViewTransform::Standard
+    };
+    let c: [f32; 3] = std::array::from_fn(|i| view_transform(p[i] * un, t));
+    let b = info.background;
+    [
+        b[0] + a * (c[0] - b[0]),
+        b[1] + a * (c[1] - b[1]),
+        b[2] + a * (c[2] - b[2]),
+        1.0,
+    ]
+}
+
+/// The display texture for one image size and the pass that fills it.
+pub struct DisplayPass {
+    pipeline: wgpu::ComputePipeline,
+    info: wgpu::Buffer,
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl DisplayPass {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("display"),
+            source: wgpu::ShaderSource::Wgsl(DISPLAY_WGSL.into()),
+        });
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("display"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DISPLAY_FORMAT,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let info = DisplayInfo::new(width, height, ViewTransform::Filmic, 0.0, [0.0; 3]);
+        Self {
+            pipeline: compute_pipeline(device, &module, "display"),
+            info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("display info"),
+                contents: bytemuck::bytes_of(&info),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            view: texture.create_view(&Default::default()),
+            texture,
+            width,
+            height,
+        }
+    }
+
+    /// Copies the display texture into a buffer readable by [`crate::gpu::GpuContext::read_buffer`]
+    /// (tests: the GPU display against [`display_pixel`]). Rows are padded to 256 bytes.
+    pub fn copy_to_buffer(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> (wgpu::Buffer, u32) {
+        let row = (self.width * 4).div_ceil(256) * 256;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("display read-back"),
+            size: row as u64 * self.height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            self.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        (buffer, row)
+    }
+
+    /// Encodes the transform of `targets.beauty` or one component (which must have this pass's size)
+    /// into the texture.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        info: &DisplayInfo,
+        solo: Solo,
+    ) {
+        let (flag, component) = match solo {
+            Solo::Beauty => (0, &targets.components[0]),
+            Solo::Component(k) => (1, &targets.components[k.min(targets.components.len() - 1)]),
+        };
+        let info = DisplayInfo {
+            width: self.width.min(targets.width),
+            height: self.height.min(targets.height),
+            solo: flag,
+            ..*info
+        };
+        queue.write_buffer(&self.info, 0, bytemuck::bytes_of(&info));
+        let bind = bind_buffers(
+            device,
+            &self.pipeline,
+            "display",
+            &[&self.info, &targets.beauty],
+            vec![
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&self.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: component.as_entire_binding(),
+                },
+            ],
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("display"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(info.width.div_ceil(8), info.height.div_ceil(8), 1);
+    }
+}

@@ -1,0 +1,279 @@
+//! Scene assembly from a [`Session`]: the hair, the environment's lights (turned by the session's yaw),
+//! the per-point absorption, the look in the renderer's form, the camera and the render settings. The
+//! CLI's `render` and the editor both build their scenes here.
+
+use super::model::{EnvironmentSource, HairSource, Look, Session};
+use crate::envmap::{SrbfSet, load_env};
+use crate::hair::Hair;
+use crate::hair::load::{LoadOptions, load_hair};
+use crate::paint::{AbsorptionSpec, PaintLayer};
+use crate::render::scene::{Environment, default_environment, generated_hair, load_environment};
+use crate::render::{Camera, HairLook, RenderSettings};
+use std::path::Path;
+
+#[derive(Debug, thiserror::Error)]
+pub enum AssembleError {
+    #[error("{0}")]
+    Hair(#[from] crate::hair::HairError),
+    #[error("{path}: {message}")]
+    Environment { path: String, message: String },
+    #[error("{0}")]
+    Paint(#[from] crate::paint::PaintLayerError),
+    #[error("{0}: no strands to render")]
+    NoStrands(String),
+    #[error("invalid look: {0}")]
+    Look(String),
+}
+
+/// A loaded hair, its name for logs and EXR headers, and a warning when the file changed since the
+/// session recorded it.
+pub struct LoadedHairSource {
+    pub hair: Hair,
+    pub name: String,
+    pub warning: Option<String>,
+}
+
+/// BLAKE3 of a file's bytes, hex.
+pub fn file_blake3(path: &Path) -> std::io::Result<String> {
+    Ok(blake3::hash(&std::fs::read(path)?).to_hex().to_string())
+}
+
+fn changed_warning(path: &Path, recorded: &Option<String>) -> Option<String> {
+    let recorded = recorded.as_ref()?;
+    match file_blake3(path) {
+        Ok(h) if &h == recorded => None,
+        Ok(_) => Some(format!(
+            "{} changed since the session was saved",
+            path.display()
+        )),
+        Err(e) => Some(format!("{}: {e}", path.display())),
+    }
+}
+
+pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, AssembleError> {
+    let loaded = match source {
+        HairSource::Generated {
+            style,
+            strands,
+            points,
+            seed,
+        } => LoadedHairSource {
+            hair: generated_hair(*style, *strands, *points, *seed),
+            name: format!("generated {style:?} {strands}x{points}"),
+            warning: None,
+        },
+        HairSource::File { path, blake3 } => {
+            let loaded = load_hair(path, &LoadOptions::default())?;
+            LoadedHairSource {
+                hair: loaded.file.hair,
+                name: path.display().to_string(),
+                warning: changed_warning(path, blake3),
+            }
+        }
+    };
+    if loaded.hair.strand_count() == 0 {
+        return Err(AssembleError::NoStrands(loaded.name));
+    }
+    Ok(loaded)
+}
+
+/// The environment (its lights unturned) and a warning when its file changed.
+pub fn load_environment_source(
+    source: &EnvironmentSource,
+) -> Result<(Environment, Option<String>), AssembleError> {
+    match source {
+        EnvironmentSource::Builtin => Ok((default_environment(), None)),
+        EnvironmentSource::File {
+            path,
+            lights,
+            blake3,
+            fitted,
+        } => {
+            // Errors of the loaders already name the file.
+            let err = |message: String| {
+                let p = path.display().to_string();
+                AssembleError::Environment {
+                    message: message
+                        .strip_prefix(&format!("{p}: "))
+                        .map(str::to_string)
+                        .unwrap_or(message),
+                    path: p,
+                }
+            };
+            let warning = changed_warning(path, blake3);
+            match fitted {
+                // The saved fit opens without refitting, even when the file moved or changed (that is
+                // reported; the image is kept when it still loads, for the reference mode).
+                Some(set) => Ok((
+                    Environment {
+                        lights: (**set).clone(),
+                        image: load_env(path).ok().map(|(image, _)| image),
+                        name: path.display().to_string(),
+                    },
+                    warning,
+                )),
+                None => load_environment(path, *lights)
+                    .map(|env| (env, warning))
+                    .map_err(|e| err(e.to_string())),
+            }
+        }
+    }
+}
+
+/// The per-point absorption of `look` on `hair` (root-to-tip gradient, per-strand variation, an
+/// optional paint layer over it) and the look in the renderer's form, with sigma_a set to the mean of
+/// the points (what the dual-scattering tables are built for).
+pub fn absorption(
+    look: &Look,
+    hair: &Hair,
+    paint: Option<&Path>,
+) -> Result<(Vec<[f32; 3]>, HairLook), AssembleError> {
+    look.validate().map_err(AssembleError::Look)?;
+    let root = look.root.sigma_a().map(|x| x as f32);
+    let tip = look.tip.map_or(root, |t| t.sigma_a().map(|x| x as f32));
+    let spec = AbsorptionSpec {
+        root,
+        tip,
+        variation: look.strand_variation.max(0.0),
+        seed: look.variation_seed,
+    };
+    let mut sigma_a = spec.per_point(hair);
+    if let Some(path) = paint {
+        PaintLayer::read(path)?.apply(&mut sigma_a, hair.strand_count(), path)?;
+    }
+    let mut params = look.params;
+    let n = sigma_a.len().max(1) as f64;
+    for c in 0..3 {
+        params.sigma_a[c] = sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n;
+    }
+    let hair_look = HairLook::new(params)
+        .with_dual(look.d_f, look.d_b)
+        .with_longitudinal(look.longitudinal);
+    Ok((sigma_a, hair_look))
+}
+
+/// Everything the renderer is built from.
+pub struct Scene {
+    pub hair: Hair,
+    pub hair_name: String,
+    /// The environment with its lights turned by the session's yaw.
+    pub environment: Environment,
+    pub sigma_a: Vec<[f32; 3]>,
+    pub look: HairLook,
+    pub camera: Camera,
+    pub settings: RenderSettings,
+    /// Files that changed since the session recorded them (the scene still opened).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// The scene of `session` at the session's render size.
+    pub fn assemble(session: &Session) -> Result<Self, AssembleError> {
+        let hair = load_hair_source(&session.hair)?;
+        let (environment, env_warning) = load_environment_source(&session.environment)?;
+        Self::from_parts(session, hair, environment, env_warning)
+    }
+
+    /// The scene from an already loaded hair and environment (the editor reloads only what changed).
+    pub fn from_parts(
+        session: &Session,
+        hair: LoadedHairSource,
+        mut environment: Environment,
+        env_warning: Option<String>,
+    ) -> Result<Self, AssembleError> {
+        let (sigma_a, look) = absorption(&session.look, &hair.hair, session.paint.as_deref())?;
+        environment.lights = turned_lights(&environment.lights, session.env_yaw);
+        let r = &session.render;
+        let (lo, hi) = hair.hair.bounds();
+        let camera = session
+            .camera
+            .resolve(lo, hi, r.width as f32 / r.height.max(1) as f32);
+        Ok(Self {
+            warnings: hair.warning.into_iter().chain(env_warning).collect(),
+            hair: hair.hair,
+            hair_name: hair.name,
+            environment,
+            sigma_a,
+            look,
+            camera,
+            settings: r.settings(r.width, r.height),
+        })
+    }
+}
+
+/// The lights turned by `yaw_deg` about +Y (no refit), strongest first (by luminous power): the
+/// renderer shades and refines light batch by light batch, so the first batch carries the most light.
+pub fn turned_lights(set: &SrbfSet, yaw_deg: f64) -> SrbfSet {
+    let mut s = if yaw_deg == 0.0 {
+        set.clone()
+    } else {
+        set.rotated(yaw_deg.to_radians())
+    };
+    let luminance = |l: &crate::envmap::SrbfLight| {
+        let p = l.power();
+        0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+    };
+    s.lights
+        .sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
+    s
+}
+
+/// What an EXR still's header records besides the session.
+pub struct StillHeader<'a> {
+    pub hair_name: &'a str,
+    pub environment: &'a Environment,
+    pub look: &'a HairLook,
+    pub camera: &'a Camera,
+    pub settings: &'a RenderSettings,
+    pub adapter: &'a str,
+    pub mode: &'a str,
+}
+
+/// The EXR header attributes of a still (the CLI's `render` and the editor's export write the same):
+/// readable summaries and the whole session as JSON, which reopens the picture.
+pub fn still_attributes(session: &Session, h: &StillHeader) -> Vec<(String, String)> {
+    let s = h.settings;
+    vec![
+        ("hair".into(), h.hair_name.into()),
+        ("environment".into(), h.environment.name.clone()),
+        (
+            "lights".into(),
+            h.environment.lights.lights.len().to_string(),
+        ),
+        ("params".into(), json(&h.look.params)),
+        ("longitudinal".into(), json(&h.look.longitudinal())),
+        (
+            "absorption".into(),
+            format!(
+                "root {}, tip {}, strand variation {}, seed {}, paint {:?}",
+                json(&session.look.root),
+                session
+                    .look
+                    .tip
+                    .map_or_else(|| "as root".to_string(), |t| json(&t)),
+                session.look.strand_variation,
+                session.look.variation_seed,
+                session.paint
+            ),
+        ),
+        ("camera".into(), json(h.camera)),
+        ("exposure_ev".into(), s.exposure.to_string()),
+        ("samples".into(), s.samples.to_string()),
+        ("shadows".into(), s.shadows.to_string()),
+        (
+            "multiple_scattering".into(),
+            format!(
+                "{} (d_f {}, d_b {})",
+                s.multiple_scattering, h.look.fast.d_f, h.look.fast.d_b
+            ),
+        ),
+        ("adapter".into(), h.adapter.into()),
+        ("mode".into(), h.mode.into()),
+        ("session".into(), json(session)),
+    ]
+}
+
+/// Compact JSON of plain data (which cannot fail to serialise).
+fn json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string(v).unwrap_or_else(|e| e.to_string())
+}

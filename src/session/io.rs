@@ -1,0 +1,219 @@
+//! Session files (`.slsession`, versioned JSON) and atomic writes: a temporary file beside the target,
+//! written, flushed to disk, then renamed over it, so a crash leaves the old file or the new one,
+//! never half of either.
+
+use super::model::{SESSION_VERSION, Session};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    #[error("{path}: {message}")]
+    Io { path: PathBuf, message: String },
+    #[error("{path} is not a strandlight session: {message}")]
+    Format { path: PathBuf, message: String },
+    #[error(
+        "{path} is a session of version {found}; this strandlight reads version {SESSION_VERSION}"
+    )]
+    Version { path: PathBuf, found: u32 },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+/// Writes `bytes` to `path` atomically (temporary file, fsync, rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "session".into());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)?;
+        // The rename itself is durable once the folder is synced (best effort: not every OS allows it).
+        if let Ok(d) = std::fs::File::open(&dir) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+impl Session {
+    /// The session as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self)
+            .unwrap_or_else(|e| unreachable!("a session holds only serialisable plain data: {e}"))
+    }
+
+    /// Parses and validates a session; errors name `path`.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, SessionError> {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| SessionError::Format {
+                path: path.into(),
+                message: e.to_string(),
+            })?;
+        let found = value.get("version").and_then(|v| v.as_u64());
+        match found {
+            Some(v) if v == SESSION_VERSION as u64 => {}
+            Some(v) => {
+                return Err(SessionError::Version {
+                    path: path.into(),
+                    found: v.min(u32::MAX as u64) as u32,
+                });
+            }
+            None => {
+                return Err(SessionError::Format {
+                    path: path.into(),
+                    message: "no \"version\" field".into(),
+                });
+            }
+        }
+        let session: Session = serde_json::from_value(value).map_err(|e| SessionError::Format {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
+        session
+            .validate()
+            .map_err(|message| SessionError::Invalid {
+                path: path.into(),
+                message,
+            })?;
+        Ok(session)
+    }
+
+    pub fn read(path: &Path) -> Result<Self, SessionError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SessionError::Io {
+            path: path.into(),
+            message: format!("cannot read the session: {e}"),
+        })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Saves atomically.
+    pub fn write(&self, path: &Path) -> Result<(), SessionError> {
+        write_atomic(path, self.to_json().as_bytes()).map_err(|e| SessionError::Io {
+            path: path.into(),
+            message: format!("cannot write the session: {e}"),
+        })
+    }
+
+    /// Checks the values a file could get wrong.
+    pub fn validate(&self) -> Result<(), String> {
+        self.look.validate()?;
+        let r = &self.render;
+        if !matches!(r.samples, 2 | 4) {
+            return Err(format!("render samples must be 2 or 4, got {}", r.samples));
+        }
+        if r.width == 0 || r.height == 0 || r.width > 16384 || r.height > 16384 {
+            return Err(format!(
+                "render size {}x{} is out of range",
+                r.width, r.height
+            ));
+        }
+        if !r.exposure.is_finite() || !self.env_yaw.is_finite() {
+            return Err("exposure and environment yaw must be finite".into());
+        }
+        let c = &self.camera;
+        if !(c.fov_y > 1.0 && c.fov_y < 170.0 && c.yaw.is_finite() && c.pitch.is_finite()) {
+            return Err("the camera's field of view lies in (1, 170) degrees".into());
+        }
+        if let Some(d) = c.distance
+            && !(d > 0.0 && d.is_finite())
+        {
+            return Err(format!("camera distance must be positive, got {d}"));
+        }
+        if let super::model::HairSource::Generated {
+            strands, points, ..
+        } = self.hair
+            && (strands == 0 || strands > 2_000_000 || !(2..=256).contains(&points))
+        {
+            return Err(format!(
+                "generated hair of {strands} strands x {points} points is out of range"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The recovery file autosave writes for a session saved at `path` (or for an unsaved one).
+pub fn recovery_path(session_path: Option<&Path>) -> PathBuf {
+    match session_path {
+        Some(p) => {
+            let mut name = p.file_name().unwrap_or_default().to_os_string();
+            name.push(".recovery");
+            p.with_file_name(name)
+        }
+        None => state_dir().join("unsaved.slsession.recovery"),
+    }
+}
+
+/// Where the editor keeps recovery files and its recent-files list: `$STRANDLIGHT_STATE_DIR`, else
+/// `$XDG_STATE_HOME/strandlight`, else `~/.local/state/strandlight`.
+pub fn state_dir() -> PathBuf {
+    if let Some(d) = std::env::var_os("STRANDLIGHT_STATE_DIR") {
+        return PathBuf::from(d);
+    }
+    if let Some(d) = std::env::var_os("XDG_STATE_HOME") {
+        return PathBuf::from(d).join("strandlight");
+    }
+    match std::env::var_os("HOME") {
+        Some(h) => PathBuf::from(h).join(".local/state/strandlight"),
+        None => std::env::temp_dir().join("strandlight"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sessions_round_trip_and_bad_files_name_themselves() {
+        let dir = std::env::temp_dir().join(format!("sl-session-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.slsession");
+        let s = Session {
+            env_yaw: 12.5,
+            ..Default::default()
+        };
+        s.write(&path).unwrap();
+        assert_eq!(Session::read(&path).unwrap(), s);
+        std::fs::write(&path, "{ not json").unwrap();
+        let e = Session::read(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("a.slsession") && e.contains("not a strandlight session"),
+            "{e}"
+        );
+        let newer = s.to_json().replace("\"version\": 1", "\"version\": 9");
+        let e = Session::from_json(&newer, &path).unwrap_err().to_string();
+        assert!(e.contains("version 9"), "{e}");
+        let bad = s.to_json().replace("\"d_f\": 0.7", "\"d_f\": 3.0");
+        let e = Session::from_json(&bad, &path).unwrap_err().to_string();
+        assert!(e.contains("d_f"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn presets_are_spelled_as_on_the_command_line() {
+        let text = Session::default()
+            .to_json()
+            .replace("\"style\": \"wavy\"", "\"style\": \"bob\"");
+        let s = Session::from_json(&text, Path::new("x")).unwrap();
+        assert!(matches!(
+            s.hair,
+            crate::session::HairSource::Generated {
+                style: crate::hair::procedural::Style::Bob,
+                ..
+            }
+        ));
+    }
+}

@@ -1,0 +1,17 @@
+//! The session model the editor and the CLI share: what defines a picture ([`Session`]), edits as data
+//! with undo/redo ([`Edit`], [`History`]), session files with atomic writes, and scene assembly.
+
+pub mod assemble;
+pub mod edit;
+pub mod history;
+pub mod io;
+pub mod model;
+
+pub use assemble::{AssembleError, Scene};
+pub use edit::{Edit, EditKind, apply};
+pub use history::History;
+pub use io::{SessionError, write_atomic};
+pub use model::{
+    Absorption, EnvironmentSource, HairSource, Look, RenderOptions, SESSION_VERSION, Session,
+    ViewCamera,
+};

@@ -1,0 +1,315 @@
+//! The session: everything that defines a picture, as the editor saves it and `render --session` reads
+//! it. Plain data (serde), no GPU state; the CLI and the editor assemble scenes from it the same way
+//! ([`super::assemble`]).
+
+use crate::envmap::SrbfSet;
+use crate::hair::procedural::Style;
+use crate::paint::sigma_a_from_colour;
+use crate::render::{Camera, RenderSettings};
+use crate::scattering::params::sigma_a_from_melanin;
+use crate::scattering::{HairParams, LongitudinalModel, Preset};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// The session file's format version.
+pub const SESSION_VERSION: u32 = 1;
+
+/// Where the hair comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum HairSource {
+    /// The procedural generator around its generated head.
+    Generated {
+        style: Style,
+        strands: usize,
+        points: usize,
+        seed: u64,
+    },
+    /// A hair file (.hair, .tfx, .gltf, .glb); the BLAKE3 of its bytes when it was chosen tells a
+    /// changed file on reopening.
+    File {
+        path: PathBuf,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        blake3: Option<String>,
+    },
+}
+
+/// Where the lights come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum EnvironmentSource {
+    /// The project's sunny sky and its committed 40-light fit.
+    Builtin,
+    /// An .hdr / .exr (fitted with `lights` SRBFs) or .srbf.json. The fitted lights are kept so that the
+    /// session reopens without refitting.
+    File {
+        path: PathBuf,
+        lights: usize,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        blake3: Option<String>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fitted: Option<Box<SrbfSet>>,
+    },
+}
+
+/// How one end of the strands gets its absorption sigma_a (per unit fibre radius, RGB).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum Absorption {
+    /// Eumelanin and pheomelanin concentrations (d'Eon et al. 2011).
+    Melanin { eumelanin: f64, pheomelanin: f64 },
+    /// A dye colour (linear RGB, the multiple-scattering albedo) inverted by Chiang et al. 2016 Eq. 9
+    /// with azimuthal roughness beta_n.
+    Dye { colour: [f64; 3], beta_n: f64 },
+    /// sigma_a itself.
+    SigmaA { sigma_a: [f64; 3] },
+}
+
+impl Absorption {
+    pub fn sigma_a(&self) -> [f64; 3] {
+        match *self {
+            Absorption::Melanin {
+                eumelanin,
+                pheomelanin,
+            } => sigma_a_from_melanin(eumelanin, pheomelanin),
+            Absorption::Dye { colour, beta_n } => sigma_a_from_colour(colour, beta_n),
+            Absorption::SigmaA { sigma_a } => sigma_a,
+        }
+    }
+
+    pub fn from_preset(preset: Preset) -> Self {
+        let (eumelanin, pheomelanin) = preset.melanin();
+        Absorption::Melanin {
+            eumelanin,
+            pheomelanin,
+        }
+    }
+}
+
+/// The hair look: Marschner's parameters (their sigma_a is replaced by the absorption below), the
+/// absorption at the roots and tips, per-strand variation, Zinke's density factors and the
+/// longitudinal function.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Look {
+    pub params: HairParams,
+    pub root: Absorption,
+    /// None: the same as the root (no gradient).
+    #[serde(default)]
+    pub tip: Option<Absorption>,
+    /// Per-strand log-normal variation of sigma_a (standard deviation of ln sigma_a).
+    #[serde(default)]
+    pub strand_variation: f32,
+    #[serde(default = "one")]
+    pub variation_seed: u64,
+    pub d_f: f32,
+    pub d_b: f32,
+    #[serde(default)]
+    pub longitudinal: LongitudinalModel,
+}
+
+fn one() -> u64 {
+    1
+}
+
+impl Look {
+    pub fn from_preset(preset: Preset) -> Self {
+        Self {
+            params: preset.params(),
+            root: Absorption::from_preset(preset),
+            tip: None,
+            strand_variation: 0.0,
+            variation_seed: 1,
+            d_f: 0.7,
+            d_b: 0.7,
+            longitudinal: LongitudinalModel::Normalized,
+        }
+    }
+
+    /// Checks every value, naming the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        self.params.validate()?;
+        for (name, a) in [("root", Some(self.root)), ("tip", self.tip)] {
+            let Some(a) = a else { continue };
+            if a.sigma_a().iter().any(|s| !(s.is_finite() && *s >= 0.0)) {
+                return Err(format!("the {name} absorption must be finite and >= 0"));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.d_f) || !(0.0..=1.0).contains(&self.d_b) {
+            return Err(format!(
+                "d_f and d_b lie in [0, 1], got {} and {}",
+                self.d_f, self.d_b
+            ));
+        }
+        if !(self.strand_variation.is_finite() && (0.0..=2.0).contains(&self.strand_variation)) {
+            return Err(format!(
+                "strand variation lies in [0, 2], got {}",
+                self.strand_variation
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Default for Look {
+    fn default() -> Self {
+        Self::from_preset(Preset::Brown)
+    }
+}
+
+/// The camera as the session keeps it: an orbit whose target and distance are framed around the hair
+/// until the user moves them.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewCamera {
+    /// Degrees about +Y; 0 looks along -Z.
+    pub yaw: f32,
+    /// Degrees of elevation.
+    pub pitch: f32,
+    /// Vertical field of view, degrees.
+    pub fov_y: f32,
+    /// None: the hair's bounding-box centre.
+    #[serde(default)]
+    pub target: Option<[f32; 3]>,
+    /// None: far enough to frame the hair.
+    #[serde(default)]
+    pub distance: Option<f32>,
+}
+
+impl Default for ViewCamera {
+    fn default() -> Self {
+        Self {
+            yaw: 35.0,
+            pitch: 10.0,
+            fov_y: 30.0,
+            target: None,
+            distance: None,
+        }
+    }
+}
+
+impl ViewCamera {
+    /// The orbit camera for a hair with bounds (lo, hi) and an image of this aspect.
+    pub fn resolve(&self, lo: glam::Vec3, hi: glam::Vec3, aspect: f32) -> Camera {
+        // As `render --fov` does: framed at the default field of view, then the session's.
+        let mut c = Camera::framing(lo, hi, self.yaw, self.pitch, aspect, 0.9);
+        c.fov_y = self.fov_y;
+        if let Some(t) = self.target {
+            c.target = t;
+        }
+        if let Some(d) = self.distance {
+            c.distance = d;
+        }
+        c
+    }
+
+    /// Keeps a resolved camera (after the user moved it).
+    pub fn from_camera(c: &Camera) -> Self {
+        Self {
+            yaw: c.yaw,
+            pitch: c.pitch,
+            fov_y: c.fov_y,
+            target: Some(c.target),
+            distance: Some(c.distance),
+        }
+    }
+}
+
+/// What a still is rendered with (the editor's viewport uses its own size).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    /// Exposure in stops (applied to the EXR as `render --exposure` does).
+    pub exposure: f32,
+    pub shadows: bool,
+    pub multiple_scattering: bool,
+    pub volume_resolution: u32,
+    pub shadow_grid_resolution: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        let s = RenderSettings::default();
+        Self {
+            width: s.width,
+            height: s.height,
+            samples: s.samples,
+            exposure: s.exposure,
+            shadows: s.shadows,
+            multiple_scattering: s.multiple_scattering,
+            volume_resolution: s.volume_resolution,
+            shadow_grid_resolution: s.shadow_grid_resolution,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The renderer's settings at a given size.
+    pub fn settings(&self, width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            samples: self.samples,
+            exposure: self.exposure,
+            shadows: self.shadows,
+            multiple_scattering: self.multiple_scattering,
+            volume_resolution: self.volume_resolution,
+            shadow_grid_resolution: self.shadow_grid_resolution,
+            ..Default::default()
+        }
+    }
+}
+
+/// Everything that defines a picture.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Session {
+    pub version: u32,
+    pub hair: HairSource,
+    pub environment: EnvironmentSource,
+    /// Turn of the environment about +Y, degrees.
+    #[serde(default)]
+    pub env_yaw: f64,
+    pub look: Look,
+    #[serde(default)]
+    pub camera: ViewCamera,
+    #[serde(default)]
+    pub render: RenderOptions,
+    /// A paint layer (SLPAINT1) applied over the look's absorption.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paint: Option<PathBuf>,
+}
+
+impl Default for Session {
+    /// The editor's first scene: a wavy style of 3000 strands on the generated head under the sunny
+    /// sky (small enough to refine in seconds on a software GPU).
+    fn default() -> Self {
+        Self {
+            version: SESSION_VERSION,
+            hair: HairSource::Generated {
+                style: Style::Wavy,
+                strands: 3000,
+                points: 16,
+                seed: 1,
+            },
+            environment: EnvironmentSource::Builtin,
+            env_yaw: 0.0,
+            look: Look::default(),
+            camera: ViewCamera::default(),
+            render: RenderOptions::default(),
+            paint: None,
+        }
+    }
+}
+
+impl Session {
+    /// The look's parameters as the renderer takes them, with sigma_a from the root absorption.
+    pub fn params(&self) -> HairParams {
+        HairParams {
+            sigma_a: self.look.root.sigma_a(),
+            ..self.look.params
+        }
+    }
+}

@@ -1,0 +1,65 @@
+//! The viewport's display pass (shaders/display.wgsl) against its CPU twin `display_pixel`, on lavapipe:
+//! both view transforms, the viewport exposure, partial coverage over the background, and a solo
+//! component.
+
+use strandlight::gpu::{GpuContext, GpuOptions};
+use strandlight::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform, display_pixel};
+use strandlight::render::targets::FrameTargets;
+
+#[test]
+fn the_display_pass_matches_its_cpu_twin() {
+    let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
+    let (w, h) = (37u32, 11u32);
+    let targets = FrameTargets::new(&ctx.device, w, h, 4);
+    let n = (w * h) as usize;
+    // Radiance from 0 to ~8 (past the filmic shoulder), coverage from 0 to 1.
+    let beauty: Vec<[f32; 4]> = (0..n)
+        .map(|i| {
+            let a = (i % 5) as f32 / 4.0;
+            let x = 8.0 * (i as f32 / n as f32).powi(2);
+            [a * x, a * 0.5 * x, a * 0.1 * x, a]
+        })
+        .collect();
+    let component: Vec<[f32; 4]> = beauty
+        .iter()
+        .map(|p| [0.3 * p[0], 0.2 * p[1], p[2], 0.0])
+        .collect();
+    ctx.queue
+        .write_buffer(&targets.beauty, 0, bytemuck::cast_slice(&beauty));
+    ctx.queue
+        .write_buffer(&targets.components[1], 0, bytemuck::cast_slice(&component));
+    let pass = DisplayPass::new(&ctx.device, w, h);
+    let mut worst = 0.0f32;
+    for (transform, ev, solo) in [
+        (ViewTransform::Filmic, 0.0, Solo::Beauty),
+        (ViewTransform::Standard, 0.0, Solo::Beauty),
+        (ViewTransform::Filmic, 1.5, Solo::Beauty),
+        (ViewTransform::Standard, -1.0, Solo::Component(1)),
+    ] {
+        let info = DisplayInfo {
+            render_scale: 2.0,
+            ..DisplayInfo::new(w, h, transform, ev, [0.2, 0.3, 0.4])
+        };
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        pass.encode(&ctx.device, &ctx.queue, &mut enc, &targets, &info, solo);
+        let (buffer, row) = pass.copy_to_buffer(&ctx.device, &mut enc);
+        ctx.queue.submit([enc.finish()]);
+        let bytes: Vec<u8> = ctx.read_buffer(&buffer).expect("read back");
+        let cpu_info = DisplayInfo {
+            solo: matches!(solo, Solo::Component(_)) as u32,
+            ..info
+        };
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let i = y * w as usize + x;
+                let want = display_pixel(&cpu_info, beauty[i], component[i]);
+                for c in 0..4 {
+                    let got = bytes[y * row as usize + 4 * x + c] as f32 / 255.0;
+                    worst = worst.max((got - want[c]).abs());
+                }
+            }
+        }
+    }
+    println!("display pass against display_pixel: worst {worst:.4} (one 8-bit step is 0.0039)");
+    assert!(worst <= 1.0 / 255.0 + 1e-4, "{worst}");
+}

@@ -1,0 +1,528 @@
+//! The editor driven as a user drives it (egui_kittest with its wgpu renderer on lavapipe): the
+//! viewport against `strandlight render --session`, panel edits against image statistics, navigation,
+//! undo/redo, save/reopen, autosave and recovery, bad files, export. Small scenes, a quarter-resolution
+//! viewport and a coarse shadow grid keep each refinement to a few seconds on two cores.
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+use strandlight::editor::{EditorApp, EditorOptions};
+use strandlight::hair::procedural::Style;
+use strandlight::render::Frame;
+use strandlight::session::{HairSource, Session};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("strandlight-editor-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d.join(name)
+}
+
+/// A bob of 400 strands with a coarse volume and shadow grid.
+fn small_session() -> Session {
+    let mut s = Session {
+        hair: HairSource::Generated {
+            style: Style::Bob,
+            strands: 400,
+            points: 8,
+            seed: 3,
+        },
+        ..Default::default()
+    };
+    s.render.volume_resolution = 48;
+    s.render.shadow_grid_resolution = 16;
+    s
+}
+
+fn harness(session: Session, state_dir: &Path, recovery: bool) -> Harness<'static, EditorApp> {
+    std::fs::create_dir_all(state_dir).expect("state dir");
+    let state_dir = state_dir.to_path_buf();
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1100.0, 640.0))
+        .wgpu_setup(strandlight::editor::wgpu_setup())
+        .build_eframe(move |cc| {
+            EditorApp::new(
+                cc,
+                EditorOptions {
+                    session_path: None,
+                    session: Some(session),
+                    offer_recovery: recovery,
+                    state_dir: Some(state_dir),
+                },
+            )
+        });
+    h.state_mut().view.scale = 0.25;
+    h
+}
+
+/// Steps the UI until the viewport has converged (the GPU works between steps).
+fn converge(h: &mut Harness<'static, EditorApp>) {
+    let t = Instant::now();
+    loop {
+        h.step();
+        if h.state().converged().is_some() && h.state().loading.is_none() {
+            // One more frame: the display pass of the last unit.
+            h.step();
+            return;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(300),
+            "the viewport did not converge in 300 s"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// The viewport's converged image, read back from the renderer.
+fn image(h: &Harness<'static, EditorApp>) -> Frame {
+    let live = h.state().live.as_ref().expect("a live scene");
+    live.renderer.read_frame(&live.ctx).expect("read back")
+}
+
+/// Mean luminance of the hair pixels (coverage-weighted beauty over coverage).
+fn mean_luminance(f: &Frame) -> f64 {
+    let (mut sum, mut cover) = (0.0, 0.0);
+    for p in &f.beauty {
+        sum += 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+        cover += p[3] as f64;
+    }
+    sum / cover.max(1e-9)
+}
+
+fn max_relative_difference(a: &Frame, b: &Frame) -> f32 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let peak = a
+        .beauty
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(1e-6f32, f32::max);
+    a.beauty
+        .iter()
+        .zip(&b.beauty)
+        .flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0, f32::max)
+        / peak
+}
+
+/// The slider (not its number field) labelled `label`.
+fn slider<'h>(h: &'h Harness<'static, EditorApp>, label: &'h str) -> egui_kittest::Node<'h> {
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, label)
+}
+
+fn click(h: &mut Harness<'static, EditorApp>, label: &str) {
+    h.get_by_label(label).click();
+    h.step();
+}
+
+#[test]
+fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
+    let dir = tmp("equal");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let adapter = h.state().gpu.as_ref().expect("a GPU").summary.name.clone();
+    assert!(
+        h.query_by_label_contains(&adapter).is_some(),
+        "the status bar names {adapter}"
+    );
+    // The window changes size (the render follows the viewport), then one orbit makes the camera
+    // explicit; the session is saved at the viewport's render size.
+    let before = image(&h);
+    h.set_size(egui::vec2(1000.0, 600.0));
+    h.step();
+    converge(&mut h);
+    assert_ne!(
+        (before.width, before.height),
+        (image(&h).width, image(&h).height)
+    );
+    let centre = h.state().viewport_rect.expect("a viewport").center();
+    middle_drag(&mut h, centre, egui::vec2(30.0, 0.0), egui::Modifiers::NONE);
+    converge(&mut h);
+    let viewport = image(&h);
+    let mut session = h.state().session.clone();
+    session.render.width = viewport.width;
+    session.render.height = viewport.height;
+    let path = dir.join("equal.slsession");
+    session.write(&path).expect("saved");
+    let exr = dir.join("equal.exr");
+    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
+        .args(["render", "--session"])
+        .arg(&path)
+        .arg("-o")
+        .arg(&exr)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let cli = read_exr_beauty(&exr, viewport.width, viewport.height);
+    let d = max_relative_difference(&viewport, &cli);
+    println!(
+        "viewport {}x{} against render --session: max difference {d:.2e} of the peak",
+        viewport.width, viewport.height
+    );
+    assert!(d < 1e-4, "{d}");
+}
+
+/// RGBA of an EXR as a frame's beauty.
+fn read_exr_beauty(path: &Path, width: u32, height: u32) -> Frame {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .expect("a readable EXR");
+    let get = |name: &str| -> Vec<f32> {
+        let c = image
+            .layer_data
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .expect("channel");
+        match &c.sample_data {
+            exr::prelude::FlatSamples::F32(v) => v.clone(),
+            other => panic!("{name} is not float32: {other:?}"),
+        }
+    };
+    let (r, g, b, a) = (get("R"), get("G"), get("B"), get("A"));
+    Frame {
+        width,
+        height,
+        samples: 4,
+        beauty: (0..r.len()).map(|i| [r[i], g[i], b[i], a[i]]).collect(),
+        depth: Vec::new(),
+        sample_ids: Vec::new(),
+        components: Vec::new(),
+    }
+}
+
+fn middle_drag(
+    h: &mut Harness<'static, EditorApp>,
+    from: egui::Pos2,
+    by: egui::Vec2,
+    modifiers: egui::Modifiers,
+) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(from);
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Middle,
+        pressed: true,
+        modifiers,
+    });
+    h.step();
+    for k in 1..=4 {
+        h.event(egui::Event::PointerMoved(from + by * (k as f32 / 4.0)));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: from + by,
+        button: egui::PointerButton::Middle,
+        pressed: false,
+        modifiers,
+    });
+    h.step();
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+#[test]
+fn panel_edits_change_the_image_and_three_undos_restore_it() {
+    let dir = tmp("edits");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let before_session = h.state().session.clone();
+    let before = image(&h);
+    let brown = mean_luminance(&before);
+
+    // Raising sigma_a (the dark-brown preset) darkens the hair; blond lightens it.
+    click(&mut h, "dark brown");
+    converge(&mut h);
+    let dark = mean_luminance(&image(&h));
+    click(&mut h, "blond");
+    converge(&mut h);
+    let blond = mean_luminance(&image(&h));
+    println!("mean luminance: dark brown {dark:.4}, brown {brown:.4}, blond {blond:.4}");
+    assert!(dark < 0.8 * brown && blond > 1.5 * brown);
+
+    // The environment's yaw changes the image without a refit (no job starts).
+    slider(&h, "yaw").set_value_accesskit(90.0);
+    h.step();
+    assert!(h.state().loading.is_none(), "yaw must not refit");
+    converge(&mut h);
+    let turned = image(&h);
+    let yawed = mean_luminance(&turned);
+    println!("yaw 90: {yawed:.4}");
+    assert!((yawed - blond).abs() > 1e-3 * blond);
+    assert_eq!(h.state().session.env_yaw, 90.0);
+
+    // Three edits (dark brown, blond, yaw), three Ctrl+Z: the session and the image as before.
+    for _ in 0..3 {
+        h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        h.step();
+    }
+    assert_eq!(h.state().session, before_session);
+    converge(&mut h);
+    let restored = image(&h);
+    let d = max_relative_difference(&before, &restored);
+    println!("after three undos: max difference {d:.2e} of the peak");
+    assert!(d < 1e-5);
+    // Redo reapplies them.
+    for _ in 0..3 {
+        h.key_press_modifiers(
+            egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+            egui::Key::Z,
+        );
+        h.step();
+    }
+    assert_eq!(h.state().session.env_yaw, 90.0);
+    assert_eq!(
+        h.state().session.look.root,
+        strandlight::session::Absorption::from_preset(strandlight::scattering::Preset::Blond)
+    );
+}
+
+#[test]
+fn a_narrower_highlight_is_sharper() {
+    let dir = tmp("beta");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let r_peak = |f: &Frame| -> f32 {
+        // The 99th percentile of the R lobe's luminance over covered pixels.
+        let mut v: Vec<f32> = f.components[0]
+            .iter()
+            .zip(&f.beauty)
+            .filter(|(_, b)| b[3] > 0.5)
+            .map(|(c, _)| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2])
+            .collect();
+        v.sort_by(f32::total_cmp);
+        v[(v.len() * 99) / 100]
+    };
+    let wide = r_peak(&image(&h));
+    slider(&h, "β_R width").set_value_accesskit(3.0);
+    h.step();
+    converge(&mut h);
+    let narrow = r_peak(&image(&h));
+    println!("R lobe p99: beta_R 7.5 deg {wide:.4}, 3 deg {narrow:.4}");
+    assert!((h.state().session.look.params.beta_r.to_degrees() - 3.0).abs() < 1e-9);
+    assert!(narrow > 1.3 * wide);
+}
+
+#[test]
+fn navigation_orbits_zooms_and_frames() {
+    let dir = tmp("nav");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let start = h.state().camera.expect("a camera");
+    let centre = h.state().viewport_rect.expect("a viewport").center();
+    middle_drag(
+        &mut h,
+        centre,
+        egui::vec2(50.0, 20.0),
+        egui::Modifiers::NONE,
+    );
+    let orbited = h.state().camera.expect("a camera");
+    println!(
+        "orbit: yaw {} -> {}, pitch {} -> {}",
+        start.yaw, orbited.yaw, start.pitch, orbited.pitch
+    );
+    assert!(orbited.yaw != start.yaw && orbited.pitch != start.pitch);
+    assert!((orbited.distance - start.distance).abs() < 1e-4);
+    assert_eq!(h.state().session.camera.yaw, orbited.yaw);
+    // Shift+middle pans: the target moves, the distance stays.
+    middle_drag(
+        &mut h,
+        centre,
+        egui::vec2(40.0, 0.0),
+        egui::Modifiers::SHIFT,
+    );
+    let panned = h.state().camera.expect("a camera");
+    assert!(panned.target != orbited.target);
+    // The wheel zooms in.
+    h.hover_at(centre);
+    for _ in 0..6 {
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: egui::vec2(0.0, 40.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Wheel,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    let zoomed = h.state().camera.expect("a camera");
+    println!("zoom: distance {} -> {}", panned.distance, zoomed.distance);
+    assert!(zoomed.distance < 0.9 * panned.distance);
+    // Home frames the hair again: the target is the hair's centre.
+    h.hover_at(centre);
+    h.key_press(egui::Key::Home);
+    h.step();
+    let framed = h.state().camera.expect("a camera");
+    let hair = h.state().live.as_ref().expect("live").hair.clone();
+    let (lo, hi) = hair.bounds();
+    let mid = 0.5 * (lo + hi);
+    assert!((glam::Vec3::from(framed.target) - mid).length() < 1e-4);
+    assert!(h.state().session.camera.target.is_none());
+    // Camera moves are not edits.
+    assert!(!h.state().history.can_undo());
+}
+
+#[test]
+fn sessions_save_reopen_autosave_and_recover() {
+    let dir = tmp("sessions");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    click(&mut h, "auburn");
+    converge(&mut h);
+    let first = image(&h);
+    let path = dir.join("look.slsession");
+    h.state_mut().save_session(&path);
+    assert!(!h.state().modified());
+    let saved = h.state().session.clone();
+
+    // Reopen in a new editor: same model, equal image.
+    let mut h2 = harness(Session::default(), &dir.join("other"), false);
+    h2.state_mut().open_session(&path);
+    converge(&mut h2);
+    assert_eq!(h2.state().session, saved);
+    // The same viewport size and camera: the same image.
+    let d = max_relative_difference(&first, &image(&h2));
+    println!("reopened: max difference {d:.2e} of the peak");
+    assert!(d < 1e-4);
+    drop(h2);
+
+    // A change produces the autosave file (the interval shortened for the test).
+    h.state_mut().autosave.interval = Duration::from_millis(10);
+    click(&mut h, "platinum");
+    let recovery = h.state().autosave.path.clone();
+    let t = Instant::now();
+    while h.state().autosave.writes == 0 {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+        assert!(t.elapsed() < Duration::from_secs(20), "no autosave");
+    }
+    assert!(recovery.is_file());
+    let changed = h.state().session.clone();
+    // "Kill" the editor: no on_exit.
+    std::mem::forget(h);
+
+    // The next start offers the recovery, which restores the model.
+    let mut h3 = harness(Session::default(), &dir, true);
+    h3.step();
+    assert!(h3.state().recovery_offer.is_some());
+    click(&mut h3, "Recover");
+    assert_eq!(h3.state().session.look, changed.look);
+    assert_eq!(h3.state().session_path.as_deref(), Some(path.as_path()));
+}
+
+#[test]
+fn corrupt_files_show_an_error_and_leave_the_scene() {
+    let dir = tmp("corrupt");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let before = h.state().session.clone();
+    let bad_hair = dir.join("broken.hair");
+    std::fs::write(&bad_hair, b"HAIR\x01\x00\x00\x00garbage").expect("written");
+    h.state_mut().open_hair(bad_hair.clone());
+    wait_for_loading(&mut h);
+    let msg = h.state().messages.last().expect("a message").text.clone();
+    println!("{msg}");
+    assert!(msg.contains("broken.hair"));
+    assert_eq!(h.state().session, before);
+    assert!(h.query_by_label_contains("broken.hair").is_some());
+
+    let bad_env = dir.join("broken.exr");
+    std::fs::write(&bad_env, b"not an exr at all").expect("written");
+    h.state_mut().load_environment(bad_env, 8);
+    wait_for_loading(&mut h);
+    let msg = h.state().messages.last().expect("a message").text.clone();
+    println!("{msg}");
+    assert!(msg.contains("broken.exr"));
+    assert_eq!(h.state().session, before);
+    assert!(h.state().live.is_some());
+
+    // A session whose hair file has gone opens the rest, says so, and keeps pointing at the file.
+    let mut gone = before.clone();
+    gone.hair = HairSource::File {
+        path: dir.join("moved-away.hair"),
+        blake3: None,
+    };
+    gone.env_yaw = 45.0;
+    let path = dir.join("gone.slsession");
+    gone.write(&path).expect("saved");
+    h.state_mut().open_session(&path);
+    converge(&mut h);
+    let warned = h
+        .state()
+        .messages
+        .iter()
+        .any(|m| m.text.contains("moved-away.hair"));
+    assert!(warned, "the missing file is reported");
+    assert_eq!(h.state().session, gone);
+}
+
+fn wait_for_loading(h: &mut Harness<'static, EditorApp>) {
+    let t = Instant::now();
+    while h.state().loading.is_some() {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+        assert!(t.elapsed() < Duration::from_secs(60), "loading hangs");
+    }
+}
+
+#[test]
+fn export_equals_render_session_and_the_screenshot_is_made() {
+    let dir = tmp("export");
+    let mut session = small_session();
+    session.render.width = 96;
+    session.render.height = 64;
+    let mut h = harness(session, &dir, false);
+    converge(&mut h);
+    let exr = dir.join("export.exr");
+    strandlight::editor::panels::menu::start_export(h.state_mut(), exr.clone());
+    let t = Instant::now();
+    while h.state().export.is_some() {
+        h.step();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(t.elapsed() < Duration::from_secs(300), "export hangs");
+    }
+    assert!(exr.is_file() && exr.with_extension("png").is_file());
+    let path = dir.join("export.slsession");
+    h.state().session.write(&path).expect("saved");
+    let cli_exr = dir.join("cli.exr");
+    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
+        .args(["render", "--session"])
+        .arg(&path)
+        .arg("-o")
+        .arg(&cli_exr)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (a, b) = (
+        read_exr_beauty(&exr, 96, 64),
+        read_exr_beauty(&cli_exr, 96, 64),
+    );
+    let d = max_relative_difference(&a, &b);
+    println!("export against render --session: max difference {d:.2e} of the peak");
+    assert!(d < 1e-4);
+
+    // The README's screenshot, made here.
+    let shot = h.render().expect("a screenshot");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("editor.png");
+    shot.save(&out).expect("saved");
+    println!("screenshot: {}", out.display());
+    let lum: f64 = shot
+        .pixels()
+        .map(|p| p.0[0] as f64 + p.0[1] as f64 + p.0[2] as f64)
+        .sum::<f64>()
+        / (3.0 * shot.pixels().len() as f64);
+    assert!(lum > 5.0, "the screenshot is black");
+}
