@@ -36,6 +36,16 @@ fn small_session() -> Session {
 }
 
 fn harness(session: Session, state_dir: &Path, recovery: bool) -> Harness<'static, EditorApp> {
+    harness_as(session, state_dir, recovery, None)
+}
+
+/// An editor with its own recovery-file name (`instance`: a number no running process has).
+fn harness_as(
+    session: Session,
+    state_dir: &Path,
+    recovery: bool,
+    instance: Option<u32>,
+) -> Harness<'static, EditorApp> {
     std::fs::create_dir_all(state_dir).expect("state dir");
     let state_dir = state_dir.to_path_buf();
     let mut h = Harness::builder()
@@ -49,6 +59,7 @@ fn harness(session: Session, state_dir: &Path, recovery: bool) -> Harness<'stati
                     session: Some(session),
                     offer_recovery: recovery,
                     state_dir: Some(state_dir),
+                    instance,
                 },
             )
         });
@@ -252,7 +263,10 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     // The environment's yaw changes the image without a refit (no job starts).
     slider(&h, "yaw").set_value_accesskit(90.0);
     h.step();
-    assert!(h.state().loading.is_none(), "yaw must not refit");
+    assert!(
+        h.state().loading.is_none() && h.state().source_job.is_none(),
+        "yaw must not refit"
+    );
     converge(&mut h);
     let turned = image(&h);
     let yawed = mean_luminance(&turned);
@@ -374,7 +388,8 @@ fn navigation_orbits_zooms_and_frames() {
 #[test]
 fn sessions_save_reopen_autosave_and_recover() {
     let dir = tmp("sessions");
-    let mut h = harness(small_session(), &dir, false);
+    // Process ids stop below 2^22 on Linux: these name editors that are not running.
+    let mut h = harness_as(small_session(), &dir, false, Some(4_000_000_001));
     converge(&mut h);
     click(&mut h, "auburn");
     converge(&mut h);
@@ -411,12 +426,26 @@ fn sessions_save_reopen_autosave_and_recover() {
     std::mem::forget(h);
 
     // The next start offers the recovery, which restores the model.
-    let mut h3 = harness(Session::default(), &dir, true);
+    let mut h3 = harness_as(Session::default(), &dir, true, Some(4_000_000_002));
     h3.step();
     assert!(h3.state().recovery_offer.is_some());
     click(&mut h3, "Recover");
     assert_eq!(h3.state().session.look, changed.look);
     assert_eq!(h3.state().session_path.as_deref(), Some(path.as_path()));
+    // The recovered work is now the new editor's own recovery file; the old one is gone.
+    assert!(!recovery.exists() && h3.state().autosave.path.is_file());
+    drop(h3);
+
+    // A recovery file of an editor that is still running (this process) is not offered.
+    let dir2 = dir.join("alive");
+    std::fs::create_dir_all(&dir2).expect("dir");
+    std::fs::copy(
+        dir.join("recovery-4000000002.slsession"),
+        dir2.join(format!("recovery-{}.slsession", std::process::id())),
+    )
+    .expect("copied");
+    let h4 = harness_as(Session::default(), &dir2, true, Some(4_000_000_003));
+    assert!(h4.state().recovery_offer.is_none());
 }
 
 #[test]
@@ -467,7 +496,7 @@ fn corrupt_files_show_an_error_and_leave_the_scene() {
 
 fn wait_for_loading(h: &mut Harness<'static, EditorApp>) {
     let t = Instant::now();
-    while h.state().loading.is_some() {
+    while h.state().loading.is_some() || h.state().source_job.is_some() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(60), "loading hangs");

@@ -40,5 +40,6 @@ pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
         session: Some(session),
         offer_recovery: true,
         state_dir: None,
+        instance: None,
     })
 }

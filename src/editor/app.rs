@@ -5,7 +5,7 @@
 use super::autosave::Autosave;
 use super::export::ExportJob;
 use super::jobs::Job;
-use super::live::{LiveScene, ViewSettings};
+use super::live::{LiveScene, Prepared, ViewSettings, prepare};
 use super::navigation;
 use super::panels;
 use crate::gpu::GpuContext;
@@ -29,6 +29,8 @@ pub struct EditorOptions {
     pub offer_recovery: bool,
     /// Where recovery files go (default [`crate::session::io::state_dir`]).
     pub state_dir: Option<PathBuf>,
+    /// Names this editor's recovery file (default: the process id; tests play several editors).
+    pub instance: Option<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,22 +49,45 @@ pub struct Message {
 
 /// What a load job brings back.
 pub enum Loaded {
-    /// Hair and environment for a new scene.
+    /// Hair and environment for a new scene, with the CPU work for its renderer done.
     Scene {
         hair: LoadedHairSource,
         environment: Environment,
+        prepared: Box<Prepared>,
         warnings: Vec<String>,
     },
-    /// A hair file that loaded: it becomes the session's hair (an edit) and the scene is rebuilt.
-    Hair {
-        hair: LoadedHairSource,
-        source: HairSource,
-    },
+    /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
+    Hair { source: HairSource },
     /// A new environment; applied as an edit when it arrives.
     Environment {
         environment: Environment,
         source: EnvironmentSource,
     },
+}
+
+/// What a scene is built from, beyond what the renderer changes in place: a failed build is not
+/// retried until one of these changes.
+#[derive(Clone, Debug, PartialEq)]
+struct SceneKey {
+    hair: HairSource,
+    environment: EnvironmentSource,
+    render: (u32, u32, u32),
+    paint: Option<PathBuf>,
+}
+
+impl SceneKey {
+    fn of(s: &Session) -> Self {
+        Self {
+            hair: s.hair.clone(),
+            environment: s.environment.clone(),
+            render: (
+                s.render.samples,
+                s.render.volume_resolution,
+                s.render.shadow_grid_resolution,
+            ),
+            paint: s.paint.clone(),
+        }
+    }
 }
 
 pub struct EditorApp {
@@ -78,11 +103,19 @@ pub struct EditorApp {
     pub gpu: Option<GpuContext>,
     egui_renderer: Option<Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>>,
     luts: Arc<Luts>,
+    /// The scene being loaded (hair, environment, renderer preparation).
     pub loading: Option<Job<Result<Loaded, String>>>,
     /// The session a scene load was started for (a newer request supersedes it).
     loading_for: Option<Session>,
+    /// A hair or environment file being loaded for an edit.
+    pub source_job: Option<Job<Result<Loaded, String>>>,
+    /// The scene whose build failed (not retried until the session's sources change).
+    failed: Option<SceneKey>,
     pub autosave: Autosave,
-    pub recovery_offer: Option<(PathBuf, Session)>,
+    /// A recovery file of an earlier run: the file, the session file it belonged to, the session.
+    pub recovery_offer: Option<(PathBuf, PathBuf, Session)>,
+    /// The environment panel's pictures (rebuilt when the environment changes).
+    pub env_preview: Option<super::env_preview::EnvPreview>,
     /// Sessions opened or saved lately, newest first (kept in the state folder).
     pub recent: Vec<PathBuf>,
     state_dir: PathBuf,
@@ -135,7 +168,11 @@ impl EditorApp {
             .state_dir
             .clone()
             .unwrap_or_else(crate::session::io::state_dir);
-        let autosave = Autosave::new(state_dir.clone(), session_path.as_deref());
+        let autosave = Autosave::new(
+            state_dir.clone(),
+            session_path.as_deref(),
+            options.instance.unwrap_or_else(std::process::id),
+        );
         let recent = read_recent(&state_dir);
         let recovery_offer = if options.offer_recovery {
             autosave.recovery_found()
@@ -156,10 +193,13 @@ impl EditorApp {
             luts: Arc::new(Luts::default_tables()),
             loading: None,
             loading_for: None,
+            source_job: None,
+            failed: None,
             autosave,
             recovery_offer,
             recent,
             state_dir,
+            env_preview: None,
             export: None,
             viewport_px: [640, 400],
             viewport_rect: None,
@@ -173,6 +213,10 @@ impl EditorApp {
 
     pub fn luts(&self) -> &Luts {
         &self.luts
+    }
+
+    pub fn egui_ctx(&self) -> egui::Context {
+        self.ctx.clone()
     }
 
     pub fn message(&mut self, level: Level, text: impl Into<String>) {
@@ -216,13 +260,12 @@ impl EditorApp {
         }
     }
 
-    /// Loads the session's hair and environment off the UI thread; the live scene is rebuilt when
-    /// they arrive.
+    /// Loads the session's hair and environment and prepares the renderer's CPU work off the UI
+    /// thread; the live scene is rebuilt when they arrive.
     pub fn load_scene(&mut self) {
-        let hair = self.session.hair.clone();
-        let env = self.session.environment.clone();
+        let session = self.session.clone();
         let ctx = self.ctx.clone();
-        self.loading_for = Some(self.session.clone());
+        self.loading_for = Some(session.clone());
         self.loading = Some(Job::spawn(
             "loading the scene",
             move || ctx.request_repaint(),
@@ -230,14 +273,14 @@ impl EditorApp {
                 // A missing or broken source is reported and the rest of the session opens (the
                 // session keeps pointing at the file).
                 let mut warnings = Vec::new();
-                let hair = match load_hair_source(&hair) {
+                let hair = match load_hair_source(&session.hair) {
                     Ok(h) => h,
                     Err(e) => {
                         warnings.push(format!("{e}; showing the default hairstyle instead"));
                         load_hair_source(&Session::default().hair).map_err(|e| e.to_string())?
                     }
                 };
-                let environment = match load_environment_source(&env) {
+                let environment = match load_environment_source(&session.environment) {
                     Ok((environment, w)) => {
                         warnings.extend(w);
                         environment
@@ -248,37 +291,38 @@ impl EditorApp {
                     }
                 };
                 warnings.extend(hair.warning.clone());
+                let prepared = prepare(&session, &hair.hair).map_err(|e| e.to_string())?;
                 Ok(Loaded::Scene {
                     hair,
                     environment,
+                    prepared: Box::new(prepared),
                     warnings,
                 })
             },
         ));
     }
 
-    /// Loads an environment file (fitting it when it is an image) and applies it as an edit when done.
+    /// Loads an environment file (fitting it when it is an image) on a worker and applies it as an
+    /// edit when done; a failure names the file and changes nothing.
     pub fn load_environment(&mut self, path: PathBuf, lights: usize) {
         let ctx = self.ctx.clone();
-        self.loading = Some(Job::spawn(
+        self.source_job = Some(Job::spawn(
             format!("loading {}", path.display()),
             move || ctx.request_repaint(),
             move |_| {
+                let blake3 = crate::session::assemble::file_blake3(&path).ok();
                 let source = EnvironmentSource::File {
                     path: path.clone(),
-                    lights,
-                    blake3: crate::session::assemble::file_blake3(&path).ok(),
+                    lights: lights.max(1),
+                    blake3: blake3.clone(),
                     fitted: None,
                 };
                 let (environment, _) =
                     load_environment_source(&source).map_err(|e| e.to_string())?;
                 let source = EnvironmentSource::File {
                     path,
-                    lights,
-                    blake3: crate::session::assemble::file_blake3(&PathBuf::from(
-                        &environment.name,
-                    ))
-                    .ok(),
+                    lights: lights.max(1),
+                    blake3,
                     fitted: Some(Box::new(environment.lights.clone())),
                 };
                 Ok(Loaded::Environment {
@@ -293,7 +337,7 @@ impl EditorApp {
     /// fails the error names the file and the scene stays.
     pub fn open_hair(&mut self, path: PathBuf) {
         let ctx = self.ctx.clone();
-        self.loading = Some(Job::spawn(
+        self.source_job = Some(Job::spawn(
             format!("loading {}", path.display()),
             move || ctx.request_repaint(),
             move |_| {
@@ -301,8 +345,8 @@ impl EditorApp {
                     blake3: crate::session::assemble::file_blake3(&path).ok(),
                     path,
                 };
-                let hair = load_hair_source(&source).map_err(|e| e.to_string())?;
-                Ok(Loaded::Hair { hair, source })
+                load_hair_source(&source).map_err(|e| e.to_string())?;
+                Ok(Loaded::Hair { source })
             },
         ));
     }
@@ -341,13 +385,26 @@ impl EditorApp {
     pub fn open_session(&mut self, path: &Path) {
         match Session::read(path) {
             Ok(s) => {
+                if self.modified() {
+                    // The unsaved work stays in its recovery file (offered at the next start).
+                    if let Err(e) = self.autosave.on_exit(&self.session, true) {
+                        self.message(Level::Warning, e);
+                    } else {
+                        let kept = self.autosave.path.display().to_string();
+                        self.message(
+                            Level::Warning,
+                            format!("the unsaved changes were kept in {kept}"),
+                        );
+                    }
+                }
                 self.session = s.clone();
                 self.saved = s;
                 self.session_path = Some(path.to_path_buf());
                 self.history.clear();
                 self.camera = None;
                 self.autosave.set_session_path(Some(path));
-                self.live = None;
+                self.drop_live();
+                self.failed = None;
                 self.load_scene();
                 self.remember(path);
                 self.message(Level::Info, format!("opened {}", path.display()));
@@ -423,88 +480,115 @@ impl EditorApp {
     /// Polls the background jobs.
     fn poll_jobs(&mut self) {
         // Scenes are installed once the viewport has been laid out (its size sizes the render).
-        if self.viewport_rect.is_some()
-            && let Some(job) = &mut self.loading
-            && let Some(result) = job.poll()
-        {
+        let scene = match (&mut self.loading, self.viewport_rect) {
+            (Some(job), Some(_)) => job.poll(),
+            _ => None,
+        };
+        if let Some(result) = scene {
             self.loading = None;
-            match result {
+            let for_session = self
+                .loading_for
+                .take()
+                .unwrap_or_else(|| self.session.clone());
+            match result.and_then(|r| r) {
                 Ok(Loaded::Scene {
                     hair,
                     environment,
+                    prepared,
                     warnings,
                 }) => {
                     for w in warnings {
                         self.message(Level::Warning, w);
                     }
-                    self.install_scene(hair, environment);
+                    self.install_scene(&for_session, hair, environment, *prepared);
                 }
-                Ok(Loaded::Hair { hair, source }) => {
-                    if let Some(w) = &hair.warning {
-                        let w = w.clone();
-                        self.message(Level::Warning, w);
-                    }
+                Ok(_) => {}
+                Err(e) => {
+                    self.failed = Some(SceneKey::of(&for_session));
+                    self.message(Level::Error, e);
+                }
+            }
+        }
+        if let Some(result) = self.source_job.as_mut().and_then(|j| j.poll()) {
+            self.source_job = None;
+            match result.and_then(|r| r) {
+                Ok(Loaded::Hair { source }) => {
                     self.perform(Edit::Hair(source), false);
-                    self.message(Level::Info, format!("opened {}", hair.name));
                     self.session.camera.target = None;
                     self.session.camera.distance = None;
-                    let environment = match &self.live {
-                        Some(live) => live.environment.clone(),
-                        None => crate::render::scene::default_environment(),
-                    };
-                    self.loading_for = Some(self.session.clone());
-                    self.install_scene(hair, environment);
                 }
                 Ok(Loaded::Environment {
                     environment,
                     source,
                 }) => {
                     self.perform(Edit::Environment(Box::new(source.clone())), false);
-                    if let Some(live) = &mut self.live {
+                    if let Some(live) = &mut self.live
+                        && self.loading.is_none()
+                        && live.hair_source == self.session.hair
+                    {
                         live.set_environment(environment, source, self.session.env_yaw);
                     }
                 }
-                Err(e) => {
-                    self.message(Level::Error, e);
-                    // The scene stays as it was: undo the source edit that asked for it.
-                    if let Some(live) = &self.live
-                        && (live.hair_source != self.session.hair
-                            || live.environment_source != self.session.environment)
-                    {
-                        self.session.hair = live.hair_source.clone();
-                        self.session.environment = live.environment_source.clone();
-                    }
-                }
+                Ok(Loaded::Scene { .. }) => {}
+                // The session is untouched: a source edit is made only when its file loaded.
+                Err(e) => self.message(Level::Error, e),
             }
         }
-        if let Some(job) = &mut self.export
-            && let Some(msg) = job.poll(&mut self.live)
-        {
-            let (level, text) = msg;
-            self.message(level, text);
-            self.export = None;
+        if let Some(job) = &mut self.export {
+            self.ctx.request_repaint_after(REFINE_POLL);
+            if let Some(msg) = job.poll(&mut self.live) {
+                let (level, text) = msg;
+                self.message(level, text);
+                self.export = None;
+            }
         }
         if let Some(err) = self.autosave.tick(&self.session, &self.ctx) {
             self.message(Level::Warning, err);
         }
     }
 
-    fn install_scene(&mut self, hair: LoadedHairSource, environment: Environment) {
+    /// Drops the live scene, releasing its egui texture.
+    pub fn drop_live(&mut self) {
+        if let Some(mut live) = self.live.take()
+            && let Some(er) = &self.egui_renderer
+        {
+            live.release(&mut er.write());
+        }
+    }
+
+    fn install_scene(
+        &mut self,
+        session: &Session,
+        hair: LoadedHairSource,
+        environment: Environment,
+        prepared: Prepared,
+    ) {
         let Some(gpu) = self.gpu.clone() else {
             return;
         };
         let camera = self.resolve_camera(&hair.hair);
-        let session = self
-            .loading_for
-            .take()
-            .unwrap_or_else(|| self.session.clone());
         let (w, h) = self.render_size();
-        match LiveScene::new(gpu, &self.luts, &session, hair, environment, &camera, w, h) {
+        match LiveScene::new(
+            gpu,
+            &self.luts,
+            session,
+            hair,
+            environment,
+            prepared,
+            &camera,
+            w,
+            h,
+        ) {
             Ok(live) => {
+                self.drop_live();
                 self.live = Some(live);
                 self.camera = Some(camera);
+                self.failed = None;
             }
-            Err(e) => self.message(Level::Error, e.to_string()),
+            Err(e) => {
+                self.failed = Some(SceneKey::of(session));
+                self.message(Level::Error, e.to_string());
+            }
         }
     }
 
@@ -523,12 +607,22 @@ impl EditorApp {
         let rebuild = self
             .live
             .as_ref()
-            .is_some_and(|l| l.needs_rebuild(&self.session));
+            .is_none_or(|l| l.needs_rebuild(&self.session));
         if rebuild {
-            if self.loading.is_none() {
+            let key = SceneKey::of(&self.session);
+            let pending = self
+                .loading_for
+                .as_ref()
+                .is_some_and(|s| SceneKey::of(s) == key);
+            if !pending && self.failed.as_ref() != Some(&key) {
                 self.load_scene();
             }
-            return;
+            if self.live.as_ref().is_none_or(|l| {
+                l.hair_source != self.session.hair
+                    || l.environment_source != self.session.environment
+            }) {
+                return;
+            }
         }
         // A framed camera (no explicit target or distance) follows the hair and the viewport's aspect.
         if let Some(live) = &self.live
@@ -648,6 +742,10 @@ impl EditorApp {
 
     /// When the app closes: the recovery file is written if there are unsaved changes.
     pub fn closing(&mut self) {
+        // A recovery still on offer belongs to an earlier run: leave it for the next start.
+        if self.recovery_offer.is_some() {
+            return;
+        }
         if let Err(e) = self.autosave.on_exit(&self.session, self.modified()) {
             eprintln!("warning: {e}");
         }

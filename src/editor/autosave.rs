@@ -1,5 +1,9 @@
 //! Autosave: a recovery file written atomically on a worker 30 s after a change (and on quit when there
 //! are unsaved changes), removed when the session is saved; the next start offers it.
+//!
+//! Each running editor writes its own file, `recovery-<pid>.slsession` in the state folder, which
+//! records the session file it belongs to. At start, files of processes that are no longer running are
+//! offered (the newest); a file of a live process belongs to another open editor and is left alone.
 
 use super::jobs::Job;
 use crate::session::{Session, write_atomic};
@@ -8,7 +12,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(30);
-pub const RECOVERY_FILE: &str = "recovery.slsession";
+const PREFIX: &str = "recovery-";
+const SUFFIX: &str = ".slsession";
 
 /// The recovery file: the session and the file it belongs to.
 #[derive(Serialize, Deserialize)]
@@ -18,30 +23,38 @@ struct Recovery {
 }
 
 pub struct Autosave {
+    instance: u32,
+    dir: PathBuf,
+    /// This editor's recovery file.
     pub path: PathBuf,
     session_path: Option<PathBuf>,
     dirty_since: Option<Instant>,
     pub interval: Duration,
     writing: Option<Job<Result<(), String>>>,
+    /// The session was saved while a write was in flight: delete the file when it lands.
+    delete_when_written: bool,
     /// Recovery files written (tests).
     pub writes: u32,
 }
 
 impl Autosave {
-    pub fn new(dir: PathBuf, session_path: Option<&Path>) -> Self {
+    /// `instance`: the process id (tests give other numbers to play several editors).
+    pub fn new(dir: PathBuf, session_path: Option<&Path>, instance: u32) -> Self {
         Self {
-            path: dir.join(RECOVERY_FILE),
+            instance,
+            path: dir.join(format!("{PREFIX}{instance}{SUFFIX}")),
+            dir,
             session_path: session_path.map(Path::to_path_buf),
             dirty_since: None,
             interval: AUTOSAVE_INTERVAL,
             writing: None,
+            delete_when_written: false,
             writes: 0,
         }
     }
 
     pub fn set_session_path(&mut self, p: Option<&Path>) {
         self.session_path = p.map(Path::to_path_buf);
-        self.dirty_since = None;
     }
 
     /// The session changed: a recovery file is due one interval from the first unsaved change.
@@ -57,19 +70,21 @@ impl Autosave {
         serde_json::to_vec_pretty(&r).unwrap_or_default()
     }
 
-    /// Once a frame: starts the write when due; returns an error message when a write failed.
+    /// Once a frame: starts the write when due; returns an error message when a write failed (it is
+    /// retried one interval later).
     pub fn tick(&mut self, session: &Session, ctx: &egui::Context) -> Option<String> {
         if let Some(job) = &mut self.writing {
-            match job.poll() {
-                Some(Ok(())) => {
-                    self.writing = None;
-                    self.writes += 1;
-                }
-                Some(Err(e)) => {
-                    self.writing = None;
+            let result = job.poll()?;
+            self.writing = None;
+            if std::mem::take(&mut self.delete_when_written) {
+                let _ = std::fs::remove_file(&self.path);
+            }
+            match result.and_then(|r| r) {
+                Ok(()) => self.writes += 1,
+                Err(e) => {
+                    self.dirty_since.get_or_insert_with(Instant::now);
                     return Some(e);
                 }
-                None => return None,
             }
         }
         let since = self.dirty_since?;
@@ -90,16 +105,26 @@ impl Autosave {
         None
     }
 
-    /// The session was saved: no recovery needed.
+    /// The session was saved: no recovery needed (a write in flight is deleted when it lands).
     pub fn saved(&mut self, session_path: Option<&Path>) {
         self.session_path = session_path.map(Path::to_path_buf);
         self.dirty_since = None;
+        self.delete_when_written = self.writing.is_some();
         let _ = std::fs::remove_file(&self.path);
     }
 
-    /// On quit: keep unsaved work in the recovery file, else remove it.
+    /// On quit (or before another session replaces an unsaved one): keep unsaved work in the
+    /// recovery file, else remove it.
     pub fn on_exit(&mut self, session: &Session, modified: bool) -> Result<(), String> {
         if modified {
+            // A write in flight targets the same file: this newer snapshot must win.
+            while let Some(job) = &mut self.writing {
+                if job.poll().is_some() {
+                    self.writing = None;
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            self.delete_when_written = false;
             write_recovery(&self.path, &self.contents(session))
         } else {
             let _ = std::fs::remove_file(&self.path);
@@ -107,19 +132,34 @@ impl Autosave {
         }
     }
 
-    /// A recovery file left by an earlier run: the file it belonged to and the session.
-    pub fn recovery_found(&self) -> Option<(PathBuf, Session)> {
-        let text = std::fs::read_to_string(&self.path).ok()?;
+    /// A recovery file left by an editor that is no longer running (the newest): its path, the
+    /// session file it belonged to and the session.
+    pub fn recovery_found(&self) -> Option<(PathBuf, PathBuf, Session)> {
+        let mut found: Vec<(std::time::SystemTime, PathBuf)> = std::fs::read_dir(&self.dir)
+            .ok()?
+            .filter_map(|e| e.ok())
+            .filter_map(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                let pid = name.strip_prefix(PREFIX)?.strip_suffix(SUFFIX)?;
+                let pid: u32 = pid.parse().ok()?;
+                if pid == self.instance || process_alive(pid) {
+                    return None;
+                }
+                Some((e.metadata().ok()?.modified().ok()?, e.path()))
+            })
+            .collect();
+        found.sort();
+        let (_, file) = found.pop()?;
+        let text = std::fs::read_to_string(&file).ok()?;
         let r: Recovery = serde_json::from_str(&text).ok()?;
-        let session =
-            Session::from_json(&serde_json::to_string(&r.session).ok()?, &self.path).ok()?;
-        Some((r.session_path.unwrap_or_default(), session))
+        let session = Session::from_json(&serde_json::to_string(&r.session).ok()?, &file).ok()?;
+        Some((file, r.session_path.unwrap_or_default(), session))
     }
+}
 
-    /// Deletes the recovery file (the user declined it).
-    pub fn discard(&self) {
-        let _ = std::fs::remove_file(&self.path);
-    }
+/// Whether a process with this id runs (Linux: /proc; elsewhere assumed gone).
+fn process_alive(pid: u32) -> bool {
+    Path::new("/proc").join(pid.to_string()).exists()
 }
 
 fn write_recovery(path: &Path, bytes: &[u8]) -> Result<(), String> {

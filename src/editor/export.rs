@@ -20,6 +20,7 @@ pub struct ExportJob {
     writing: Option<Job<Result<String, String>>>,
     pub started: Instant,
     pub fraction: f32,
+    wake: egui::Context,
 }
 
 impl ExportJob {
@@ -30,7 +31,11 @@ impl ExportJob {
         session: &Session,
         exr: PathBuf,
         png: Option<PathBuf>,
+        wake: egui::Context,
     ) -> Result<Self, String> {
+        if live.needs_rebuild(session) {
+            return Err("the scene is still loading; export when it is shown".into());
+        }
         for p in std::iter::once(&exr).chain(png.iter()) {
             let dir = match p.parent() {
                 Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -71,13 +76,14 @@ impl ExportJob {
             writing: None,
             started: Instant::now(),
             fraction: 0.0,
+            wake,
         })
     }
 
     /// One frame of the export; returns the final message when done.
     pub fn poll(&mut self, live: &mut Option<LiveScene>) -> Option<(Level, String)> {
         if let Some(job) = &mut self.writing {
-            return job.poll().map(|r| match r {
+            return job.poll().map(|r| match r.and_then(|r| r) {
                 Ok(m) => (Level::Info, m),
                 Err(e) => (Level::Error, e),
             });
@@ -113,9 +119,10 @@ impl ExportJob {
         );
         let (exr, png) = (self.exr.clone(), self.png.clone());
         let seconds = self.started.elapsed().as_secs_f64();
+        let wake = self.wake.clone();
         self.writing = Some(Job::spawn(
             "writing the still",
-            || {},
+            move || wake.request_repaint(),
             move |_| {
                 frame
                     .write_exr(&exr, &attributes, true)

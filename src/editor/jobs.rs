@@ -38,20 +38,24 @@ impl<T: Send + 'static> Job<T> {
         }
     }
 
-    /// The result once the worker is done (once).
-    pub fn poll(&mut self) -> Option<T> {
+    /// The result once the worker is done (once); a worker that died without one (a panic) is an
+    /// error, so no caller waits for it forever.
+    pub fn poll(&mut self) -> Option<Result<T, String>> {
         if self.finished {
             return None;
         }
         match self.rx.try_recv() {
             Ok(v) => {
                 self.finished = true;
-                Some(v)
+                Some(Ok(v))
             }
             Err(TryRecvError::Empty) => None,
             Err(TryRecvError::Disconnected) => {
                 self.finished = true;
-                None
+                Some(Err(format!(
+                    "{}: the worker stopped without a result",
+                    self.label
+                )))
             }
         }
     }
@@ -76,12 +80,26 @@ mod tests {
         let t = Instant::now();
         let v = loop {
             if let Some(v) = job.poll() {
-                break v;
+                break v.unwrap();
             }
             assert!(t.elapsed().as_secs() < 10);
             std::thread::yield_now();
         };
         assert_eq!(v, 4);
         assert!(job.poll().is_none() && job.is_finished());
+    }
+
+    #[test]
+    fn a_worker_that_panics_is_an_error_not_a_hang() {
+        let mut job: Job<u32> = Job::spawn("doomed", || {}, |_| panic!("on purpose"));
+        let t = Instant::now();
+        let r = loop {
+            if let Some(r) = job.poll() {
+                break r;
+            }
+            assert!(t.elapsed().as_secs() < 10);
+            std::thread::yield_now();
+        };
+        assert!(r.unwrap_err().contains("doomed"));
     }
 }

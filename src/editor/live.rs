@@ -11,7 +11,7 @@ use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::progressive::{Progress, WorkUnit};
 use crate::render::renderer::build_tables;
 use crate::render::scene::Environment;
-use crate::render::{Camera, RenderError, Renderer};
+use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::lut::Luts;
@@ -57,6 +57,26 @@ pub enum LiveError {
 
 type Tables = (HairParams, ForwardTable, DualTables);
 
+/// What a scene needs computed from the session and the hair before the renderer is built: the
+/// per-point absorption, the look in the renderer's form and its tables (all CPU work, done on the
+/// loading worker).
+pub struct Prepared {
+    pub sigma_a: Vec<[f32; 3]>,
+    pub look: HairLook,
+    pub tables: (ForwardTable, DualTables),
+}
+
+/// Computes [`Prepared`] (off the UI thread).
+pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
+    let (sigma_a, look) = absorption(&session.look, hair, session.paint.as_deref())?;
+    let tables = build_tables(&look.params);
+    Ok(Prepared {
+        sigma_a,
+        look,
+        tables,
+    })
+}
+
 /// What the renderer was last told.
 #[derive(Clone, Debug, PartialEq)]
 struct Applied {
@@ -79,6 +99,9 @@ pub struct LiveScene {
     pub display: DisplayPass,
     pub texture: Option<egui::TextureId>,
     applied: Applied,
+    /// The mean absorption of the points (the dual tables' sigma_a), kept while only the look's other
+    /// parameters change.
+    mean_sigma_a: [f64; 3],
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
     pub progress: Option<Progress>,
@@ -92,7 +115,8 @@ pub struct LiveScene {
 }
 
 impl LiveScene {
-    /// Builds the renderer for `session` with a loaded hair and environment at a viewport size.
+    /// Builds the renderer for `session` with a loaded hair and environment at a viewport size, from
+    /// what [`prepare`] computed off the UI thread.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: GpuContext,
@@ -100,14 +124,19 @@ impl LiveScene {
         session: &Session,
         hair: LoadedHairSource,
         environment: Environment,
+        prepared: Prepared,
         camera: &Camera,
         width: u32,
         height: u32,
     ) -> Result<Self, LiveError> {
-        let (sigma_a, look) = absorption(&session.look, &hair.hair, session.paint.as_deref())?;
         let lights = turned_lights(&environment.lights, session.env_yaw);
         let settings = session.render.settings(width, height);
-        let renderer = Renderer::new(
+        let Prepared {
+            sigma_a,
+            look,
+            tables,
+        } = prepared;
+        let renderer = Renderer::with_tables(
             &ctx,
             settings,
             luts,
@@ -116,6 +145,7 @@ impl LiveScene {
             &look,
             &lights.lights,
             camera,
+            tables,
         )?;
         let display = DisplayPass::new(&ctx.device, width, height);
         Ok(Self {
@@ -127,6 +157,7 @@ impl LiveScene {
             renderer,
             display,
             texture: None,
+            mean_sigma_a: look.params.sigma_a,
             applied: Applied {
                 look: session.look,
                 paint: session.paint.clone(),
@@ -150,6 +181,7 @@ impl LiveScene {
     pub fn needs_rebuild(&self, session: &Session) -> bool {
         let (a, b) = (&self.applied.render, &session.render);
         self.hair_source != session.hair
+            || self.environment_source != session.environment
             || a.samples != b.samples
             || a.volume_resolution != b.volume_resolution
             || a.shadow_grid_resolution != b.shadow_grid_resolution
@@ -160,15 +192,29 @@ impl LiveScene {
     pub fn sync(&mut self, session: &Session, camera: &Camera) -> Result<(), LiveError> {
         let mut changed = false;
         if session.look != self.applied.look || session.paint != self.applied.paint {
-            let (sigma_a, look) = absorption(&session.look, &self.hair, session.paint.as_deref())?;
-            let absorption_changed = session.look.root != self.applied.look.root
-                || session.look.tip != self.applied.look.tip
-                || session.look.strand_variation != self.applied.look.strand_variation
-                || session.look.variation_seed != self.applied.look.variation_seed
+            let (old, new) = (&self.applied.look, &session.look);
+            let absorption_changed = new.root != old.root
+                || new.tip != old.tip
+                || new.strand_variation != old.strand_variation
+                || new.variation_seed != old.variation_seed
                 || session.paint != self.applied.paint;
-            if absorption_changed {
+            // Applied before anything can fail, so a failure is reported once, not every frame.
+            self.applied.look = session.look;
+            self.applied.paint = session.paint.clone();
+            let look = if absorption_changed {
+                let (sigma_a, look) =
+                    absorption(&session.look, &self.hair, session.paint.as_deref())?;
                 self.renderer.set_absorption(&self.ctx, &sigma_a)?;
-            }
+                self.mean_sigma_a = look.params.sigma_a;
+                look
+            } else {
+                session.look.validate().map_err(AssembleError::Look)?;
+                let mut params = session.look.params;
+                params.sigma_a = self.mean_sigma_a;
+                HairLook::new(params)
+                    .with_dual(session.look.d_f, session.look.d_b)
+                    .with_longitudinal(session.look.longitudinal)
+            };
             if self.renderer.set_params_deferred(&self.ctx, &look) {
                 let params = look.params;
                 // A newer build replaces an older one; set_tables ignores stale tables anyway.
@@ -181,8 +227,6 @@ impl LiveScene {
                     },
                 ));
             }
-            self.applied.look = session.look;
-            self.applied.paint = session.paint.clone();
             changed = true;
         }
         if session.env_yaw != self.applied.env_yaw {
@@ -198,8 +242,9 @@ impl LiveScene {
             changed = true;
         }
         if a.exposure != b.exposure {
+            // Only the resolve changes: no restart, the display shows it at once.
             self.renderer.set_exposure(&self.ctx, b.exposure);
-            changed = true;
+            self.view = None;
         }
         self.applied.render = session.render;
         if *camera != self.applied.camera {
@@ -264,6 +309,13 @@ impl LiveScene {
         })
     }
 
+    /// Releases the egui texture (before the scene is dropped or replaced).
+    pub fn release(&mut self, egui_renderer: &mut egui_wgpu::Renderer) {
+        if let Some(id) = self.texture.take() {
+            egui_renderer.free_texture(&id);
+        }
+    }
+
     fn restarted(&mut self) {
         self.refine_started = Instant::now();
         self.converged_in = None;
@@ -273,16 +325,20 @@ impl LiveScene {
     /// One UI frame's work: takes finished tables, submits one bounded refinement unit and, when the
     /// image or the view changed, the display pass. Never waits for the GPU.
     pub fn step(&mut self, view: ViewSettings) -> Result<Progress, LiveError> {
-        if let Some(job) = &mut self.tables
-            && let Some((params, forward, dual)) = job.poll()
-        {
-            self.tables = None;
-            if self
-                .renderer
-                .set_tables(&self.ctx, &params, &forward, &dual)
-            {
-                self.restarted();
+        let finished = self.tables.as_mut().and_then(|job| job.poll());
+        match finished {
+            Some(Ok((params, forward, dual))) => {
+                self.tables = None;
+                if self
+                    .renderer
+                    .set_tables(&self.ctx, &params, &forward, &dual)
+                {
+                    self.restarted();
+                }
             }
+            // A table build that died leaves the old tables (the shading still follows the look).
+            Some(Err(_)) => self.tables = None,
+            None => {}
         }
         let progress = self.renderer.refine(&self.ctx)?;
         if progress.converged && self.converged_in.is_none() {

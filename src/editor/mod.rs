@@ -5,6 +5,7 @@
 
 pub mod app;
 pub mod autosave;
+pub mod env_preview;
 pub mod export;
 pub mod jobs;
 pub mod live;

@@ -52,6 +52,12 @@ pub enum RenderError {
     AbsorptionCount { points: usize, absorption: usize },
     #[error("{0} hair segments; the visibility pass names at most 2^24")]
     TooManySegments(usize),
+    #[error("{what} needs {bytes} bytes, more than the GPU binds in one buffer ({limit})")]
+    TooLarge {
+        what: String,
+        bytes: u64,
+        limit: u64,
+    },
     #[error("the GPU: {0}")]
     Gpu(String),
 }
@@ -235,6 +241,26 @@ impl Renderer {
         lights: &[SrbfLight],
         camera: &Camera,
     ) -> Result<Self, RenderError> {
+        let tables = build_tables(&look.params);
+        Self::with_tables(
+            ctx, settings, luts, hair, sigma_a, look, lights, camera, tables,
+        )
+    }
+
+    /// [`Renderer::new`] with the forward and dual tables of `look.params` already built
+    /// ([`build_tables`], on a worker thread in the editor).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_tables(
+        ctx: &GpuContext,
+        settings: RenderSettings,
+        luts: &Luts,
+        hair: &Hair,
+        sigma_a: &[[f32; 3]],
+        look: &HairLook,
+        lights: &[SrbfLight],
+        camera: &Camera,
+        tables: (ForwardTable, DualTables),
+    ) -> Result<Self, RenderError> {
         let device = &ctx.device;
         let max = device.limits().max_texture_dimension_2d;
         if settings.width == 0
@@ -257,6 +283,34 @@ impl Renderer {
         if segments >= MAX_SEGMENTS as usize {
             return Err(RenderError::TooManySegments(segments));
         }
+        let limit = device
+            .limits()
+            .max_storage_buffer_binding_size
+            .min(device.limits().max_buffer_size);
+        let check = |what: &str, bytes: u64| {
+            if bytes > limit {
+                Err(RenderError::TooLarge {
+                    what: what.into(),
+                    bytes,
+                    limit,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        check(
+            &format!("a {}x{} image", settings.width, settings.height),
+            settings.width as u64 * settings.height as u64 * 16,
+        )?;
+        let grid = settings.shadow_grid(hair);
+        check(
+            &format!(
+                "the shadow grid ({} points x {} lights)",
+                grid.point_count(),
+                lights.len()
+            ),
+            grid.point_count() as u64 * lights.len().max(1) as u64 * 32,
+        )?;
         let gpu_hair = GpuHair::new(device, hair, sigma_a);
         let grid = settings.volume_grid(hair);
         let volume = GpuFiberDensity::new(device, grid, gpu_hair.segment_count);
@@ -282,7 +336,7 @@ impl Renderer {
             skip,
             settings.multiple_scattering,
         );
-        let (forward, dual) = build_tables(&look.params);
+        let (forward, dual) = tables;
         let storage = |label: &str, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -527,6 +581,15 @@ impl Renderer {
         if (width, height) == (self.settings.width, self.settings.height) {
             return Ok(());
         }
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
+        let bytes = width as u64 * height as u64 * 16;
+        if bytes > limit {
+            return Err(RenderError::TooLarge {
+                what: format!("a {width}x{height} image"),
+                bytes,
+                limit,
+            });
+        }
         self.settings.width = width;
         self.settings.height = height;
         self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
@@ -572,7 +635,21 @@ impl Renderer {
         };
         ctx.queue
             .write_buffer(&self.resolve_info, 0, bytemuck::bytes_of(&info));
-        self.restart_refinement();
+        // Only the resolve changes: it runs after every unit; here once more for the current image.
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("exposure"),
+            });
+        self.resolve_pass.encode(
+            &ctx.device,
+            &mut enc,
+            &self.camera,
+            &self.resolve_info,
+            &self.targets,
+            None,
+        );
+        ctx.queue.submit([enc.finish()]);
     }
 
     /// The frame's targets (the display pass reads the beauty).
@@ -637,6 +714,7 @@ impl Renderer {
             self.last_ran.extend(["fiber_density", "density_pyramid"]);
             self.volume_dirty = false;
             self.shadow_grid_dirty = true;
+            self.refinement.grid_done = 0;
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
             let count = self.shadow_grid.entry_count();

@@ -68,9 +68,15 @@ impl History {
         true
     }
 
-    /// Closes the open gesture (the pointer was released): the next edit starts a new step.
+    /// Closes the open gesture (the pointer was released): the next edit starts a new step. A drag
+    /// that came back to where it started leaves no step.
     pub fn end_gesture(&mut self) {
-        self.open = None;
+        if self.open.take().is_some()
+            && let Some(step) = self.undo.last()
+            && step.undo == step.redo
+        {
+            self.undo.pop();
+        }
     }
 
     /// Undoes the last step; returns the edit applied (None: nothing to undo).
@@ -154,6 +160,17 @@ mod tests {
         assert!(h.can_redo());
         h.perform(&mut s, Edit::EnvYaw(5.0), false);
         assert!(!h.can_redo());
+    }
+
+    #[test]
+    fn a_drag_back_to_its_start_leaves_no_step() {
+        let mut s = Session::default();
+        let mut h = History::default();
+        h.perform(&mut s, Edit::EnvYaw(10.0), true);
+        h.perform(&mut s, Edit::EnvYaw(0.0), true);
+        h.end_gesture();
+        assert!(!h.can_undo());
+        assert_eq!(yaw(&s), 0.0);
     }
 
     #[test]

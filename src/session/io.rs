@@ -30,7 +30,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "session".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    // Unique per process and call: two writers of one file never share a temporary.
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -123,7 +126,25 @@ impl Session {
         if !r.exposure.is_finite() || !self.env_yaw.is_finite() {
             return Err("exposure and environment yaw must be finite".into());
         }
+        if !(4..=512).contains(&r.volume_resolution)
+            || !(2..=128).contains(&r.shadow_grid_resolution)
+        {
+            return Err(format!(
+                "volume resolution lies in [4, 512] and shadow grid resolution in [2, 128], got {} and {}",
+                r.volume_resolution, r.shadow_grid_resolution
+            ));
+        }
+        if let super::model::EnvironmentSource::File { lights, .. } = &self.environment
+            && !(1..=1024).contains(lights)
+        {
+            return Err(format!(
+                "an environment is fitted with 1 to 1024 lights, got {lights}"
+            ));
+        }
         let c = &self.camera;
+        if c.target.is_some_and(|t| t.iter().any(|v| !v.is_finite())) {
+            return Err("the camera target must be finite".into());
+        }
         if !(c.fov_y > 1.0 && c.fov_y < 170.0 && c.yaw.is_finite() && c.pitch.is_finite()) {
             return Err("the camera's field of view lies in (1, 170) degrees".into());
         }
@@ -142,18 +163,6 @@ impl Session {
             ));
         }
         Ok(())
-    }
-}
-
-/// The recovery file autosave writes for a session saved at `path` (or for an unsaved one).
-pub fn recovery_path(session_path: Option<&Path>) -> PathBuf {
-    match session_path {
-        Some(p) => {
-            let mut name = p.file_name().unwrap_or_default().to_os_string();
-            name.push(".recovery");
-            p.with_file_name(name)
-        }
-        None => state_dir().join("unsaved.slsession.recovery"),
     }
 }
 

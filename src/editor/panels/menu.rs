@@ -150,7 +150,7 @@ pub fn start_export(app: &mut EditorApp, exr: std::path::PathBuf) {
         return;
     };
     let png = Some(ExportJob::preview_path(&exr));
-    match ExportJob::start(live, app.luts(), &app.session, exr, png) {
+    match ExportJob::start(live, app.luts(), &app.session, exr, png, app.egui_ctx()) {
         Ok(job) => app.export = Some(job),
         Err(e) => app.message(Level::Error, format!("export: {e}")),
     }

@@ -38,7 +38,7 @@ pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
 
 /// After a crash: offer the recovery file.
 fn recovery_prompt(app: &mut EditorApp, ctx: &egui::Context) {
-    let Some((path, _)) = &app.recovery_offer else {
+    let Some((_, path, _)) = &app.recovery_offer else {
         return;
     };
     let from = if path.as_os_str().is_empty() {
@@ -64,25 +64,28 @@ fn recovery_prompt(app: &mut EditorApp, ctx: &egui::Context) {
                 }
             });
         });
-    match choice {
-        Some(true) => {
-            if let Some((path, session)) = app.recovery_offer.take() {
-                app.session = session;
-                app.session_path = (!path.as_os_str().is_empty()).then_some(path);
-                app.history.clear();
-                app.camera = None;
-                app.live = None;
-                app.autosave.changed();
-                app.load_scene();
-                app.message(Level::Info, "recovered the unsaved session");
-            }
+    let Some(recover) = choice else {
+        return;
+    };
+    let Some((file, path, session)) = app.recovery_offer.take() else {
+        return;
+    };
+    if recover {
+        app.session = session;
+        app.session_path = (!path.as_os_str().is_empty()).then_some(path);
+        app.autosave.set_session_path(app.session_path.as_deref());
+        app.history.clear();
+        app.camera = None;
+        app.drop_live();
+        // Written again as this editor's own recovery file before the old one goes.
+        app.autosave.changed();
+        if let Err(e) = app.autosave.on_exit(&app.session.clone(), true) {
+            app.message(Level::Warning, e);
         }
-        Some(false) => {
-            app.autosave.discard();
-            app.recovery_offer = None;
-        }
-        None => {}
+        app.load_scene();
+        app.message(Level::Info, "recovered the unsaved session");
     }
+    let _ = std::fs::remove_file(file);
 }
 
 /// Errors stay on screen until dismissed.

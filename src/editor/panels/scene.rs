@@ -146,11 +146,30 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
         app.perform(Edit::EnvYaw(yaw), c.gesture);
     }
     if let Some(live) = &app.live {
+        let env = &live.environment;
+        let key = (env.name.clone(), env.lights.lights.len());
+        if app.env_preview.as_ref().map(|p| &p.key) != Some(&key) {
+            app.env_preview = Some(crate::editor::env_preview::build(ui.ctx(), env));
+        }
         ui.weak(format!(
             "{} SRBF lights · {}",
-            live.environment.lights.lights.len(),
-            live.environment.name
+            env.lights.lights.len(),
+            env.name
         ));
+    }
+    if let Some(p) = &app.env_preview {
+        let w = ui.available_width().min(250.0);
+        let size = egui::vec2(w, 0.5 * w);
+        if let Some(image) = &p.image {
+            ui.add(egui::Image::new((image.id(), size)))
+                .on_hover_text("The environment image (median luminance exposed to 0.18)");
+        }
+        ui.add(egui::Image::new((p.fit.id(), size)))
+            .on_hover_text("Its SRBF reconstruction: what the renderer lights with");
+        match p.relative_l2 {
+            Some(e) => ui.weak(format!("fit error {:.1} % (relative L2)", 100.0 * e)),
+            None => ui.weak("the fit recorded no error"),
+        };
     }
 }
 
@@ -179,21 +198,18 @@ fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
     ));
     ui.horizontal(|ui| {
         ui.label("still");
-        c.changed |= ui
-            .add(
-                egui::DragValue::new(&mut r.width)
-                    .range(16..=8192)
-                    .suffix(" px"),
-            )
-            .changed();
-        ui.label("×");
-        c.changed |= ui
-            .add(
-                egui::DragValue::new(&mut r.height)
-                    .range(16..=8192)
-                    .suffix(" px"),
-            )
-            .changed();
+        let mut size = [r.width, r.height];
+        for (k, v) in size.iter_mut().enumerate() {
+            if k == 1 {
+                ui.label("×");
+            }
+            let resp = ui
+                .add(egui::DragValue::new(v).range(16..=8192).suffix(" px"))
+                .on_hover_text("Size of the exported still, pixels");
+            c.changed |= resp.changed();
+            c.gesture |= resp.is_pointer_button_down_on() || resp.dragged();
+        }
+        [r.width, r.height] = size;
     });
     ui.horizontal(|ui| {
         ui.label("samples");
