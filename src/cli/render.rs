@@ -13,6 +13,7 @@ use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
+use strandlight::render::tiled::{DEFAULT_TILE, render_tiled};
 use strandlight::render::{Camera, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::session::assemble::{StillHeader, still_attributes};
@@ -118,6 +119,10 @@ pub struct RenderArgs {
     /// Points of the per-light shadow grid along the hair's longest side.
     #[arg(long, default_value_t = 48)]
     pub shadow_grid: u32,
+    /// Render in tiles of at most this many pixels a side (default: only when the image's buffers
+    /// exceed what the GPU binds at once, then 1024).
+    #[arg(long)]
+    pub tile: Option<u32>,
     /// Linear float EXR (RGBA, alpha = coverage).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -300,9 +305,21 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     eprintln!("adapter: {} ({})", ctx.summary.name, ctx.summary.backend);
     let luts = Luts::default_tables();
     let t = Instant::now();
+    // Tiles when asked, or when the image's buffers would exceed what the GPU binds at once.
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let tile = match args.tile {
+        Some(t) => t.max(16),
+        None if settings.width as u64 * settings.height as u64 * 16 > limit => DEFAULT_TILE,
+        None => 0,
+    };
+    let mut first = settings.clone();
+    if tile > 0 {
+        first.width = settings.width.min(tile);
+        first.height = settings.height.min(tile);
+    }
     let mut renderer = Renderer::new(
         &ctx,
-        settings.clone(),
+        first,
         &luts,
         &hair,
         &sigma_a,
@@ -310,8 +327,23 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &env.lights.lights,
         &camera,
     )?;
-    renderer.render_frame(&ctx);
-    let mut frame = renderer.read_frame(&ctx)?;
+    let mut frame = if tile > 0 {
+        eprintln!(
+            "rendering {}x{} in tiles of {tile} pixels",
+            settings.width, settings.height
+        );
+        render_tiled(
+            &ctx,
+            &mut renderer,
+            &camera,
+            settings.width,
+            settings.height,
+            tile,
+        )?
+    } else {
+        renderer.render_frame(&ctx);
+        renderer.read_frame(&ctx)?
+    };
     if let Some(times) = renderer.pass_times(&ctx)? {
         let list: Vec<String> = times
             .iter()

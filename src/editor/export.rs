@@ -1,11 +1,15 @@
 //! Export a still (Ctrl+E): the session rendered off-screen at its render size by a second renderer on
-//! the same device, refined a bounded unit per UI frame (the UI never freezes), then read back and
-//! written as EXR (with AOVs and the header `render` writes) and a PNG preview on a worker.
+//! the same device, refined a bounded unit per UI frame (the UI never freezes), tile by tile when the
+//! image's buffers exceed what the GPU binds at once (an 8K still on lavapipe), then written as EXR (with
+//! AOVs and the header `render` writes) and a PNG preview on a worker.
 
 use super::app::Level;
 use super::jobs::Job;
 use super::live::LiveScene;
 use crate::render::Renderer;
+use crate::render::camera::Tile;
+use crate::render::frame::Frame;
+use crate::render::tiled::{DEFAULT_TILE, empty_frame, paste};
 use crate::session::Session;
 use crate::session::assemble::{LoadedHairSource, Scene, StillHeader, still_attributes};
 use std::path::PathBuf;
@@ -17,6 +21,10 @@ pub struct ExportJob {
     session: Session,
     scene: Scene,
     renderer: Renderer,
+    tiles: Vec<Tile>,
+    /// The tile being refined, and the full frame the finished ones are pasted into.
+    current: usize,
+    frame: Option<Frame>,
     writing: Option<Job<Result<String, String>>>,
     pub started: Instant,
     pub fraction: f32,
@@ -25,6 +33,8 @@ pub struct ExportJob {
 
 impl ExportJob {
     /// Starts an export of `session` with the live scene's hair and environment.
+    /// `tile`: at most this many pixels a side per tile (None: tiles only when the image needs them).
+    #[allow(clippy::too_many_arguments)]
     pub fn start(
         live: &LiveScene,
         luts: &crate::scattering::lut::Luts,
@@ -32,6 +42,7 @@ impl ExportJob {
         exr: PathBuf,
         png: Option<PathBuf>,
         wake: egui::Context,
+        tile: Option<u32>,
     ) -> Result<Self, String> {
         if live.needs_rebuild(session) {
             return Err("the scene is still loading; export when it is shown".into());
@@ -56,9 +67,34 @@ impl ExportJob {
         };
         let scene = Scene::from_parts(session, hair, live.environment.clone(), None)
             .map_err(|e| e.to_string())?;
-        let renderer = Renderer::new(
+        Self::with_scene(live, luts, session, scene, exr, png, wake, tile)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn with_scene(
+        live: &LiveScene,
+        luts: &crate::scattering::lut::Luts,
+        session: &Session,
+        scene: Scene,
+        exr: PathBuf,
+        png: Option<PathBuf>,
+        wake: egui::Context,
+        tile: Option<u32>,
+    ) -> Result<Self, String> {
+        let (w, h) = (scene.settings.width, scene.settings.height);
+        let limit = live.ctx.device.limits().max_storage_buffer_binding_size;
+        let tile = tile.unwrap_or(if w as u64 * h as u64 * 16 > limit {
+            DEFAULT_TILE
+        } else {
+            w.max(h)
+        });
+        let tiles = Tile::cover(w, h, tile);
+        let mut settings = scene.settings.clone();
+        settings.width = tiles[0].size[0];
+        settings.height = tiles[0].size[1];
+        let mut renderer = Renderer::new(
             &live.ctx,
-            scene.settings.clone(),
+            settings,
             luts,
             &scene.hair,
             &scene.sigma_a,
@@ -67,12 +103,18 @@ impl ExportJob {
             &scene.camera,
         )
         .map_err(|e| e.to_string())?;
+        renderer
+            .set_camera_tile(&live.ctx, &scene.camera, tiles[0])
+            .map_err(|e| e.to_string())?;
         Ok(Self {
             exr,
             png,
             session: session.clone(),
             scene,
             renderer,
+            tiles,
+            current: 0,
+            frame: None,
             writing: None,
             started: Instant::now(),
             fraction: 0.0,
@@ -96,14 +138,31 @@ impl ExportJob {
             Ok(p) => p,
             Err(e) => return Some((Level::Error, format!("export: {e}"))),
         };
-        self.fraction = progress.fraction;
+        let n = self.tiles.len();
+        self.fraction = (self.current as f32 + progress.fraction) / n as f32;
         if !progress.converged {
             return None;
         }
         // Converged: the GPU is idle for this renderer, the read-back is short.
-        let frame = match self.renderer.read_frame(ctx) {
+        let part = match self.renderer.read_frame(ctx) {
             Ok(f) => f,
             Err(e) => return Some((Level::Error, format!("export: {e}"))),
+        };
+        let s = &self.scene.settings;
+        let full = self.frame.get_or_insert_with(|| {
+            empty_frame(s.width, s.height, part.samples, part.components.len())
+        });
+        paste(full, &self.tiles[self.current], &part);
+        self.current += 1;
+        if self.current < n {
+            let t = self.tiles[self.current];
+            if let Err(e) = self.renderer.set_camera_tile(ctx, &self.scene.camera, t) {
+                return Some((Level::Error, format!("export: {e}")));
+            }
+            return None;
+        }
+        let Some(frame) = self.frame.take() else {
+            return Some((Level::Error, "export: no tiles".into()));
         };
         let attributes = still_attributes(
             &self.session,

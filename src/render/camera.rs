@@ -85,10 +85,35 @@ impl Camera {
     }
 
     pub fn uniform(&self, width: u32, height: u32, min_width_px: f32) -> CameraUniform {
-        let view_proj = self.projection(width, height) * self.view();
+        self.tile_uniform(
+            &Tile {
+                full: [width, height],
+                origin: [0, 0],
+                size: [width, height],
+            },
+            min_width_px,
+        )
+    }
+
+    /// The camera of one tile of a larger image: the full image's projection narrowed to the tile's
+    /// pixels (an off-centre frustum), so a still rendered tile by tile is the untiled one.
+    pub fn tile_uniform(&self, tile: &Tile, min_width_px: f32) -> CameraUniform {
+        let [width, height] = tile.size;
+        let [fw, fh] = [tile.full[0].max(1) as f32, tile.full[1].max(1) as f32];
+        // NDC of the tile's centre in the full image, and the scale taking the tile's NDC range to [-1, 1].
+        let (sx, sy) = (fw / width.max(1) as f32, fh / height.max(1) as f32);
+        let cx = 2.0 * (tile.origin[0] as f32 + 0.5 * width as f32) / fw - 1.0;
+        let cy = 1.0 - 2.0 * (tile.origin[1] as f32 + 0.5 * height as f32) / fh;
+        let narrow = Mat4::from_cols(
+            Vec4::new(sx, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, sy, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, 1.0, 0.0),
+            Vec4::new(-cx * sx, -cy * sy, 0.0, 1.0),
+        );
+        let view_proj = narrow * self.projection(tile.full[0], tile.full[1]) * self.view();
         let eye = self.eye();
         let forward = (Vec3::from(self.target) - eye).normalize_or(Vec3::NEG_Z);
-        let pixel_angle = 2.0 * (0.5 * self.fov_y.to_radians()).tan() / height.max(1) as f32;
+        let pixel_angle = 2.0 * (0.5 * self.fov_y.to_radians()).tan() / fh;
         let (near, far) = self.clip_planes();
         CameraUniform {
             view_proj: view_proj.to_cols_array_2d(),
@@ -101,6 +126,35 @@ impl Camera {
             near,
             far,
         }
+    }
+}
+
+/// A rectangle of pixels of a larger image (tiled stills).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    /// The whole image's size.
+    pub full: [u32; 2],
+    /// The tile's top-left pixel in it.
+    pub origin: [u32; 2],
+    /// The tile's size.
+    pub size: [u32; 2],
+}
+
+impl Tile {
+    /// The tiles (row-major, at most `tile` pixels a side) covering a width x height image.
+    pub fn cover(width: u32, height: u32, tile: u32) -> Vec<Tile> {
+        let t = tile.max(16);
+        let mut out = Vec::new();
+        for y0 in (0..height).step_by(t as usize) {
+            for x0 in (0..width).step_by(t as usize) {
+                out.push(Tile {
+                    full: [width, height],
+                    origin: [x0, y0],
+                    size: [t.min(width - x0), t.min(height - y0)],
+                });
+            }
+        }
+        out
     }
 }
 

@@ -15,6 +15,7 @@ pub mod shade;
 pub mod shading;
 pub mod shadow_grid;
 pub mod targets;
+pub mod tiled;
 pub mod timing;
 pub mod visibility;
 

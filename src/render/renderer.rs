@@ -3,7 +3,7 @@
 //! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
 //! the per-light shadow grid when they or the lights changed, visibility, shading batches, resolve).
 
-use super::camera::Camera;
+use super::camera::{Camera, Tile};
 use super::frame::Frame;
 use super::progressive::Refinement;
 use super::resolve::{ResolveInfo, ResolvePass};
@@ -193,6 +193,8 @@ pub struct Renderer {
     pub(super) camera: wgpu::Buffer,
     /// The camera the uniform was made from (rewritten when the image size changes).
     pub(super) camera_view: Camera,
+    /// The tile of a larger still the camera renders (None: the whole image).
+    pub(super) tile: Option<Tile>,
     pub(super) lights: wgpu::Buffer,
     pub(super) light_count: u32,
     pub(super) resolve_info: wgpu::Buffer,
@@ -362,6 +364,7 @@ impl Renderer {
             ),
             camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
             camera_view: *camera,
+            tile: None,
             lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("lights"),
                 contents: bytemuck::cast_slice(&gpu_lights(lights)),
@@ -445,6 +448,24 @@ impl Renderer {
         self.restart_refinement();
     }
 
+    /// Renders one tile of a larger still with `camera` (the image size becomes the tile's; the
+    /// shadow grid is kept from tile to tile).
+    pub fn set_camera_tile(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        tile: Tile,
+    ) -> Result<(), RenderError> {
+        self.set_size(ctx, tile.size[0], tile.size[1])?;
+        self.camera_view = *camera;
+        self.tile = Some(tile);
+        let u = camera.tile_uniform(&tile, self.settings.min_width_px);
+        ctx.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&u));
+        self.restart_refinement();
+        Ok(())
+    }
+
     /// Hair parameters changed, without waiting for the tables: the uniform is rewritten now (single
     /// scattering shows the change in the next frame); returns true when the exact parameters changed,
     /// and then the caller builds the tables ([`build_tables`], off the UI thread) and hands them to
@@ -491,6 +512,7 @@ impl Renderer {
 
     pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) {
         self.camera_view = *camera;
+        self.tile = None;
         let u = camera.uniform(
             self.settings.width,
             self.settings.height,
@@ -593,9 +615,12 @@ impl Renderer {
         self.settings.width = width;
         self.settings.height = height;
         self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
-        // The camera uniform holds the image size (projection aspect, pixel rays).
-        let camera = self.camera_view;
-        self.set_camera(ctx, &camera);
+        // The camera uniform holds the image size (projection aspect, pixel rays); a tile's is set by
+        // set_camera_tile after this.
+        if self.tile.is_none() {
+            let camera = self.camera_view;
+            self.set_camera(ctx, &camera);
+        }
         self.update_batches(&ctx.device);
         Ok(())
     }

@@ -145,12 +145,25 @@ pub fn export_dialog(app: &mut EditorApp) {
 
 /// Starts exporting the session's still to `exr` (and a PNG preview beside it).
 pub fn start_export(app: &mut EditorApp, exr: std::path::PathBuf) {
+    start_export_tiled(app, exr, None);
+}
+
+/// [`start_export`] in tiles of at most `tile` pixels a side (None: only when the image needs them).
+pub fn start_export_tiled(app: &mut EditorApp, exr: std::path::PathBuf, tile: Option<u32>) {
     let Some(live) = &app.live else {
         app.message(Level::Error, "export: the scene is still loading");
         return;
     };
     let png = Some(ExportJob::preview_path(&exr));
-    match ExportJob::start(live, app.luts(), &app.session, exr, png, app.egui_ctx()) {
+    match ExportJob::start(
+        live,
+        app.luts(),
+        &app.session,
+        exr,
+        png,
+        app.egui_ctx(),
+        tile,
+    ) {
         Ok(job) => app.export = Some(job),
         Err(e) => app.message(Level::Error, format!("export: {e}")),
     }
