@@ -125,6 +125,8 @@ pub struct EditorApp {
     pub viewport_rect: Option<egui::Rect>,
     /// Smoothed UI frame time.
     pub frame_ms: f32,
+    /// The frame after convergence was requested (it paints the last image).
+    painted_converged: bool,
     last_frame: Option<Instant>,
     ctx: egui::Context,
 }
@@ -204,6 +206,7 @@ impl EditorApp {
             viewport_px: [640, 400],
             viewport_rect: None,
             frame_ms: 0.0,
+            painted_converged: false,
             last_frame: None,
             ctx: cc.egui_ctx.clone(),
         };
@@ -649,6 +652,11 @@ impl EditorApp {
                     // Poll for the unit in flight about once per unit budget: on a software GPU,
                     // egui's own frames share the CPU with the refinement.
                     self.ctx.request_repaint_after(REFINE_POLL);
+                    self.painted_converged = false;
+                } else if !self.painted_converged {
+                    // One more frame to paint the converged image and status.
+                    self.painted_converged = true;
+                    self.ctx.request_repaint();
                 }
             }
             Err(e) => {
@@ -799,8 +807,10 @@ impl eframe::App for EditorApp {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        panels::show(self, ui);
+        // The renderer's step first (with last frame's viewport size), so this frame paints the
+        // image and the progress it produced.
         self.update_viewport();
+        panels::show(self, ui);
     }
 
     fn on_exit(&mut self) {
