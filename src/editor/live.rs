@@ -66,6 +66,19 @@ pub struct Prepared {
     pub tables: (ForwardTable, DualTables),
 }
 
+/// The refinement unit budget for this adapter: on a software GPU egui's own frames run on the same
+/// two cores and cost ~50 ms each, so units of the default 30 ms left the refinement a third of the
+/// machine; 80 ms units trade UI rate for throughput there. A hardware GPU keeps the default.
+pub fn unit_budget(ctx: &GpuContext) -> std::time::Duration {
+    if ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+        SOFTWARE_UNIT_BUDGET
+    } else {
+        crate::render::progressive::DEFAULT_UNIT_BUDGET
+    }
+}
+
+pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_millis(80);
+
 /// Computes [`Prepared`] (off the UI thread).
 pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
     let (sigma_a, look) = absorption(&session.look, hair, session.paint.as_deref())?;
@@ -136,7 +149,7 @@ impl LiveScene {
             look,
             tables,
         } = prepared;
-        let renderer = Renderer::with_tables(
+        let mut renderer = Renderer::with_tables(
             &ctx,
             settings,
             luts,
@@ -147,6 +160,7 @@ impl LiveScene {
             camera,
             tables,
         )?;
+        renderer.set_unit_budget(unit_budget(&ctx));
         let display = DisplayPass::new(&ctx.device, width, height);
         Ok(Self {
             hair: Arc::new(hair.hair),
