@@ -1,5 +1,7 @@
 //! `strandlight render` and `strandlight bench` end to end (lavapipe in CI).
 
+mod common;
+
 use std::process::Command;
 
 fn strandlight() -> Command {
@@ -179,29 +181,7 @@ fn a_tiled_render_equals_the_untiled_one() {
             "{}",
             String::from_utf8_lossy(&out.stderr)
         );
-        use exr::prelude::{ReadChannels, ReadLayers};
-        let image = exr::prelude::read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .all_channels()
-            .first_valid_layer()
-            .all_attributes()
-            .from_file(&exr)
-            .expect("a readable EXR");
-        let mut v = Vec::new();
-        for name in ["A", "B", "G", "R"] {
-            let ch = image
-                .layer_data
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.to_string() == name)
-                .expect("channel");
-            if let exr::prelude::FlatSamples::F32(x) = &ch.sample_data {
-                v.extend_from_slice(x);
-            }
-        }
-        v
+        common::read_exr_channels(&exr, &["A", "B", "G", "R"]).concat()
     };
     let whole = render("untiled.exr", None);
     let tiled = render("tiled.exr", Some("64"));

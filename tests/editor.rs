@@ -3,6 +3,8 @@
 //! undo/redo, save/reopen, autosave and recovery, bad files, export. Small scenes, a quarter-resolution
 //! viewport and a coarse shadow grid keep each refinement to a few seconds on two cores.
 
+mod common;
+
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use std::path::{Path, PathBuf};
@@ -191,34 +193,14 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
 
 /// RGBA of an EXR as a frame's beauty.
 fn read_exr_beauty(path: &Path, width: u32, height: u32) -> Frame {
-    use exr::prelude::{ReadChannels, ReadLayers};
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .expect("a readable EXR");
-    let get = |name: &str| -> Vec<f32> {
-        let c = image
-            .layer_data
-            .channel_data
-            .list
-            .iter()
-            .find(|c| c.name.to_string() == name)
-            .expect("channel");
-        match &c.sample_data {
-            exr::prelude::FlatSamples::F32(v) => v.clone(),
-            other => panic!("{name} is not float32: {other:?}"),
-        }
-    };
-    let (r, g, b, a) = (get("R"), get("G"), get("B"), get("A"));
+    let c = common::read_exr_channels(path, &["R", "G", "B", "A"]);
     Frame {
         width,
         height,
         samples: 4,
-        beauty: (0..r.len()).map(|i| [r[i], g[i], b[i], a[i]]).collect(),
+        beauty: (0..c[0].len())
+            .map(|i| [c[0][i], c[1][i], c[2][i], c[3][i]])
+            .collect(),
         depth: Vec::new(),
         sample_ids: Vec::new(),
         components: Vec::new(),

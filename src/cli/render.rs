@@ -13,7 +13,7 @@ use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
-use strandlight::render::tiled::{DEFAULT_TILE, render_tiled};
+use strandlight::render::tiled::{DEFAULT_TILE, needs_tiles, render_tiled};
 use strandlight::render::{Camera, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::session::assemble::{StillHeader, still_attributes};
@@ -306,10 +306,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let luts = Luts::default_tables();
     let t = Instant::now();
     // Tiles when asked, or when the image's buffers would exceed what the GPU binds at once.
-    let limit = ctx.device.limits().max_storage_buffer_binding_size;
     let tile = match args.tile {
-        Some(t) => t.max(16),
-        None if settings.width as u64 * settings.height as u64 * 16 > limit => DEFAULT_TILE,
+        Some(t) if t < 16 => bail!("--tile must be at least 16 pixels, got {t}"),
+        Some(t) => t,
+        None if needs_tiles(&ctx, settings.width, settings.height) => DEFAULT_TILE,
         None => 0,
     };
     let mut first = settings.clone();
@@ -349,7 +349,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .iter()
             .map(|(n, ms)| format!("{n} {ms:.2} ms"))
             .collect();
-        eprintln!("GPU time per pass: {}", list.join(", "));
+        let of = if tile > 0 { " (the last tile)" } else { "" };
+        eprintln!("GPU time per pass{of}: {}", list.join(", "));
     }
     eprintln!(
         "rendered {}x{} ({} strands, {} lights) in {:.2} s",

@@ -649,8 +649,8 @@ impl EditorApp {
         match result {
             Ok(p) => {
                 if !p.converged || live.tables_pending() {
-                    // Poll for the unit in flight about once per unit budget: on a software GPU,
-                    // egui's own frames share the CPU with the refinement.
+                    // Poll for the unit in flight every 30 ms (not every vsync: on a software GPU,
+                    // egui's own frames share the CPU with the refinement).
                     self.ctx.request_repaint_after(REFINE_POLL);
                     self.painted_converged = false;
                 } else if !self.painted_converged {

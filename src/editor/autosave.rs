@@ -116,15 +116,15 @@ impl Autosave {
     /// On quit (or before another session replaces an unsaved one): keep unsaved work in the
     /// recovery file, else remove it.
     pub fn on_exit(&mut self, session: &Session, modified: bool) -> Result<(), String> {
-        if modified {
-            // A write in flight targets the same file: this newer snapshot must win.
-            while let Some(job) = &mut self.writing {
-                if job.poll().is_some() {
-                    self.writing = None;
-                }
-                std::thread::sleep(Duration::from_millis(1));
+        // A write in flight targets the same file: it must land before this one (or the deletion).
+        while let Some(job) = &mut self.writing {
+            if job.poll().is_some() {
+                self.writing = None;
             }
-            self.delete_when_written = false;
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        self.delete_when_written = false;
+        if modified {
             write_recovery(&self.path, &self.contents(session))
         } else {
             let _ = std::fs::remove_file(&self.path);

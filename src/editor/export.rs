@@ -82,8 +82,7 @@ impl ExportJob {
         tile: Option<u32>,
     ) -> Result<Self, String> {
         let (w, h) = (scene.settings.width, scene.settings.height);
-        let limit = live.ctx.device.limits().max_storage_buffer_binding_size;
-        let tile = tile.unwrap_or(if w as u64 * h as u64 * 16 > limit {
+        let tile = tile.unwrap_or(if crate::render::tiled::needs_tiles(&live.ctx, w, h) {
             DEFAULT_TILE
         } else {
             w.max(h)
@@ -103,6 +102,7 @@ impl ExportJob {
             &scene.camera,
         )
         .map_err(|e| e.to_string())?;
+        renderer.set_unit_budget(crate::editor::live::unit_budget(&live.ctx));
         renderer
             .set_camera_tile(&live.ctx, &scene.camera, tiles[0])
             .map_err(|e| e.to_string())?;
@@ -198,6 +198,11 @@ impl ExportJob {
             },
         ));
         None
+    }
+
+    /// The files are being written (too late to cancel).
+    pub fn writing(&self) -> bool {
+        self.writing.is_some()
     }
 
     /// The EXR path with `.png` for the preview.

@@ -156,15 +156,8 @@ impl EnvMap {
     /// Writes a tone-mapped 8-bit sRGB PNG preview (Reinhard on exposure-scaled radiance; the EXR
     /// stays the linear data, this is only for looking at).
     pub fn write_png_preview(&self, path: &Path, exposure: f32) -> Result<(), EnvError> {
-        let srgb = |x: f32| {
-            let x = x.clamp(0.0, 1.0);
-            let v = if x <= 0.0031308 {
-                12.92 * x
-            } else {
-                1.055 * x.powf(1.0 / 2.4) - 0.055
-            };
-            (v * 255.0 + 0.5) as u8
-        };
+        let srgb =
+            |x: f32| (crate::render::frame::srgb_encode(x.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
         let mut img = image::RgbImage::new(self.width as u32, self.height as u32);
         for (i, px) in img.pixels_mut().enumerate() {
             let c = self.pixels[i].map(|v| v * exposure);

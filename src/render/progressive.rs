@@ -118,6 +118,15 @@ impl Refinement {
             .min(remaining.max(1))
     }
 
+    /// The image width changed by `ratio`: a row costs about that much more (or less), and the next
+    /// band starts small.
+    pub(super) fn resized(&mut self, ratio: f64) {
+        if let Some(c) = &mut self.shade_cost {
+            *c *= ratio.max(1e-6);
+        }
+        self.shade_last = 1;
+    }
+
     /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
     /// measurement, so one slow unit does not halve the next ones).
     fn measured(&mut self, unit: WorkUnit, elapsed: Duration) {

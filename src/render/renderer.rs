@@ -612,15 +612,15 @@ impl Renderer {
                 limit,
             });
         }
+        self.refinement
+            .resized(width as f64 / self.settings.width.max(1) as f64);
         self.settings.width = width;
         self.settings.height = height;
         self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
-        // The camera uniform holds the image size (projection aspect, pixel rays); a tile's is set by
-        // set_camera_tile after this.
-        if self.tile.is_none() {
-            let camera = self.camera_view;
-            self.set_camera(ctx, &camera);
-        }
+        // The camera uniform holds the image size (projection aspect, pixel rays); a tile's is written
+        // by set_camera_tile after this.
+        let camera = self.camera_view;
+        self.set_camera(ctx, &camera);
         self.update_batches(&ctx.device);
         Ok(())
     }

@@ -11,7 +11,16 @@ use crate::gpu::GpuContext;
 /// Tiles of at most this many pixels a side by default (16 MiB per RGBA float buffer).
 pub const DEFAULT_TILE: u32 = 1024;
 
-/// An empty full-size frame the tiles are pasted into.
+/// Whether a width x height image exceeds what the device binds or rasterises at once (then it is
+/// rendered in tiles).
+pub fn needs_tiles(ctx: &GpuContext, width: u32, height: u32) -> bool {
+    let l = ctx.device.limits();
+    let bytes = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+    width as u64 * height as u64 * 16 > bytes || width.max(height) > l.max_texture_dimension_2d
+}
+
+/// An empty full-size frame the tiles are pasted into (96 bytes a pixel: an 8K still needs ~3.2 GB
+/// of memory before it is written).
 pub fn empty_frame(width: u32, height: u32, samples: u32, components: usize) -> Frame {
     let n = width as usize * height as usize;
     Frame {

@@ -334,3 +334,32 @@ pub fn clump(n: usize, seed: u64) -> strandlight::hair::Hair {
         .collect();
     strandlight::hair::Hair::from_strands(strands, 0.008).0
 }
+
+/// The named float channels of an EXR's first layer (panics with the name when one is missing).
+pub fn read_exr_channels(path: &std::path::Path, names: &[&str]) -> Vec<Vec<f32>> {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .expect("a readable EXR");
+    names
+        .iter()
+        .map(|name| {
+            let c = image
+                .layer_data
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.to_string() == *name)
+                .unwrap_or_else(|| panic!("channel {name} missing"));
+            match &c.sample_data {
+                exr::prelude::FlatSamples::F32(v) => v.clone(),
+                other => panic!("{name} is not float32: {other:?}"),
+            }
+        })
+        .collect()
+}

@@ -150,6 +150,13 @@ pub fn start_export(app: &mut EditorApp, exr: std::path::PathBuf) {
 
 /// [`start_export`] in tiles of at most `tile` pixels a side (None: only when the image needs them).
 pub fn start_export_tiled(app: &mut EditorApp, exr: std::path::PathBuf, tile: Option<u32>) {
+    if app.export.is_some() {
+        app.message(
+            Level::Error,
+            "an export is running: cancel it or wait for it first",
+        );
+        return;
+    }
     let Some(live) = &app.live else {
         app.message(Level::Error, "export: the scene is still loading");
         return;

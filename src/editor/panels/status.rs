@@ -55,7 +55,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
                     .text("export"),
             );
             cancel = ui
-                .small_button("cancel")
+                .add_enabled(!e.writing(), egui::Button::new("cancel").small())
                 .on_hover_text("Stop the export (nothing is written)")
                 .clicked();
         }

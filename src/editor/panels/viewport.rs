@@ -9,10 +9,15 @@ pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
     let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
     let ppp = ui.ctx().pixels_per_point();
     app.viewport_rect = Some(rect);
-    app.viewport_px = [
+    let px = [
         (rect.width() * ppp).round().max(16.0) as u32,
         (rect.height() * ppp).round().max(16.0) as u32,
     ];
+    if px != app.viewport_px {
+        // The renderer steps before the panels: one more frame resizes it.
+        ui.ctx().request_repaint();
+    }
+    app.viewport_px = px;
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 0.0, egui::Color32::from_rgb(41, 41, 43));
     match app.live.as_ref().and_then(|l| l.texture) {

@@ -89,20 +89,9 @@ pub fn reset_button(ui: &mut egui::Ui, enabled: bool) -> bool {
 
 /// Linear to sRGB-encoded byte, and back.
 pub fn linear_to_srgb8(x: f64) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let v = if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (v * 255.0 + 0.5) as u8
+    (crate::render::frame::srgb_encode(x.clamp(0.0, 1.0) as f32) * 255.0 + 0.5) as u8
 }
 
 pub fn srgb8_to_linear(b: u8) -> f64 {
-    let v = b as f64 / 255.0;
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
+    crate::render::frame::srgb_decode(b as f64 / 255.0)
 }
