@@ -569,3 +569,31 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
         / (3.0 * shot.pixels().len() as f64);
     assert!(lum > 5.0, "the screenshot is black");
 }
+
+#[test]
+fn a_lost_gpu_device_is_reported_and_the_session_kept() {
+    let dir = tmp("lost");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    click(&mut h, "auburn");
+    let device = h.state().gpu.as_ref().expect("a GPU").device.clone();
+    device.destroy();
+    let t = Instant::now();
+    while h.state().gpu.is_some() {
+        // wgpu reports the loss when the device is next polled (the renderer polls every frame).
+        let _ = device.poll(wgpu::PollType::Poll);
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+        assert!(t.elapsed() < Duration::from_secs(20), "the loss was not reported");
+    }
+    let msg = h.state().messages.last().expect("a message").text.clone();
+    println!("{msg}");
+    assert!(msg.contains("GPU device was lost"));
+    assert!(h.state().live.is_none() && h.state().gpu.is_none());
+    // The session with the edit is in the recovery file.
+    let text = std::fs::read_to_string(&h.state().autosave.path).expect("a recovery file");
+    assert!(
+        text.contains("0.6") && text.contains("1.2"),
+        "auburn's melanin"
+    );
+}

@@ -127,6 +127,8 @@ pub struct EditorApp {
     pub frame_ms: f32,
     /// The frame after convergence was requested (it paints the last image).
     painted_converged: bool,
+    /// Set by wgpu when the device is lost (reason and message).
+    device_lost: Arc<std::sync::Mutex<Option<String>>>,
     last_frame: Option<Instant>,
     ctx: egui::Context,
 }
@@ -207,11 +209,41 @@ impl EditorApp {
             viewport_rect: None,
             frame_ms: 0.0,
             painted_converged: false,
+            device_lost: Arc::new(std::sync::Mutex::new(None)),
             last_frame: None,
             ctx: cc.egui_ctx.clone(),
         };
+        if let Some(g) = &app.gpu {
+            let (flag, wake) = (app.device_lost.clone(), app.ctx.clone());
+            g.device.set_device_lost_callback(move |reason, message| {
+                if let Ok(mut f) = flag.lock() {
+                    *f = Some(format!("{reason:?}: {message}"));
+                }
+                wake.request_repaint();
+            });
+        }
         app.load_scene();
         app
+    }
+
+    /// A lost GPU device: reported, the viewport stops and the session goes to the recovery file
+    /// (eframe owns the device; the editor cannot recreate it, a restart offers the recovery).
+    fn check_device(&mut self) {
+        let lost = self.device_lost.lock().ok().and_then(|mut f| f.take());
+        let Some(why) = lost else {
+            return;
+        };
+        self.export = None;
+        self.drop_live();
+        self.gpu = None;
+        let kept = match self.autosave.on_exit(&self.session.clone(), true) {
+            Ok(()) => format!("the session is kept in {}", self.autosave.path.display()),
+            Err(e) => e,
+        };
+        self.message(
+            Level::Error,
+            format!("the GPU device was lost ({why}); the viewport stopped, {kept}: save it and restart strandlight"),
+        );
     }
 
     pub fn luts(&self) -> &Luts {
@@ -606,6 +638,9 @@ impl EditorApp {
 
     /// The viewport's per-frame work: rebuild, sync, refine, display.
     pub fn update_viewport(&mut self) {
+        if self.gpu.is_none() {
+            return;
+        }
         let (w, h) = self.render_size();
         let rebuild = self
             .live
@@ -798,6 +833,7 @@ fn install_fonts(ctx: &egui::Context) {
 impl eframe::App for EditorApp {
     fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
         self.frame_timing();
+        self.check_device();
         self.poll_jobs();
         self.dropped_files(ctx);
         self.shortcuts(ctx);

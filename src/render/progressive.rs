@@ -62,7 +62,13 @@ pub struct RefineStats {
     /// The longest unit, submission to completion (as seen by the polling that noticed it), and which.
     pub longest: Duration,
     pub longest_unit: Option<WorkUnit>,
+    /// Time spent per pass since the restart, submission to completion of its units (wall clock as
+    /// the polling saw it: an upper bound of GPU time), in [`UNIT_PASSES`] order.
+    pub pass_time: [Duration; 4],
 }
+
+/// The passes the units belong to, in [`RefineStats::pass_time`] order.
+pub const UNIT_PASSES: [&str; 4] = ["volume", "shadow grid", "visibility", "shading"];
 
 /// Where progressive refinement stands (owned by the [`Renderer`]).
 pub struct Refinement {
@@ -134,6 +140,13 @@ impl Refinement {
             self.stats.longest = elapsed;
             self.stats.longest_unit = Some(unit);
         }
+        let pass = match unit {
+            WorkUnit::Volume => 0,
+            WorkUnit::ShadowGrid { .. } => 1,
+            WorkUnit::Visibility => 2,
+            WorkUnit::Shade { .. } => 3,
+        };
+        self.stats.pass_time[pass] += elapsed;
         let per = |n: u32| elapsed.as_secs_f64() / n.max(1) as f64;
         let blend = |old: Option<f64>, new: f64| Some(old.map_or(new, |o| 0.5 * (o + new)));
         match unit {

@@ -1,6 +1,7 @@
 //! The status bar: adapter, hair and light counts, refinement progress, UI frame time, jobs, messages.
 
 use crate::editor::app::{EditorApp, Level};
+use crate::render::progressive::UNIT_PASSES;
 
 pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
@@ -20,12 +21,23 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             let (w, h) = (live.display.width, live.display.height);
             match (live.progress, live.converged_in) {
                 (Some(p), Some(t)) if p.converged && !live.tables_pending() => {
+                    let passes: Vec<String> = UNIT_PASSES
+                        .iter()
+                        .zip(p.stats.pass_time)
+                        .filter(|(_, d)| !d.is_zero())
+                        .map(|(n, d)| format!("{n} {:.0}", d.as_secs_f64() * 1e3))
+                        .collect();
                     ui.label(format!(
                         "{w}×{h} converged in {:.1} s · {} units, longest {:.0} ms",
                         t.as_secs_f64(),
                         p.stats.units,
                         p.stats.longest.as_secs_f64() * 1e3
+                    ))
+                    .on_hover_text(format!(
+                        "Time per pass (ms, submission to completion of its units): {}",
+                        passes.join(", ")
                     ));
+                    ui.weak(format!("ms: {}", passes.join(" · ")));
                 }
                 (Some(p), _) => {
                     ui.add(
