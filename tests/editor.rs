@@ -584,7 +584,10 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
         let _ = device.poll(wgpu::PollType::Poll);
         h.step();
         std::thread::sleep(Duration::from_millis(5));
-        assert!(t.elapsed() < Duration::from_secs(20), "the loss was not reported");
+        assert!(
+            t.elapsed() < Duration::from_secs(20),
+            "the loss was not reported"
+        );
     }
     let msg = h.state().messages.last().expect("a message").text.clone();
     println!("{msg}");
