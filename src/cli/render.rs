@@ -9,6 +9,7 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
 use strandlight::render::camera::CAMERA_PRESETS;
+use strandlight::render::frame::check_output_folders;
 use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
@@ -256,30 +257,16 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
     })
 }
 
-/// Fails before any rendering when an output could not be written: its folder must exist.
-fn check_outputs(outputs: &[&PathBuf]) -> anyhow::Result<()> {
-    for path in outputs {
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        if !dir.is_dir() {
-            bail!(
-                "{}: the folder {} does not exist (nothing was rendered)",
-                path.display(),
-                dir.display()
-            );
-        }
-    }
-    Ok(())
-}
-
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.output.is_none() && args.png.is_none() {
         bail!("nothing to write: give -o still.exr and/or --png preview.png");
     }
-    let outputs: Vec<&PathBuf> = args.output.iter().chain(args.png.iter()).collect();
-    check_outputs(&outputs)?;
+    check_output_folders(
+        args.output
+            .iter()
+            .chain(args.png.iter())
+            .map(PathBuf::as_path),
+    )?;
     let session = match &args.session {
         Some(path) => Session::read(path)?,
         None => session_from_args(&args)?,

@@ -479,8 +479,7 @@ impl EditorApp {
 
     /// The camera resolved for the current hair (framed when the session has no target yet).
     /// The aspect is the viewport render's, as `render --session` frames with the still's.
-    fn resolve_camera(&self, hair: &crate::hair::Hair) -> Camera {
-        let (lo, hi) = hair.bounds();
+    fn resolve_camera(&self, (lo, hi): (glam::Vec3, glam::Vec3)) -> Camera {
         let (w, h) = self.render_size();
         self.session
             .camera
@@ -492,9 +491,8 @@ impl EditorApp {
         self.session.camera.target = None;
         self.session.camera.distance = None;
         if let Some(live) = &self.live {
-            let hair = live.hair.clone();
             // The session keeps "framed" (no target, no distance): it follows the hair.
-            let c = self.resolve_camera(&hair);
+            let c = self.resolve_camera(live.bounds);
             self.camera = Some(c);
             self.session.camera.yaw = c.yaw;
             self.session.camera.pitch = c.pitch;
@@ -601,7 +599,7 @@ impl EditorApp {
         let Some(gpu) = self.gpu.clone() else {
             return;
         };
-        let camera = self.resolve_camera(&hair.hair);
+        let camera = self.resolve_camera(hair.hair.bounds());
         let (w, h) = self.render_size();
         match LiveScene::new(
             gpu,
@@ -666,8 +664,7 @@ impl EditorApp {
         if let Some(live) = &self.live
             && (self.session.camera.target.is_none() || self.session.camera.distance.is_none())
         {
-            let hair = live.hair.clone();
-            self.camera = Some(self.resolve_camera(&hair));
+            self.camera = Some(self.resolve_camera(live.bounds));
         }
         let (Some(live), Some(camera)) = (&mut self.live, self.camera) else {
             return;

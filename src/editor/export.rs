@@ -47,19 +47,10 @@ impl ExportJob {
         if live.needs_rebuild(session) {
             return Err("the scene is still loading; export when it is shown".into());
         }
-        for p in std::iter::once(&exr).chain(png.iter()) {
-            let dir = match p.parent() {
-                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-                _ => PathBuf::from("."),
-            };
-            if !dir.is_dir() {
-                return Err(format!(
-                    "{}: the folder {} does not exist",
-                    p.display(),
-                    dir.display()
-                ));
-            }
-        }
+        crate::render::frame::check_output_folders(
+            std::iter::once(exr.as_path()).chain(png.as_deref()),
+        )
+        .map_err(|e| e.to_string())?;
         let hair = LoadedHairSource {
             hair: (*live.hair).clone(),
             name: live.hair_name.clone(),

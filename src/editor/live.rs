@@ -15,7 +15,7 @@ use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::lut::Luts;
-use crate::session::assemble::{LoadedHairSource, absorption, turned_lights};
+use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
 use crate::shadow::forward::ForwardTable;
 use std::sync::Arc;
@@ -103,6 +103,8 @@ struct Applied {
 pub struct LiveScene {
     pub ctx: GpuContext,
     pub hair: Arc<Hair>,
+    /// The hair's bounding box (the framed camera reads it every frame).
+    pub bounds: (glam::Vec3, glam::Vec3),
     pub hair_name: String,
     pub hair_source: HairSource,
     /// The environment with its lights unturned.
@@ -163,6 +165,7 @@ impl LiveScene {
         renderer.set_unit_budget(unit_budget(&ctx));
         let display = DisplayPass::new(&ctx.device, width, height);
         Ok(Self {
+            bounds: hair.hair.bounds(),
             hair: Arc::new(hair.hair),
             hair_name: hair.name,
             hair_source: session.hair.clone(),
@@ -223,11 +226,7 @@ impl LiveScene {
                 look
             } else {
                 session.look.validate().map_err(AssembleError::Look)?;
-                let mut params = session.look.params;
-                params.sigma_a = self.mean_sigma_a;
-                HairLook::new(params)
-                    .with_dual(session.look.d_f, session.look.d_b)
-                    .with_longitudinal(session.look.longitudinal)
+                renderer_look(&session.look, self.mean_sigma_a)
             };
             if self.renderer.set_params_deferred(&self.ctx, &look) {
                 let params = look.params;

@@ -45,6 +45,28 @@ fn exr_text(s: &str) -> exr::prelude::Text {
     exr::prelude::Text::new_or_none(&latin).unwrap_or_else(|| exr::prelude::Text::from("?"))
 }
 
+/// Fails before any rendering when an output could not be written: its folder must exist.
+pub fn check_output_folders<'a>(
+    outputs: impl IntoIterator<Item = &'a Path>,
+) -> Result<(), OutputError> {
+    for path in outputs {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            return Err(out_err(
+                path,
+                format!(
+                    "the folder {} does not exist (nothing was rendered)",
+                    dir.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Frame {
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize

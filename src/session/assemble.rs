@@ -141,15 +141,22 @@ pub fn absorption(
     if let Some(path) = paint {
         PaintLayer::read(path)?.apply(&mut sigma_a, hair.strand_count(), path)?;
     }
-    let mut params = look.params;
     let n = sigma_a.len().max(1) as f64;
-    for c in 0..3 {
-        params.sigma_a[c] = sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n;
-    }
-    let hair_look = HairLook::new(params)
+    let mean: [f64; 3] =
+        std::array::from_fn(|c| sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n);
+    Ok((sigma_a, renderer_look(look, mean)))
+}
+
+/// The look in the renderer's form with `mean_sigma_a` (the points' mean absorption, what the
+/// dual-scattering tables are built for).
+pub fn renderer_look(look: &Look, mean_sigma_a: [f64; 3]) -> HairLook {
+    let params = crate::scattering::HairParams {
+        sigma_a: mean_sigma_a,
+        ..look.params
+    };
+    HairLook::new(params)
         .with_dual(look.d_f, look.d_b)
-        .with_longitudinal(look.longitudinal);
-    Ok((sigma_a, hair_look))
+        .with_longitudinal(look.longitudinal)
 }
 
 /// Everything the renderer is built from.
