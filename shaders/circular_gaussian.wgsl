@@ -67,15 +67,19 @@ fn erf_approx(x: f32) -> f32 {
 
 // integral_a^b (c0 + c1 x) g(x; mu, lambda) dx, g = exp(-(x - mu)^2 / lambda^2).
 fn gaussian_linear_integral(a: f32, b: f32, mu: f32, lambda: f32, c0: f32, c1: f32) -> f32 {
-    let ua = (a - mu) / lambda;
-    let ub = (b - mu) / lambda;
-    let i0 = 0.5 * SQRT_PI * lambda * (erf_approx(ub) - erf_approx(ua));
-    let i1 = 0.5 * lambda * lambda * (exp(-ua * ua) - exp(-ub * ub));
-    return (c0 + c1 * mu) * i0 + c1 * i1;
+    let i = gaussian_linear_moments(a, b, mu, lambda);
+    return (c0 + c1 * mu) * i.x + c1 * i.y;
 }
 
-// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx, y = x - mu.
-fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32>) -> f32 {
+// (integral g, integral (x - mu) g) over [a, b]: gaussian_linear_integral's moments, once per segment.
+fn gaussian_linear_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec2<f32> {
+    let ua = (a - mu) / lambda;
+    let ub = (b - mu) / lambda;
+    return vec2<f32>(0.5 * SQRT_PI * lambda * (erf_approx(ub) - erf_approx(ua)), 0.5 * lambda * lambda * (exp(-ua * ua) - exp(-ub * ub)));
+}
+
+// integral_a^b y^k g(x; mu, lambda) dx (k = 0, 1, 2; y = x - mu), once per segment pair.
+fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec3<f32> {
     let ua = (a - mu) / lambda;
     let ub = (b - mu) / lambda;
     let ea = exp(-ua * ua);
@@ -83,7 +87,13 @@ fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32
     let m0 = 0.5 * SQRT_PI * (erf_approx(ub) - erf_approx(ua));
     let m1 = 0.5 * (ea - eb);
     let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
-    return lambda * (d.x * m0 + d.y * lambda * m1 + d.z * lambda * lambda * m2);
+    return vec3<f32>(lambda * m0, lambda * lambda * m1, lambda * lambda * lambda * m2);
+}
+
+// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx, y = x - mu.
+fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32>) -> f32 {
+    let m = gaussian_quadratic_moments(a, b, mu, lambda);
+    return d.x * m.x + d.y * m.y + d.z * m.z;
 }
 
 // 2 pi e^-kappa I0(kappa): the period integral of exp(kappa (cos x - 1)).

@@ -69,6 +69,11 @@ fn extinction_at(p: vec3<f32>, lod: f32) -> Extinction {
     let l1 = min(l0 + 1u, pyramid_info.count - 1u);
     let t = l - f32(l0);
     let e0 = level_sample(pyramid_info.levels[l0], p);
+    // A whole level (every step of a thin ray, and a cone's first steps) reads one level: the other has
+    // weight zero, and mix(e0, e1, 0) is e0 exactly.
+    if (t == 0.0 || l1 == l0) {
+        return e0;
+    }
     let e1 = level_sample(pyramid_info.levels[l1], p);
     return Extinction(mix(e0.a, e1.a, t), mix(e0.m0, e1.m0, t), mix(e0.m1, e1.m1, t));
 }

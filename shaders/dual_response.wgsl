@@ -1,6 +1,6 @@
 // Multiple scattering per SRBF light by dual scattering (Xu 2011 Sec. 4.3, Zinke 2008): twin of
 // src/scattering/dual_response.rs and of DualTables::lookup / mean_delta_sigma in dual_terms.rs.
-// Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response. The includer
+// Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response. The includer
 // binds `dual_tables`: DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample, RGB) followed by
 // (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b).
 
@@ -77,7 +77,7 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
     let w = longitudinal_factor(d.longitudinal, ti);
     if (d.kind == DUAL_GLOBAL) {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
-        return w * azimuthal_window_integral(d.lobe, p.eta, p.sigma_a.xyz, theta_d, d.dphi, 0.0, FRAC_PI_2) / PI;
+        return w * azimuthal_table_box(d.lobe, p.sigma_a.xyz, theta_d, d.dphi);
     }
     let a = dual_lookup(0u, theta_d)[d.channel] * backscatter_depth_fraction(dual_lookup(3u, theta_d)[d.channel], d.depth_behind);
     return vec3<f32>(w * a);
@@ -100,14 +100,7 @@ fn dual_quadrature(p: FastHairParams, d: DualIntegrand, mu: f32, l: f32) -> vec3
             let x2 = quadrature_sample(s + 1u, m, mu, l);
             let f2 = dual_integrand(p, d, x2);
             if (x2 > x0 && x1 > x0 && x2 > x1) {
-                for (var c = 0u; c < 3u; c++) {
-                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
-                    let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
-                    let y0 = x0 - mu;
-                    let y1 = x1 - mu;
-                    let dd = vec3<f32>(f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2);
-                    out[c] = out[c] + gaussian_quadratic_integral(x0, x2, mu, l, dd);
-                }
+                out = out + quadrature_parabola_pair(x0, x1, x2, f0, f1, f2, mu, l);
             } else if (x2 > x0) {
                 out = out + quadrature_linear_piece(x0, x2, f0, f2, mu, l);
             }

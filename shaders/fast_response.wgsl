@@ -128,6 +128,10 @@ fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
     let w = longitudinal_factor(longitudinal, theta_i);
+    // The quadrature's end nodes sit at the poles, where cos(theta_i) (and so w) vanishes.
+    if (w == 0.0) {
+        return vec3<f32>(0.0);
+    }
     let dphi = phi_o - light.phi;
     let sigma = params.sigma_a.xyz;
     if (lobe == 0u) {
@@ -198,10 +202,26 @@ fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f
     if (x1 <= x0) {
         return out;
     }
+    let i = gaussian_linear_moments(x0, x1, mu, lambda);
     for (var c = 0u; c < 3u; c++) {
         let c1 = (f1[c] - f0[c]) / (x1 - x0);
         let c0 = f0[c] - c1 * x0;
-        out[c] = gaussian_linear_integral(x0, x1, mu, lambda, c0, c1);
+        out[c] = (c0 + c1 * mu) * i.x + c1 * i.y;
+    }
+    return out;
+}
+
+// The parabola through (x0, f0), (x1, f1), (x2, f2) per channel against g(x; mu, l) over [x0, x2]: Newton form
+// in y = x - mu, the Gaussian's moments computed once for the three channels.
+fn quadrature_parabola_pair(x0: f32, x1: f32, x2: f32, f0: vec3<f32>, f1: vec3<f32>, f2: vec3<f32>, mu: f32, l: f32) -> vec3<f32> {
+    let m = gaussian_quadratic_moments(x0, x2, mu, l);
+    var out = vec3<f32>(0.0);
+    for (var c = 0u; c < 3u; c++) {
+        let q1 = (f1[c] - f0[c]) / (x1 - x0);
+        let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
+        let y0 = x0 - mu;
+        let y1 = x1 - mu;
+        out[c] = (f0[c] - q1 * y0 + q2 * y0 * y1) * m.x + (q1 - q2 * (y0 + y1)) * m.y + q2 * m.z;
     }
     return out;
 }
@@ -234,14 +254,7 @@ fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
             let x2 = quadrature_sample(s + 1u, m, mu, l);
             let f2 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x2);
             if (x2 > x0 && x1 > x0 && x2 > x1) {
-                for (var c = 0u; c < 3u; c++) {
-                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
-                    let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
-                    let y0 = x0 - mu;
-                    let y1 = x1 - mu;
-                    let d = vec3<f32>(f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2);
-                    out[c] = out[c] + gaussian_quadratic_integral(x0, x2, mu, l, d);
-                }
+                out = out + quadrature_parabola_pair(x0, x1, x2, f0, f1, f2, mu, l);
             } else if (x2 > x0) {
                 out = out + quadrature_linear_piece(x0, x2, f0, f2, mu, l);
             }

@@ -44,6 +44,7 @@ struct ShadeBatch {
 @group(0) @binding(16) var<storage, read_write> aov_ms_global: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
 @group(0) @binding(18) var visibility: texture_multisampled_2d<f32>;
+@group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -91,9 +92,23 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
         if (multiple) {
             // One spread for the three channels: their mean sigma_f^2.
             let s2 = (sh.sigma_f2.x + sh.sigma_f2.y + sh.sigma_f2.z) / 3.0;
-            let global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
-            let local = local_response(p, light, o.x, o.y, s2, sh.depth_behind);
-            let local_direct = local_response(p, light, o.x, o.y, 0.0, sh.depth_behind);
+            // Only what Zinke's combination does not multiply by zero: the forward-scattered part where
+            // T_f exceeds the direct fraction, the direct part where light arrives directly; the local
+            // term once when the spread is zero (both are then the same).
+            var global = vec3<f32>(0.0);
+            var local = vec3<f32>(0.0);
+            var local_direct = vec3<f32>(0.0);
+            if (sh.transmittance > 0.0) {
+                local_direct = local_response(p, light, o.x, o.y, 0.0, sh.depth_behind);
+            }
+            if (any(sh.transmittance_f > vec3<f32>(sh.transmittance))) {
+                global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
+                if (s2 == 0.0 && sh.transmittance > 0.0) {
+                    local = local_direct;
+                } else {
+                    local = local_response(p, light, o.x, o.y, s2, sh.depth_behind);
+                }
+            }
             let ms = dual_scattering_components(p, sh.transmittance, sh.transmittance_f, local_direct, global, local);
             let power = srbf_integral(l.lambda) * l.rgb;
             out.ms_global = out.ms_global + power * ms.ms_global;

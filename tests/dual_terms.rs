@@ -275,6 +275,9 @@ fn global_and_local_terms_against_direct_quadrature() {
     use strandlight::scattering::marschner::longitudinal_m_p_normalized;
     let p = HairParams::with_sigma_a([0.2, 0.5, 1.0]);
     let tables = DualTables::build(&p, XU_ROOTS);
+    let azimuthal = strandlight::scattering::azimuthal_table::AzimuthalTable::for_params(
+        &FastHairParams::new(&p, 4),
+    );
     let gauss = |x: f64, s: f64| (-x * x / (2.0 * s * s)).exp() / ((2.0 * PI).sqrt() * s);
     let (mut worst_g, mut worst_l): (f64, f64) = (0.0, 0.0);
     // The last column: the optical depth of hair behind the point (infinite: Zinke's unbounded hair).
@@ -319,6 +322,7 @@ fn global_and_local_terms_against_direct_quadrature() {
             let mut direct = 0.0;
             for lobe in Lobe::ALL {
                 fast += global_response_lobe(
+                    &azimuthal,
                     &fp,
                     lobe.p(),
                     light,

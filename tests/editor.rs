@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use strandlight::editor::{EditorApp, EditorOptions};
 use strandlight::hair::procedural::Style;
 use strandlight::render::Frame;
+use strandlight::render::progressive::WorkUnit;
 use strandlight::session::{HairSource, Session};
 
 fn tmp(name: &str) -> PathBuf {
@@ -314,8 +315,32 @@ fn a_narrower_highlight_is_sharper() {
         v[(v.len() * 99) / 100]
     };
     let wide = r_peak(&image(&h));
+    let before = h.state().live.as_ref().expect("a scene").refine_started;
     slider(&h, "β_R width").set_value_accesskit(3.0);
-    h.step();
+    // The new look shows before the shadow grid is rebuilt for the new tables (with dual scattering
+    // their forward terms need it): the first image is shaded with the grid already built, and the
+    // multiple scattering follows.
+    let (mut grid_units, t) = (0, Instant::now());
+    loop {
+        h.step();
+        let live = h.state().live.as_ref().expect("a scene");
+        if matches!(
+            live.progress.and_then(|p| p.submitted),
+            Some(WorkUnit::ShadowGrid { .. })
+        ) {
+            grid_units += 1;
+        }
+        if live.refine_started > before && live.first_image_in.is_some() {
+            println!(
+                "beta_R 7.5 -> 3 deg: first image after {:.2} s",
+                live.first_image_in.unwrap_or_default().as_secs_f64()
+            );
+            break;
+        }
+        assert!(t.elapsed() < Duration::from_secs(120), "no first image");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    assert_eq!(grid_units, 0, "the first image waited for the shadow grid");
     converge(&mut h);
     let narrow = r_peak(&image(&h));
     println!("R lobe p99: beta_R 7.5 deg {wide:.4}, 3 deg {narrow:.4}");

@@ -6,6 +6,7 @@
 use rand_core::Rng;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use strandlight::scattering::azimuthal_table::AzimuthalTable;
 use strandlight::scattering::fast_azimuthal::{
     CircularLobe, LobeFit, attenuation_polynomial, bravais_eta_prime, sigma_a_prime,
     taylor_attenuation, trt_lobes, tt_lobe,
@@ -146,8 +147,9 @@ fn grid(n: usize, seed: u64) -> Vec<Config> {
             let mut p = HairParams::with_sigma_a([0.05 * 40f64.powf(u()); 3]);
             p.beta_r = (2.0 + 8.0 * u()).to_radians();
             p.alpha_r = -(5.0 + 5.0 * u()).to_radians();
-            p.eta = 1.4 + 0.3 * u();
-            p.eccentricity = if i % 2 == 0 { 1.0 } else { 0.9 };
+            // Four indices and two shapes: one azimuthal table per fiber (FIBERS).
+            u();
+            (p.eta, p.eccentricity) = FIBERS[i % FIBERS.len()];
             Config {
                 params: p,
                 light: SrbfLight64 {
@@ -161,6 +163,36 @@ fn grid(n: usize, seed: u64) -> Vec<Config> {
         .collect()
 }
 
+/// The fibers of the grid: (eta, eccentricity).
+const FIBERS: [(f64, f64); 8] = [
+    (1.42, 1.0),
+    (1.42, 0.9),
+    (1.5, 1.0),
+    (1.5, 0.9),
+    (1.58, 1.0),
+    (1.58, 0.9),
+    (1.68, 1.0),
+    (1.68, 0.9),
+];
+
+/// The azimuthal tables of FIBERS, built once.
+fn azimuthal_tables() -> &'static [AzimuthalTable] {
+    static TABLES: std::sync::OnceLock<Vec<AzimuthalTable>> = std::sync::OnceLock::new();
+    TABLES.get_or_init(|| {
+        FIBERS
+            .iter()
+            .map(|&(eta, a)| AzimuthalTable::build(eta as f32, a as f32))
+            .collect()
+    })
+}
+
+fn table_for(fp: &FastHairParams) -> &'static AzimuthalTable {
+    azimuthal_tables()
+        .iter()
+        .find(|t| t.matches(fp))
+        .expect("every grid fiber has a table")
+}
+
 fn fast(luts: &Luts, c: &Config, m: u32) -> [f64; 3] {
     let fp = FastHairParams::new(&c.params, m);
     let light = SrbfInFrame {
@@ -168,7 +200,14 @@ fn fast(luts: &Luts, c: &Config, m: u32) -> [f64; 3] {
         phi: c.light.phi as f32,
         lambda: c.light.lambda as f32,
     };
-    let r = srbf_response(luts, &fp, light, c.view.theta as f32, c.view.phi as f32);
+    let r = srbf_response(
+        luts,
+        table_for(&fp),
+        &fp,
+        light,
+        c.view.theta as f32,
+        c.view.phi as f32,
+    );
     [r[0][0] as f64, r[1][0] as f64, r[2][0] as f64]
 }
 
@@ -210,7 +249,14 @@ fn fig5_linear_quadrature_m4_against_m200() {
                 phi: c.light.phi as f32,
                 lambda: c.light.lambda as f32,
             };
-            let r = srbf_response(&luts, &fp, light, c.view.theta as f32, c.view.phi as f32);
+            let r = srbf_response(
+                &luts,
+                table_for(&fp),
+                &fp,
+                light,
+                c.view.theta as f32,
+                c.view.phi as f32,
+            );
             r[0][0] as f64 + r[1][0] as f64 + r[2][0] as f64
         };
         let mut errs: Vec<f64> = configs

@@ -112,6 +112,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             ForwardTable::build(&s.params, REFERENCE_VARIANT),
             DualTables::build(&s.params, REFERENCE_VARIANT),
         );
+        let azimuthal = strandlight::render::renderer::azimuthal_table_for(&s.params);
         let sources = GridSources {
             pyramid: &pyramid,
             forward: multiple.then_some((&volume, &forward)),
@@ -123,6 +124,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         let cpu = shade_pixels(&frame, &cam, &shading_hair, &pixels, |sp, wo| {
             shade_point(
                 &luts,
+                &azimuthal,
                 &s.look.fast,
                 sp,
                 wo,

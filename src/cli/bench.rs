@@ -66,6 +66,11 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
+    /// The whole shadow grid rebuilt alone and waited for (wall clock, once): lavapipe's timestamps
+    /// bracket a compute dispatch's submission, not its work, so `gpu_ms_median.shadow_grid` reads ~0
+    /// there after the first frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shadow_grid_wall_ms: Option<f64>,
     /// The same frame by progressive refinement (volume and grid rebuilt unless --keep-volume).
     #[serde(skip_serializing_if = "Option::is_none")]
     progressive: Option<ProgressiveReport>,
@@ -175,6 +180,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 per_pass.entry(name).or_default().push(ms);
             }
         }
+        let shadow_grid_wall_ms = if args.no_shadows {
+            None
+        } else {
+            Some(renderer.time_shadow_grid(&ctx)? * 1e3)
+        };
         let progressive = if args.no_progressive {
             None
         } else {
@@ -233,6 +243,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             gpu_ms_total_min: totals.iter().copied().fold(f64::INFINITY, f64::min),
             gpu_ms_total_median: median(totals),
             wall_ms_median: median(walls),
+            shadow_grid_wall_ms,
             progressive,
         });
     }

@@ -8,6 +8,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 use strandlight::envmap::SrbfSet;
+use strandlight::scattering::azimuthal_table::AzimuthalTable;
 use strandlight::scattering::dual_response::{
     dual_scattering_components, global_response_lobe, local_response,
 };
@@ -42,6 +43,9 @@ struct Report {
     lut_build_seconds_median: f64,
     lut_build_seconds_all: Vec<f64>,
     dual_tables_build_seconds_median: f64,
+    /// The azimuthal table of the exact window integrals (all threads; rebuilt when eta or the
+    /// eccentricity change).
+    azimuthal_table_build_seconds_median: f64,
     lights_file: String,
     lights: usize,
     quadrature_segments: u32,
@@ -94,6 +98,14 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
     let luts = Luts::default_tables();
     let fp = FastHairParams::new(&params, DEFAULT_QUADRATURE_SEGMENTS)
         .with_longitudinal(args.longitudinal);
+    let mut table_times: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            std::hint::black_box(AzimuthalTable::for_params(&fp));
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    let table = AzimuthalTable::for_params(&fp);
     // Deterministic shading points: tangents and views spread over the sphere (golden spiral).
     let dir = |k: usize, n: usize, twist: f64| {
         let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
@@ -126,7 +138,7 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
             let t = Instant::now();
             for (lights, theta_o, phi_o) in &points {
                 for l in lights {
-                    let r = srbf_response(&luts, &fp, *l, *theta_o, *phi_o);
+                    let r = srbf_response(&luts, &table, &fp, *l, *theta_o, *phi_o);
                     checksum += r.iter().flatten().map(|v| *v as f64).sum::<f64>();
                 }
             }
@@ -141,13 +153,13 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
             for (lights, theta_o, phi_o) in &points {
                 for l in lights {
                     let (to, po) = (*theta_o, *phi_o);
-                    let r = srbf_response(&luts, &fp, *l, to, po);
+                    let r = srbf_response(&luts, &table, &fp, *l, to, po);
                     // A shadow-grid value: half the light forward-scattered, spread 0.05 rad^2,
                     // two fibers behind the point.
                     let (direct, t_f, s2, behind) = (0.5, [0.7f32; 3], 0.05, 2.0);
                     let mut global = [0.0f32; 3];
                     for lobe in 0..3 {
-                        let g = global_response_lobe(&fp, lobe, *l, to, po, s2);
+                        let g = global_response_lobe(&table, &fp, lobe, *l, to, po, s2);
                         for c in 0..3 {
                             global[c] += g[c];
                         }
@@ -173,6 +185,7 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
         lut_build_seconds_median: lut_median,
         lut_build_seconds_all: all,
         dual_tables_build_seconds_median: median(&mut dual_times),
+        azimuthal_table_build_seconds_median: median(&mut table_times),
         lights_file: path.display().to_string(),
         lights: set.lights.len(),
         quadrature_segments: fp.quadrature_segments,

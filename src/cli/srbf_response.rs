@@ -6,6 +6,7 @@ use super::params_args::{ParamArgs, ParamsReport, VariantArg, check_angles, read
 use anyhow::{Context, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
+use strandlight::scattering::azimuthal_table::AzimuthalTable;
 use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
 use strandlight::scattering::lut::Luts;
@@ -126,8 +127,10 @@ fn evaluate(
         phi: q.phi_j.to_radians() as f32,
         lambda: q.lambda as f32,
     };
+    let table = AzimuthalTable::for_params(&fp);
     let fast = srbf_response(
         luts,
+        &table,
         &fp,
         light,
         q.theta_o.to_radians() as f32,

@@ -9,15 +9,13 @@ use crate::gpu::GpuContext;
 use crate::hair::Hair;
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::progressive::{Progress, WorkUnit};
-use crate::render::renderer::build_tables;
+use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
-use crate::scattering::dual_terms::DualTables;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
-use crate::shadow::forward::ForwardTable;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -55,7 +53,7 @@ pub enum LiveError {
     Assemble(#[from] AssembleError),
 }
 
-type Tables = (HairParams, ForwardTable, DualTables);
+type Tables = (HairParams, ParamTables);
 
 /// What a scene needs computed from the session and the hair before the renderer is built: the
 /// per-point absorption, the look in the renderer's form and its tables (all CPU work, done on the
@@ -63,7 +61,7 @@ type Tables = (HairParams, ForwardTable, DualTables);
 pub struct Prepared {
     pub sigma_a: Vec<[f32; 3]>,
     pub look: HairLook,
-    pub tables: (ForwardTable, DualTables),
+    pub tables: ParamTables,
 }
 
 /// The refinement unit budget for this adapter: on a software GPU egui's own frames run on the same
@@ -82,7 +80,7 @@ pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_
 /// Computes [`Prepared`] (off the UI thread).
 pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
     let (sigma_a, look) = absorption(&session.look, hair, session.paint.as_deref())?;
-    let tables = build_tables(&look.params);
+    let tables = build_tables(&look.params, None);
     Ok(Prepared {
         sigma_a,
         look,
@@ -119,6 +117,8 @@ pub struct LiveScene {
     mean_sigma_a: [f64; 3],
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
+    /// Tables built but not yet handed to the renderer (see `step`).
+    held_tables: Option<Tables>,
     pub progress: Option<Progress>,
     /// When the current refinement started, and how long it took to converge.
     pub refine_started: Instant,
@@ -184,6 +184,7 @@ impl LiveScene {
             },
             view: None,
             tables: None,
+            held_tables: None,
             progress: None,
             refine_started: Instant::now(),
             converged_in: None,
@@ -230,14 +231,13 @@ impl LiveScene {
             };
             if self.renderer.set_params_deferred(&self.ctx, &look) {
                 let params = look.params;
+                let azimuthal = self.renderer.azimuthal_table().clone();
                 // A newer build replaces an older one; set_tables ignores stale tables anyway.
+                self.held_tables = None;
                 self.tables = Some(Job::spawn(
                     "hair tables",
                     || {},
-                    move |_| {
-                        let (f, d) = build_tables(&params);
-                        (params, f, d)
-                    },
+                    move |_| (params, build_tables(&params, Some(&azimuthal))),
                 ));
             }
             changed = true;
@@ -340,18 +340,25 @@ impl LiveScene {
     pub fn step(&mut self, view: ViewSettings) -> Result<Progress, LiveError> {
         let finished = self.tables.as_mut().and_then(|job| job.poll());
         match finished {
-            Some(Ok((params, forward, dual))) => {
+            Some(Ok(tables)) => {
                 self.tables = None;
-                if self
-                    .renderer
-                    .set_tables(&self.ctx, &params, &forward, &dual)
-                {
-                    self.restarted();
-                }
+                self.held_tables = Some(tables);
             }
             // A table build that died leaves the old tables (the shading still follows the look).
             Some(Err(_)) => self.tables = None,
             None => {}
+        }
+        // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
+        // terms read them). Right after a parameter change the refinement shades with the old grid at
+        // once: hand the tables over once that first image is on screen, so the change shows in about
+        // one light batch's time and its multiple scattering follows, or at once when the grid is being
+        // rebuilt anyway (one rebuild, not two).
+        if self.held_tables.is_some()
+            && (self.first_image_in.is_some() || self.renderer.shadow_grid_stale())
+            && let Some((params, tables)) = self.held_tables.take()
+            && self.renderer.set_tables(&self.ctx, &params, &tables)
+        {
+            self.restarted();
         }
         let progress = self.renderer.refine(&self.ctx)?;
         if progress.converged && self.converged_in.is_none() {
@@ -404,8 +411,8 @@ impl LiveScene {
         Ok(progress)
     }
 
-    /// Whether a table build is still running.
+    /// Whether tables are still being built or not yet handed to the renderer.
     pub fn tables_pending(&self) -> bool {
-        self.tables.is_some()
+        self.tables.is_some() || self.held_tables.is_some()
     }
 }

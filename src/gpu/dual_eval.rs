@@ -37,6 +37,7 @@ pub fn upload_dual_tables(device: &wgpu::Device, t: &DualTables) -> wgpu::Buffer
 pub fn evaluate_dual(
     ctx: &GpuContext,
     tables: &wgpu::Buffer,
+    azimuthal_table: &wgpu::Buffer,
     queries: &[FastQuery],
 ) -> Result<Vec<[[f32; 3]; 4]>, String> {
     let module = ctx
@@ -46,7 +47,7 @@ pub fn evaluate_dual(
             source: wgpu::ShaderSource::Wgsl(shaders::dual_eval_module().into()),
         });
     let pipeline = compute_pipeline(&ctx.device, &module, "main");
-    let v: Vec<[f32; 4]> = ctx.run_batch(&pipeline, &[tables], queries, 4)?;
+    let v: Vec<[f32; 4]> = ctx.run_batch(&pipeline, &[tables, azimuthal_table], queries, 4)?;
     Ok((0..queries.len())
         .map(|i| std::array::from_fn(|t| [v[4 * i + t][0], v[4 * i + t][1], v[4 * i + t][2]]))
         .collect())

@@ -4,6 +4,7 @@
 
 use super::context::{GpuContext, compute_pipeline};
 use super::shaders;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::lut::{LutTexture, Luts};
 use bytemuck::{Pod, Zeroable};
@@ -48,6 +49,15 @@ impl GpuLuts {
     }
 }
 
+/// The azimuthal table as a storage buffer (vec4 cells; the renderer binds the same layout).
+pub fn upload_azimuthal_table(device: &wgpu::Device, table: &AzimuthalTable) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("azimuthal table"),
+        contents: table.as_bytes(),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
 pub struct FastEvalPipeline {
     pipeline: wgpu::ComputePipeline,
 }
@@ -64,16 +74,17 @@ impl FastEvalPipeline {
         }
     }
 
-    /// M_R, M_TT, M_TRT (RGB) per query.
+    /// M_R, M_TT, M_TRT (RGB) per query; every query's eta and eccentricity are the table's.
     pub fn evaluate(
         &self,
         ctx: &GpuContext,
         luts: &GpuLuts,
+        table: &wgpu::Buffer,
         queries: &[FastQuery],
     ) -> Result<Vec<[[f32; 3]; 3]>, String> {
         let v: Vec<[f32; 4]> = ctx.run_batch(
             &self.pipeline,
-            &[&luts.c, &luts.h_tt, &luts.h_trt],
+            &[&luts.c, &luts.h_tt, &luts.h_trt, table],
             queries,
             3,
         )?;

@@ -4,7 +4,7 @@
 pub const CIRCULAR_GAUSSIAN: &str = include_str!("../../shaders/circular_gaussian.wgsl");
 pub const LUT: &str = include_str!("../../shaders/lut.wgsl");
 pub const FAST_AZIMUTHAL: &str = include_str!("../../shaders/fast_azimuthal.wgsl");
-pub const FAST_EXACT_AZIMUTHAL: &str = include_str!("../../shaders/fast_exact_azimuthal.wgsl");
+pub const AZIMUTHAL_TABLE: &str = include_str!("../../shaders/azimuthal_table.wgsl");
 pub const FAST_RESPONSE: &str = include_str!("../../shaders/fast_response.wgsl");
 pub const FAST_EVAL: &str = include_str!("../../shaders/fast_eval.wgsl");
 pub const DENSITY_PYRAMID: &str = include_str!("../../shaders/density_pyramid.wgsl");
@@ -79,13 +79,13 @@ pub fn transmittance_eval_module() -> String {
 }
 
 /// The fast-model library (no bindings, no entry points): the including module declares the
-/// storage buffers `lut_c`, `lut_h_tt` and `lut_h_trt`.
+/// storage buffers `lut_c`, `lut_h_tt`, `lut_h_trt` and `azimuthal_table`.
 pub fn fast_model_library() -> String {
     [
         CIRCULAR_GAUSSIAN,
         LUT,
         FAST_AZIMUTHAL,
-        FAST_EXACT_AZIMUTHAL,
+        AZIMUTHAL_TABLE,
         FAST_RESPONSE,
     ]
     .join("\n")

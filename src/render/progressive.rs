@@ -184,6 +184,12 @@ impl Renderer {
         self.settings.shadows && self.light_count > 0
     }
 
+    /// Whether the refinement will rebuild (some of) the shadow grid before it shades: the volume or
+    /// the grid is stale.
+    pub fn shadow_grid_stale(&self) -> bool {
+        self.grid_used() && (self.volume_dirty || self.shadow_grid_dirty)
+    }
+
     /// Whether the grid frames read is stale.
     fn grid_needed(&self) -> bool {
         self.grid_used() && self.shadow_grid_dirty

@@ -17,6 +17,7 @@
 
 use super::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
 use crate::envmap::EnvMap;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
     dual_scattering_components, global_response_lobe, local_response_behind,
 };
@@ -52,6 +53,8 @@ pub struct DualReference<'a> {
     pub dual: &'a DualTables,
     /// d_f, d_b and the parameters in the fast model's form (its sigma_a is replaced per point).
     pub fast: FastHairParams,
+    /// The azimuthal table of `fast`'s eta and eccentricity.
+    pub azimuthal: &'a AzimuthalTable,
 }
 
 /// How the reference shadows each direction.
@@ -163,7 +166,8 @@ fn dual_directional(
         for c in 0..3 {
             let s2 = f.sigma_f2[c];
             for t in 0..3 {
-                global[c] += global_response_lobe(&fp, t, light, theta_o, phi_o, s2)[c];
+                global[c] +=
+                    global_response_lobe(d.azimuthal, &fp, t, light, theta_o, phi_o, s2)[c];
             }
             local[c] = local_response_behind(&fp, d.dual, light, theta_o, phi_o, s2, behind)[c];
         }
@@ -236,11 +240,13 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             || ForwardTable::build(params, REFERENCE_VARIANT),
             || DualTables::build(params, REFERENCE_VARIANT),
         );
+        let azimuthal = AzimuthalTable::for_params(&scene.look.fast);
         let d = DualReference {
             fibers: fibers.as_ref(),
             forward: &forward,
             dual: &dual,
             fast: scene.look.fast,
+            azimuthal: &azimuthal,
         };
         let shadows = ReferenceShadows::Dual(&d);
         super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {

@@ -23,6 +23,7 @@ use crate::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
 use crate::gpu::forward::{forward_table_texels, upload_forward_table};
 use crate::hair::Hair;
 use crate::render::reference::REFERENCE_VARIANT;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use crate::scattering::lut::Luts;
@@ -30,6 +31,7 @@ use crate::scattering::params::{HairParams, LongitudinalModel};
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
 use crate::shadow::forward::ForwardTable;
 use crate::shadow::grid::ShadowGrid;
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 /// The passes, in the order `render_frame` runs them (timestamp names).
@@ -98,13 +100,43 @@ impl HairLook {
 }
 
 /// The tables that depend on hair parameters and are built on the CPU: the forward table (eta, alpha,
-/// beta; read per crossed fiber's absorption) and the dual-scattering tables (all parameters).
+/// beta; read per crossed fiber's absorption), the dual-scattering tables (all parameters) and the
+/// azimuthal table of the exact window integrals (eta and eccentricity; read per point's absorption).
 /// The editor builds them on a worker thread ([`Renderer::set_params_deferred`], [`Renderer::set_tables`]).
-pub fn build_tables(params: &HairParams) -> (ForwardTable, DualTables) {
-    rayon::join(
-        || ForwardTable::build(params, REFERENCE_VARIANT),
-        || DualTables::build(params, REFERENCE_VARIANT),
-    )
+pub struct ParamTables {
+    pub forward: ForwardTable,
+    pub dual: DualTables,
+    pub azimuthal: Arc<AzimuthalTable>,
+}
+
+/// The azimuthal table of `params` (the fast form's f32 eta and eccentricity).
+pub fn azimuthal_table_for(params: &HairParams) -> AzimuthalTable {
+    AzimuthalTable::build(params.eta as f32, params.eccentricity as f32)
+}
+
+/// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same.
+pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
+    let ((forward, dual), azimuthal) = rayon::join(
+        || {
+            rayon::join(
+                || ForwardTable::build(params, REFERENCE_VARIANT),
+                || DualTables::build(params, REFERENCE_VARIANT),
+            )
+        },
+        || match reuse {
+            Some(t)
+                if t.eta == params.eta as f32 && t.eccentricity == params.eccentricity as f32 =>
+            {
+                t.clone()
+            }
+            _ => Arc::new(azimuthal_table_for(params)),
+        },
+    );
+    ParamTables {
+        forward,
+        dual,
+        azimuthal,
+    }
 }
 
 /// What does not change from frame to frame without rebuilding targets.
@@ -190,6 +222,9 @@ pub struct Renderer {
     pub(super) params: wgpu::Buffer,
     pub(super) forward_table: wgpu::Buffer,
     pub(super) dual_tables: wgpu::Buffer,
+    /// The azimuthal table the buffer holds (sized for the largest, an elliptical fiber's).
+    pub(super) azimuthal: Arc<AzimuthalTable>,
+    pub(super) azimuthal_table: wgpu::Buffer,
     pub(super) camera: wgpu::Buffer,
     /// The camera the uniform was made from (rewritten when the image size changes).
     pub(super) camera_view: Camera,
@@ -243,7 +278,7 @@ impl Renderer {
         lights: &[SrbfLight],
         camera: &Camera,
     ) -> Result<Self, RenderError> {
-        let tables = build_tables(&look.params);
+        let tables = build_tables(&look.params, None);
         Self::with_tables(
             ctx, settings, luts, hair, sigma_a, look, lights, camera, tables,
         )
@@ -261,7 +296,7 @@ impl Renderer {
         look: &HairLook,
         lights: &[SrbfLight],
         camera: &Camera,
-        tables: (ForwardTable, DualTables),
+        tables: ParamTables,
     ) -> Result<Self, RenderError> {
         let device = &ctx.device;
         let max = device.limits().max_texture_dimension_2d;
@@ -304,6 +339,7 @@ impl Renderer {
             &format!("a {}x{} image", settings.width, settings.height),
             settings.width as u64 * settings.height as u64 * 16,
         )?;
+        check("the azimuthal table", AzimuthalTable::MAX_BYTES)?;
         let grid = settings.shadow_grid(hair);
         check(
             &format!(
@@ -338,7 +374,19 @@ impl Renderer {
             skip,
             settings.multiple_scattering,
         );
-        let (forward, dual) = tables;
+        let ParamTables {
+            forward,
+            dual,
+            azimuthal,
+        } = tables;
+        let azimuthal_table = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("azimuthal table"),
+            size: AzimuthalTable::MAX_BYTES,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&azimuthal_table, 0, azimuthal.as_bytes());
         let storage = |label: &str, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -362,6 +410,8 @@ impl Renderer {
                 "dual tables",
                 bytemuck::cast_slice(&dual_tables_texels(&dual)),
             ),
+            azimuthal,
+            azimuthal_table,
             camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
             camera_view: *camera,
             tile: None,
@@ -427,24 +477,11 @@ impl Renderer {
     pub fn set_params(&mut self, ctx: &GpuContext, look: &HairLook) {
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
-        if look.params != self.tables_for {
-            let (forward, dual) = build_tables(&look.params);
-            self.tables_for = look.params;
-            ctx.queue.write_buffer(
-                &self.forward_table,
-                0,
-                bytemuck::cast_slice(&forward_table_texels(&forward)),
-            );
-            ctx.queue.write_buffer(
-                &self.dual_tables,
-                0,
-                bytemuck::cast_slice(&dual_tables_texels(&dual)),
-            );
-            if self.settings.multiple_scattering {
-                self.mark_shadow_grid_dirty();
-            }
-        }
         self.look = *look;
+        if look.params != self.tables_for {
+            let tables = build_tables(&look.params, Some(&self.azimuthal));
+            self.set_tables(ctx, &look.params, &tables);
+        }
         self.restart_refinement();
     }
 
@@ -480,13 +517,17 @@ impl Renderer {
         tables_needed
     }
 
+    /// The azimuthal table in use (kept by a rebuild for the same eta and eccentricity).
+    pub fn azimuthal_table(&self) -> &Arc<AzimuthalTable> {
+        &self.azimuthal
+    }
+
     /// Uploads tables built for `params`; ignored (false) when the look has moved on since.
     pub fn set_tables(
         &mut self,
         ctx: &GpuContext,
         params: &HairParams,
-        forward: &ForwardTable,
-        dual: &DualTables,
+        tables: &ParamTables,
     ) -> bool {
         if *params != self.look.params {
             return false;
@@ -494,13 +535,18 @@ impl Renderer {
         ctx.queue.write_buffer(
             &self.forward_table,
             0,
-            bytemuck::cast_slice(&forward_table_texels(forward)),
+            bytemuck::cast_slice(&forward_table_texels(&tables.forward)),
         );
         ctx.queue.write_buffer(
             &self.dual_tables,
             0,
-            bytemuck::cast_slice(&dual_tables_texels(dual)),
+            bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
+        if !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal) {
+            ctx.queue
+                .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.as_bytes());
+            self.azimuthal = tables.azimuthal.clone();
+        }
         self.tables_for = *params;
         if self.settings.multiple_scattering {
             self.mark_shadow_grid_dirty();
@@ -710,6 +756,7 @@ impl Renderer {
             luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
             shadow_values: &self.shadow_grid.values,
             dual_tables: &self.dual_tables,
+            azimuthal_table: &self.azimuthal_table,
         }
     }
 
@@ -786,6 +833,36 @@ impl Renderer {
         }
         ctx.queue.submit([enc.finish()]);
         self.refinement.complete_frame();
+    }
+
+    /// Rebuilds the whole shadow grid alone and waits for it: wall-clock seconds (benchmarks). On lavapipe
+    /// a compute pass's timestamps bracket the dispatch's submission to its thread pool, not its work, so
+    /// a pass that no later barrier waits for inside its own bracket (the grid) reads ~0 ms there.
+    pub fn time_shadow_grid(&mut self, ctx: &GpuContext) -> Result<f64, RenderError> {
+        if !self.settings.shadows || self.light_count == 0 {
+            return Ok(0.0);
+        }
+        let t = std::time::Instant::now();
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("shadow grid alone"),
+            });
+        let inputs = self.shadow_grid_inputs();
+        self.shadow_grid_pass.encode(
+            &ctx.device,
+            &mut enc,
+            &inputs,
+            &self.shadow_grid,
+            0,
+            self.shadow_grid.entry_count(),
+            None,
+        );
+        ctx.queue.submit([enc.finish()]);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        Ok(t.elapsed().as_secs_f64())
     }
 
     /// GPU milliseconds per pass of the last frame (None without timestamp queries).

@@ -7,6 +7,7 @@ use super::frame::Frame;
 use crate::envmap::SrbfLight;
 use crate::envmap::srbf::srbf_integral;
 use crate::hair::Hair;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
     dual_scattering_components, global_response_lobe, local_response,
 };
@@ -97,8 +98,10 @@ pub type GridShadows<'a> = (&'a ShadowGrid, &'a GridSources<'a>);
 /// `shade_point` of the WGSL: lights' R, TT, TRT radiance towards omega_o, each light scaled by its
 /// transmittance read from the shadow grid when shadows are given; with `dual` (the dual-scattering
 /// tables), also MS.global and MS.local.
+#[allow(clippy::too_many_arguments)]
 pub fn shade_point(
     luts: &Luts,
+    table: &AzimuthalTable,
     params: &FastHairParams,
     sp: &ShadingPoint,
     omega_o: Vec3,
@@ -125,7 +128,7 @@ pub fn shade_point(
             |(grid, src)| grid.shadow(src, sp.position, dir, lambda),
         );
         let light = SrbfInFrame { theta, phi, lambda };
-        let m = srbf_response(luts, &p, light, theta_o, phi_o);
+        let m = srbf_response(luts, table, &p, light, theta_o, phi_o);
         for t in 0..3 {
             for c in 0..3 {
                 out[t][c] += sh.transmittance * l.rgb[c] as f32 * m[t][c];
@@ -135,15 +138,25 @@ pub fn shade_point(
             continue;
         };
         let s2 = (sh.sigma_f2[0] + sh.sigma_f2[1] + sh.sigma_f2[2]) / 3.0;
-        let mut global = [0.0; 3];
-        for t in 0..3 {
-            let g = global_response_lobe(&p, t, light, theta_o, phi_o, s2);
-            for c in 0..3 {
-                global[c] += g[c];
-            }
+        // Only what Zinke's combination does not multiply by zero (as the WGSL): the forward-scattered
+        // part where T_f exceeds the direct fraction, the direct part where light arrives directly.
+        let (mut global, mut local, mut local_direct) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        if sh.transmittance > 0.0 {
+            local_direct = local_response(&p, tables, light, theta_o, phi_o, 0.0, sh.depth_behind);
         }
-        let local = local_response(&p, tables, light, theta_o, phi_o, s2, sh.depth_behind);
-        let local_direct = local_response(&p, tables, light, theta_o, phi_o, 0.0, sh.depth_behind);
+        if sh.transmittance_f.iter().any(|&t| t > sh.transmittance) {
+            for t in 0..3 {
+                let g = global_response_lobe(table, &p, t, light, theta_o, phi_o, s2);
+                for c in 0..3 {
+                    global[c] += g[c];
+                }
+            }
+            local = if s2 == 0.0 && sh.transmittance > 0.0 {
+                local_direct
+            } else {
+                local_response(&p, tables, light, theta_o, phi_o, s2, sh.depth_behind)
+            };
+        }
         let (ms_global, ms_local) = dual_scattering_components(
             &p,
             sh.transmittance,

@@ -54,6 +54,7 @@ pub struct ShadingInputs<'a> {
     pub luts: [&'a wgpu::Buffer; 3],
     pub shadow_values: &'a wgpu::Buffer,
     pub dual_tables: &'a wgpu::Buffer,
+    pub azimuthal_table: &'a wgpu::Buffer,
 }
 
 pub struct ShadingPass {
@@ -136,12 +137,16 @@ impl ShadingPass {
             binding: buffers.len() as u32,
             resource: wgpu::BindingResource::TextureView(&targets.visibility),
         };
+        let azimuthal = wgpu::BindGroupEntry {
+            binding: buffers.len() as u32 + 1,
+            resource: inputs.azimuthal_table.as_entire_binding(),
+        };
         bind_buffers(
             device,
             &self.pipeline,
             "shading",
             &buffers,
-            vec![visibility],
+            vec![visibility, azimuthal],
         )
     }
 

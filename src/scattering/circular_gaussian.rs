@@ -119,25 +119,44 @@ pub fn erf_approx_f64(x: f64) -> f64 {
 /// integral_a^b (c0 + c1 x) g(x; mu, lambda) dx in closed form, g(x; mu, lambda) = exp(-(x - mu)^2 / lambda^2):
 /// the piece of Xu's linear quadrature (Sec. 4.2.2) on one segment.
 pub fn gaussian_linear_integral(a: f32, b: f32, mu: f32, lambda: f32, c0: f32, c1: f32) -> f32 {
+    let [i0, i1] = gaussian_linear_moments(a, b, mu, lambda);
+    (c0 + c1 * mu) * i0 + c1 * i1
+}
+
+/// The moments (integral g, integral (x - mu) g) over [a, b] of [`gaussian_linear_integral`], computed once
+/// for the three channels of a segment.
+pub fn gaussian_linear_moments(a: f32, b: f32, mu: f32, lambda: f32) -> [f32; 2] {
     let (ua, ub) = ((a - mu) / lambda, (b - mu) / lambda);
     let sqrt_pi = PI.sqrt();
     // integral g = (sqrt(pi) lambda / 2) (erf(ub) - erf(ua));
     // integral (x - mu) g = (lambda^2 / 2) (e^-ua^2 - e^-ub^2).
-    let i0 = 0.5 * sqrt_pi * lambda * (erf_approx(ub) - erf_approx(ua));
-    let i1 = 0.5 * lambda * lambda * ((-ua * ua).exp() - (-ub * ub).exp());
-    (c0 + c1 * mu) * i0 + c1 * i1
+    [
+        0.5 * sqrt_pi * lambda * (erf_approx(ub) - erf_approx(ua)),
+        0.5 * lambda * lambda * ((-ua * ua).exp() - (-ub * ub).exp()),
+    ]
 }
 
 /// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx with y = x - mu, in closed form (the quadratic
 /// pieces of the quadrature). With u = y / lambda: integral e^(-u^2) = (sqrt(pi)/2)(erf ub - erf ua),
 /// integral u e^(-u^2) = (e^(-ua^2) - e^(-ub^2))/2, integral u^2 e^(-u^2) = (1/2) integral e^(-u^2) - [u e^(-u^2)/2].
 pub fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: [f32; 3]) -> f32 {
+    let m = gaussian_quadratic_moments(a, b, mu, lambda);
+    d[0] * m[0] + d[1] * m[1] + d[2] * m[2]
+}
+
+/// The moments integral y^k g dx (k = 0, 1, 2; y = x - mu) over [a, b] of [`gaussian_quadratic_integral`],
+/// computed once for the three channels of a segment pair.
+pub fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> [f32; 3] {
     let (ua, ub) = ((a - mu) / lambda, (b - mu) / lambda);
     let (ea, eb) = ((-ua * ua).exp(), (-ub * ub).exp());
     let m0 = 0.5 * PI.sqrt() * (erf_approx(ub) - erf_approx(ua));
     let m1 = 0.5 * (ea - eb);
     let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
-    lambda * (d[0] * m0 + d[1] * lambda * m1 + d[2] * lambda * lambda * m2)
+    [
+        lambda * m0,
+        lambda * lambda * m1,
+        lambda * lambda * lambda * m2,
+    ]
 }
 
 #[cfg(test)]

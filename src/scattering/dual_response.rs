@@ -9,13 +9,13 @@
 //! directional). Responses are per unit light power; the renderer multiplies by the SRBF's power
 //! pi lambda_j^2 (1 - e^(-4 / lambda_j^2)) and radiance.
 
+use super::azimuthal_table::AzimuthalTable;
 use super::dual_terms::{DualTables, HairBehind};
 use super::fast_azimuthal::Rgb32;
-use super::fast_exact_azimuthal::azimuthal_window_integral;
 use super::fast_params::FastHairParams;
 use super::fast_response::{LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature};
 use super::lut::wrap_angle_f32;
-use std::f32::consts::{FRAC_PI_2, PI, SQRT_2};
+use std::f32::consts::{PI, SQRT_2};
 
 /// Standard deviation of the forward-scattered light's longitudinal spread.
 pub fn forward_spread(sigma_f2: f32, lambda_j: f32) -> f32 {
@@ -23,10 +23,15 @@ pub fn forward_spread(sigma_f2: f32, lambda_j: f32) -> f32 {
 }
 
 /// calN_t^G(phi_o - phi_j, theta_d) = (1/pi) integral_{-pi/2}^{pi/2} N_t(theta_d, phi_o - phi_j - x) dx (Xu Eq. 28),
-/// from the exact N_t.
-pub fn inner_integral_global(p: &FastHairParams, lobe: u32, theta_d: f32, dphi: f32) -> Rgb32 {
-    azimuthal_window_integral(lobe, p.eta, p.sigma_a_rgb(), theta_d, dphi, 0.0, FRAC_PI_2)
-        .map(|v| v / PI)
+/// from the exact N_t, tabulated ([`AzimuthalTable::window_box`]).
+pub fn inner_integral_global(
+    table: &AzimuthalTable,
+    p: &FastHairParams,
+    lobe: u32,
+    theta_d: f32,
+    dphi: f32,
+) -> Rgb32 {
+    table.window_box(lobe, p.sigma_a_rgb(), theta_d, dphi)
 }
 
 /// M_t^G per unit light power (Xu Eq. 27): (1/cos theta_j) integral g^u(theta_i; theta_j, sigma) M_t(theta_h)
@@ -34,6 +39,7 @@ pub fn inner_integral_global(p: &FastHairParams, lobe: u32, theta_d: f32, dphi: 
 /// normalised ([`LongitudinalLobe::factor`]), by the quadrature of Sec. 4.2.2 against the product of the two
 /// Gaussians.
 pub fn global_response_lobe(
+    table: &AzimuthalTable,
     p: &FastHairParams,
     lobe: u32,
     light: SrbfInFrame,
@@ -60,7 +66,7 @@ pub fn global_response_lobe(
     linear_quadrature(p.quadrature_segments, mu, l, |ti| {
         let theta_d = 0.5 * (theta_o - ti);
         let w = longitudinal.factor(ti);
-        inner_integral_global(p, lobe, theta_d, dphi).map(|n| w * n)
+        inner_integral_global(table, p, lobe, theta_d, dphi).map(|n| w * n)
     })
     .map(|v| (c * v).max(0.0))
 }

@@ -15,8 +15,7 @@
 
 use super::circular_gaussian::asin_precise;
 use super::fast_azimuthal::{
-    LobeFit, Rgb32, attenuation_exact, bravais_eta_prime, fresnel_schlick, inner_integral_lobes,
-    sigma_a_prime, smoothstep,
+    Rgb32, attenuation_exact, bravais_eta_prime, fresnel_schlick, sigma_a_prime,
 };
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
@@ -81,7 +80,7 @@ pub fn invert_exit_azimuth(p: u32, eta_p: f32, a: f32, b: f32, target: f32) -> f
 }
 
 /// A_p(h)/2 with Xu's Schlick Fresnel and exact absorption: R F, TT (1-F)^2 T, TRT (1-F)^2 F T^2.
-fn half_attenuation(p: u32, eta: f32, cos_d: f32, eta_p: f32, sigma_p: Rgb32, h: f32) -> Rgb32 {
+pub fn half_attenuation(p: u32, eta: f32, cos_d: f32, eta_p: f32, sigma_p: Rgb32, h: f32) -> Rgb32 {
     let f = fresnel_schlick(eta, cos_d, h);
     std::array::from_fn(|c| {
         let t = attenuation_exact(sigma_p[c], eta_p, h);
@@ -130,6 +129,27 @@ pub fn azimuthal_window_integral(
     let eta_p = bravais_eta_prime(eta, theta_d);
     let cos_d = theta_d.cos();
     let sigma_p: Rgb32 = std::array::from_fn(|c| sigma_a_prime(sigma_a[c], eta, theta_d));
+    let mut out = [0.0; 3];
+    for_each_window_node(p, eta_p, dphi, kappa, half_width, |t, weight| {
+        let a_half = half_attenuation(p, eta, cos_d, eta_p, sigma_p, t.sin());
+        for ch in 0..3 {
+            out[ch] += weight * a_half[ch];
+        }
+    });
+    out
+}
+
+/// The quadrature of [`azimuthal_window_integral`] without the attenuation: calls `node(t, weight)` for every
+/// Gauss-Legendre node t (h = sin t) with weight = panel weight x k(dphi - Phi(t)) x cos t, so that
+/// sum weight A_p(sin t) / 2 is the window integral.
+pub fn for_each_window_node(
+    p: u32,
+    eta_p: f32,
+    dphi: f32,
+    kappa: f32,
+    half_width: f32,
+    mut node: impl FnMut(f32, f32),
+) {
     let w = half_width.min(PI);
     // Monotone pieces of Phi in t.
     let mut ends = [-FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, FRAC_PI_2];
@@ -139,11 +159,12 @@ pub fn azimuthal_window_integral(
         ends = [-FRAC_PI_2, -tc, tc, FRAC_PI_2];
         pieces = 3;
     }
-    let mut out = [0.0; 3];
     for k in 0..pieces {
         let (a, b) = (ends[k], ends[k + 1]);
         let (pa, pb) = (exit_azimuth(p, a, eta_p), exit_azimuth(p, b, eta_p));
         let (lo, hi) = (pa.min(pb), pa.max(pb));
+        // The ends of the piece at its lowest and highest exit azimuth.
+        let (t_lo, t_hi) = if pa <= pb { (a, b) } else { (b, a) };
         // Every 2 pi branch of the window [dphi - w, dphi + w] that meets [lo, hi].
         let m0 = ((lo - (dphi + w)) / TAU).ceil() as i32;
         let m1 = ((hi - (dphi - w)) / TAU).floor() as i32;
@@ -153,8 +174,17 @@ pub fn azimuthal_window_integral(
             if wh <= wl {
                 continue;
             }
-            let ta = invert_exit_azimuth(p, eta_p, a, b, wl);
-            let tb = invert_exit_azimuth(p, eta_p, a, b, wh);
+            // A window end clipped to the piece's range is the piece's end: no root to find.
+            let ta = if wl == lo {
+                t_lo
+            } else {
+                invert_exit_azimuth(p, eta_p, a, b, wl)
+            };
+            let tb = if wh == hi {
+                t_hi
+            } else {
+                invert_exit_azimuth(p, eta_p, a, b, wh)
+            };
             let (t0, t1) = (ta.min(tb), ta.max(tb));
             let half = 0.5 * (t1 - t0) / PANELS as f32;
             for panel in 0..PANELS {
@@ -168,42 +198,9 @@ pub fn azimuthal_window_integral(
                     } else {
                         1.0
                     };
-                    let a_half = half_attenuation(p, eta, cos_d, eta_p, sigma_p, t.sin());
-                    let jac = half * wt * g * t.cos();
-                    for ch in 0..3 {
-                        out[ch] += jac * a_half[ch];
-                    }
+                    node(t, half * wt * g * t.cos());
                 }
             }
         }
     }
-    out
-}
-
-/// calN_TT or calN_TRT: the exact integral under narrow lights, the circular-Gaussian fit (Xu Eq. 16, 20)
-/// under wide ones, blended by a smoothstep in lambda' over [0.7, 1.4]. `fit` builds the fit on demand.
-pub fn inner_integral_blended(
-    p: u32,
-    eta: f32,
-    sigma_a: Rgb32,
-    theta_d: f32,
-    lambda_prime: f32,
-    dphi: f32,
-    fit: impl FnOnce() -> LobeFit,
-) -> Rgb32 {
-    let t = smoothstep(EXACT_BLEND_LO, EXACT_BLEND_HI, lambda_prime);
-    let mut out = [0.0; 3];
-    if t > 0.0 {
-        let g = inner_integral_lobes(&fit(), lambda_prime, dphi);
-        for c in 0..3 {
-            out[c] += t * g[c];
-        }
-    }
-    if t < 1.0 {
-        let e = inner_integral_exact(p, eta, sigma_a, theta_d, lambda_prime, dphi);
-        for c in 0..3 {
-            out[c] += (1.0 - t) * e[c];
-        }
-    }
-    out
 }

@@ -17,11 +17,11 @@
 //! paper's rule (mu - lambda, mu, mu + lambda); clipping keeps every sample useful and lets a large m
 //! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
 
+use super::azimuthal_table::{AzimuthalTable, inner_integral_blended};
 use super::circular_gaussian::{
-    bessel_i0_scaled, gaussian_linear_integral, gaussian_quadratic_integral,
+    bessel_i0_scaled, gaussian_linear_moments, gaussian_quadratic_moments,
 };
 use super::fast_azimuthal::{LobeFit, Rgb32, eta_star_mean, inner_integral_r, trt_lobes, tt_lobe};
-use super::fast_exact_azimuthal::inner_integral_blended;
 use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -87,13 +87,14 @@ pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) ->
             let x2 = quadrature_sample(s + 1, m, mu, lambda);
             let f2 = f(x2);
             if x2 > x0 && x1 > x0 && x2 > x1 {
+                let m = gaussian_quadratic_moments(x0, x2, mu, lambda);
                 for c in 0..3 {
                     // Newton form in y = x - mu: p = f0 + q1 (x - x0) + q2 (x - x0)(x - x1).
                     let q1 = (f1[c] - f0[c]) / (x1 - x0);
                     let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
                     let (y0, y1) = (x0 - mu, x1 - mu);
                     let d = [f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2];
-                    out[c] += gaussian_quadratic_integral(x0, x2, mu, lambda, d);
+                    out[c] += d[0] * m[0] + d[1] * m[1] + d[2] * m[2];
                 }
             } else if x2 > x0 {
                 add_linear(&mut out, x0, x2, f0, f2, mu, lambda);
@@ -115,11 +116,12 @@ fn add_linear(out: &mut Rgb32, x0: f32, x1: f32, f0: Rgb32, f1: Rgb32, mu: f32, 
     if x1 <= x0 {
         return;
     }
+    let [i0, i1] = gaussian_linear_moments(x0, x1, mu, lambda);
     for c in 0..3 {
         // f ~ c0 + c1 x on [x0, x1].
         let c1 = (f1[c] - f0[c]) / (x1 - x0);
         let c0 = f0[c] - c1 * x0;
-        out[c] += gaussian_linear_integral(x0, x1, mu, lambda, c0, c1);
+        out[c] += (c0 + c1 * mu) * i0 + c1 * i1;
     }
 }
 
@@ -251,6 +253,7 @@ pub fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f
 #[allow(clippy::too_many_arguments)]
 pub fn outer_integrand(
     luts: &Luts,
+    table: &AzimuthalTable,
     p: &FastHairParams,
     lobe: u32,
     light: SrbfInFrame,
@@ -262,6 +265,10 @@ pub fn outer_integrand(
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
     let w = longitudinal.factor(theta_i);
+    // The quadrature's end nodes sit at the poles, where cos(theta_i) (and so w) vanishes.
+    if w == 0.0 {
+        return [0.0; 3];
+    }
     let dphi = phi_o - light.phi;
     if lobe == 0 {
         let n = inner_integral_r(luts, p.eta, theta_d, lp, dphi);
@@ -269,13 +276,13 @@ pub fn outer_integrand(
     }
     let sigma = p.sigma_a_rgb();
     if lobe == 1 {
-        return inner_integral_blended(1, p.eta, sigma, theta_d, lp, dphi, || {
+        return inner_integral_blended(table, 1, p.eta, sigma, theta_d, lp, dphi, || {
             azimuthal_fit(luts, p, 1, theta_d, lp, 0.0)
         })
         .map(|n| w * n);
     }
     let eta = eta_star_mean(luts, p.eta, p.eccentricity, lp, light.phi + phi_o);
-    inner_integral_blended(2, eta, sigma, theta_d, lp, dphi, || {
+    inner_integral_blended(table, 2, eta, sigma, theta_d, lp, dphi, || {
         trt_lobes(luts, eta, sigma, theta_d, p.caustic_width, p.caustic_fade)
     })
     .map(|n| w * n)
@@ -365,6 +372,7 @@ pub fn longitudinal_weight(
 /// Gaussian (1 at the peak, smooth around it) joins the interpolated factor.
 pub fn srbf_response_lobe(
     luts: &Luts,
+    table: &AzimuthalTable,
     p: &FastHairParams,
     lobe: u32,
     light: SrbfInFrame,
@@ -383,7 +391,18 @@ pub fn srbf_response_lobe(
     linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
         let d = (ti - w.peak) / w.lambda;
         let ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0).exp();
-        outer_integrand(luts, p, lobe, light, theta_o, phi_o, &longitudinal, ti).map(|v| ratio * v)
+        outer_integrand(
+            luts,
+            table,
+            p,
+            lobe,
+            light,
+            theta_o,
+            phi_o,
+            &longitudinal,
+            ti,
+        )
+        .map(|v| ratio * v)
     })
     // The parabolas may dip below zero where f vanishes; the response cannot.
     .map(|v| (scale * v).max(0.0))
@@ -392,10 +411,11 @@ pub fn srbf_response_lobe(
 /// M_R, M_TT, M_TRT (RGB each).
 pub fn srbf_response(
     luts: &Luts,
+    table: &AzimuthalTable,
     p: &FastHairParams,
     light: SrbfInFrame,
     theta_o: f32,
     phi_o: f32,
 ) -> [Rgb32; 3] {
-    std::array::from_fn(|t| srbf_response_lobe(luts, p, t as u32, light, theta_o, phi_o))
+    std::array::from_fn(|t| srbf_response_lobe(luts, table, p, t as u32, light, theta_o, phi_o))
 }

@@ -1,5 +1,6 @@
 //! Hair scattering maths: the exact Marschner model (reference) and, later, the fast forms.
 
+pub mod azimuthal_table;
 pub mod circular_gaussian;
 pub mod dual_response;
 pub mod dual_terms;

@@ -1,0 +1,473 @@
+//! The exact azimuthal window integrals as a table: calN_TT, calN_TRT under narrow lights (Xu Eq. 12) and
+//! calN_t^G of the forward-scattered light (Eq. 28), looked up instead of integrated per shading point.
+//!
+//! What is tabulated: for lobe p the window integral is
+//!   calN_p = integral k(dphi - Phi(t)) cos t G_p(t) exp(-s x(t)) dt,
+//! G_p = A_p / 2 without absorption ((1 - F)^2 F^(p-1) / 2; F / 2 for R), x = cos gamma_t = sqrt(1 - h^2 / eta'^2)
+//! the chord length per unit diameter, s = 2 p sigma_a' (T = exp(-2 sigma_a' x), T^2 for TRT). Everything but
+//! exp(-s x) depends only on (eta, theta_d, lambda', dphi), so each cell stores the measure
+//! mu(x) = k cos t G_p dt as a two-node Gauss rule (weights w_1, w_2 and nodes x_1 <= x_2 that integrate
+//! 1, x, x^2, x^3 exactly against mu), and the runtime sum w_1 e^(-s x_1) + w_2 e^(-s x_2) gives calN_p for
+//! any absorption, per channel and per point (painted dye needs no rebuild). The error is that of a
+//! two-point rule for e^(-s x) over the spread of x inside one window (small: x lies in
+//! [sqrt(1 - 1/eta'^2), 1] and narrow windows see a narrow part of it) plus the interpolation between cells;
+//! `tests/azimuthal_table.rs` measures both against the integral.
+//!
+//! Axes (the integrals are even in theta_d and in dphi): |theta_d| in [0, THETA_D_MAX] uniform,
+//! lambda' in [LAMBDA_MIN, LAMBDA_MAX] uniform in ln lambda', |dphi| in [0, pi] uniform (TT, box windows)
+//! or aligned with the TRT caustic and support edge ([`trt_dphi`]: they move with eta', and cells
+//! interpolated across theta_d or eta*-bar at the same dphi put two half caustics where there is one), and for
+//! TRT under eccentricity the averaged index eta*-bar (Xu Eq. 26) uniform over [eta_2*, eta_1*]. Gaussian windows are
+//! stored divided by the window's own integral 2 pi e^-kappa I0(kappa) so cells vary slowly in lambda'.
+//! Cells hold (w_1, w_1 x_1, w_2, w_2 x_2): interpolated linearly, a corner with no weight does not pull
+//! the nodes. Built on the CPU in f64 moments of the f32 quadrature of [`for_each_window_node`], with rayon;
+//! rebuilt when eta or the eccentricity change (nothing else reaches it). The WGSL twin
+//! (`shaders/azimuthal_table.wgsl`) reads the same buffer of vec4.
+
+use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
+use super::fast_azimuthal::{
+    LobeFit, Rgb32, bravais_eta_prime, fresnel_schlick, inner_integral_lobes, sigma_a_prime,
+    smoothstep,
+};
+use super::fast_exact_azimuthal::{EXACT_BLEND_HI, EXACT_BLEND_LO, for_each_window_node};
+use super::fast_params::FastHairParams;
+use rayon::prelude::*;
+use std::f32::consts::{FRAC_PI_2, PI, TAU};
+
+/// Samples of |theta_d| over [0, THETA_D_MAX].
+pub const TABLE_THETA_D: usize = 32;
+pub const THETA_D_MAX: f32 = 1.5;
+/// Samples of lambda', log-spaced over [LAMBDA_MIN, LAMBDA_MAX] (the exact integrals are used below
+/// [`EXACT_BLEND_HI`]; the circular-Gaussian fits above it).
+pub const TABLE_LAMBDA: usize = 40;
+pub const LAMBDA_MIN: f32 = 0.005;
+pub const LAMBDA_MAX: f32 = EXACT_BLEND_HI;
+/// Samples of |dphi| over [0, pi], both ends included.
+pub const TABLE_DPHI: usize = 256;
+/// Samples of eta*-bar for TRT when the fiber is elliptical (1 when it is round).
+pub const TABLE_ETA_ECCENTRIC: usize = 6;
+/// Half-width of the Gaussian window in units of lambda' (as the exact integral).
+const WINDOW: f32 = 3.5;
+
+/// One table for one (eta, eccentricity). Layout of `cells` (vec4 each): [0] header (eta_lo, eta_hi,
+/// eta samples, eta); then TT windows [theta_d][lambda][dphi]; TRT windows [eta][theta_d][lambda][dphi];
+/// box windows of R, TT, TRT [lobe][theta_d][dphi].
+#[derive(Clone, Debug, PartialEq)]
+pub struct AzimuthalTable {
+    pub eta: f32,
+    pub eccentricity: f32,
+    pub cells: Vec<[f32; 4]>,
+}
+
+/// Where the TRT windows start (in cells).
+pub fn trt_base() -> usize {
+    1 + TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI
+}
+
+/// Where the box windows start for `eta_samples` TRT index samples.
+pub fn box_base(eta_samples: usize) -> usize {
+    trt_base() + eta_samples * TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI
+}
+
+/// The range of eta*-bar (Xu Eq. 24-26) for index eta and eccentricity a: (eta_2*, eta_1*) ordered.
+pub fn eta_star_range(eta: f32, a: f32) -> (f32, f32) {
+    if a == 1.0 {
+        return (eta, eta);
+    }
+    let eta1 = 2.0 * (eta - 1.0) * a * a - eta + 2.0;
+    let eta2 = 2.0 * (eta - 1.0) / (a * a) - eta + 2.0;
+    (eta1.min(eta2), eta1.max(eta2))
+}
+
+fn axis_theta_d(i: usize) -> f32 {
+    THETA_D_MAX * i as f32 / (TABLE_THETA_D - 1) as f32
+}
+
+fn axis_lambda(i: usize) -> f32 {
+    let (a, b) = (LAMBDA_MIN.ln(), LAMBDA_MAX.ln());
+    (a + (b - a) * i as f32 / (TABLE_LAMBDA - 1) as f32).exp()
+}
+
+fn axis_dphi(i: usize) -> f32 {
+    PI * i as f32 / (TABLE_DPHI - 1) as f32
+}
+
+/// The two azimuths where N_TRT changes abruptly for index eta', ordered: the caustic |phi_c| =
+/// |Phi(2, h_c)| (h_c = sqrt((4 - eta'^2) / 3); 0 when eta' >= 2, no caustic) and the edge of the support
+/// |Phi(2, 1)| = |4 asin(1 / eta') - pi| (both wrapped into [0, pi]).
+pub fn trt_knots(eta_p: f32) -> [f32; 2] {
+    let mut caustic = 0.0;
+    if eta_p < 2.0 {
+        let hc = ((4.0 - eta_p * eta_p) / 3.0).max(0.0).sqrt().min(1.0);
+        caustic = (4.0 * asin_precise(hc / eta_p) - 2.0 * asin_precise(hc)).abs();
+    }
+    let edge = (4.0 * asin_precise((1.0 / eta_p).min(1.0)) - PI).abs();
+    [caustic.min(edge), caustic.max(edge)]
+}
+
+/// The TRT cells' azimuth axis, aligned with the caustic and the support's edge so that cells at
+/// different theta_d and eta*-bar interpolate caustic with caustic: u in [0, 1/3] spans [0, k_1] and
+/// [1/3, 2/3] spans [k_1, k_2] linearly, [2/3, 1] spans [k_2, pi] quadratically (fine just past the
+/// edge, where narrow lights' smoothed features end).
+pub fn trt_dphi(u: f32, knots: [f32; 2]) -> f32 {
+    let [k1, k2] = knots;
+    if u <= 1.0 / 3.0 {
+        return 3.0 * u * k1;
+    }
+    if u <= 2.0 / 3.0 {
+        return k1 + (k2 - k1) * (3.0 * u - 1.0);
+    }
+    let v = 3.0 * u - 2.0;
+    k2 + (PI - k2) * v * v
+}
+
+/// The inverse of [`trt_dphi`] for |dphi| in [0, pi].
+pub fn trt_u(dphi: f32, knots: [f32; 2]) -> f32 {
+    let [k1, k2] = knots;
+    if dphi <= k1 {
+        return if k1 > 0.0 {
+            dphi / (3.0 * k1)
+        } else {
+            1.0 / 3.0
+        };
+    }
+    if dphi <= k2 {
+        return if k2 > k1 {
+            (1.0 + (dphi - k1) / (k2 - k1)) / 3.0
+        } else {
+            2.0 / 3.0
+        };
+    }
+    (2.0 + ((dphi - k2) / (PI - k2)).max(0.0).sqrt()) / 3.0
+}
+
+fn axis_eta(lo: f32, hi: f32, samples: usize, i: usize) -> f32 {
+    if samples <= 1 {
+        return lo;
+    }
+    lo + (hi - lo) * i as f32 / (samples - 1) as f32
+}
+
+/// The integral of the Gaussian window over a period, 2 pi e^-kappa I0(kappa), kappa = 2 / lambda'^2.
+pub fn window_energy(lambda_prime: f32) -> f32 {
+    TAU * bessel_i0_scaled(2.0 / (lambda_prime * lambda_prime))
+}
+
+/// The two-node Gauss rule of the window's measure in x (a cell): (w_1, w_1 x_1, w_2, w_2 x_2).
+/// `kappa` = 0 is the box window of half-width `half_width`.
+pub fn window_rule(
+    p: u32,
+    eta: f32,
+    theta_d: f32,
+    dphi: f32,
+    kappa: f32,
+    half_width: f32,
+) -> [f32; 4] {
+    let eta_p = bravais_eta_prime(eta, theta_d);
+    let cos_d = theta_d.cos();
+    let inv_eta_p2 = 1.0 / (eta_p as f64 * eta_p as f64);
+    // Moments of y = 1 - x about the first node's y (shifted: narrow windows see y within 1e-4).
+    let mut shift: Option<f64> = None;
+    let mut m = [0.0f64; 4];
+    for_each_window_node(p, eta_p, dphi, kappa, half_width, |t, weight| {
+        let h = t.sin();
+        let f = fresnel_schlick(eta, cos_d, h);
+        let g = match p {
+            0 => 0.5 * f,
+            1 => 0.5 * (1.0 - f) * (1.0 - f),
+            _ => 0.5 * (1.0 - f) * (1.0 - f) * f,
+        };
+        let h = h as f64;
+        let y = 1.0 - (1.0 - h * h * inv_eta_p2).max(0.0).sqrt();
+        let y0 = *shift.get_or_insert(y);
+        let z = y - y0;
+        let wgt = weight as f64 * g as f64;
+        m[0] += wgt;
+        m[1] += wgt * z;
+        m[2] += wgt * z * z;
+        m[3] += wgt * z * z * z;
+    });
+    gauss_rule_2(m, shift.unwrap_or(0.0))
+}
+
+/// The two-point Gauss rule of a positive measure from its moments m_k = integral z^k (k = 0..3) about
+/// y0 (y = y0 + z, x = 1 - y), as (w_1, w_1 x_1, w_2, w_2 x_2) with x_1 <= x_2. One node when the
+/// measure is (numerically) a point.
+pub fn gauss_rule_2(m: [f64; 4], y0: f64) -> [f32; 4] {
+    if m[0] <= 0.0 {
+        return [0.0; 4];
+    }
+    let mean = m[1] / m[0];
+    let c2 = (m[2] / m[0] - mean * mean).max(0.0);
+    let c3 = m[3] / m[0] - 3.0 * mean * m[2] / m[0] + 2.0 * mean * mean * mean;
+    let x_mean = 1.0 - (y0 + mean);
+    if c2 < 1e-14 {
+        return [m[0] as f32, (m[0] * x_mean) as f32, 0.0, 0.0];
+    }
+    // Orthogonal polynomial z^2 - r z - c2 (z about the mean), r = c3 / c2; its roots are the nodes.
+    let r = c3 / c2;
+    let root = (r * r + 4.0 * c2).sqrt();
+    let (z_hi, z_lo) = (0.5 * (r + root), 0.5 * (r - root));
+    let w_hi = -z_lo / (z_hi - z_lo);
+    let w_lo = z_hi / (z_hi - z_lo);
+    // z_hi is the larger y, the smaller x: node 1.
+    let (x1, x2) = (x_mean - z_hi, x_mean - z_lo);
+    let (w1, w2) = (m[0] * w_hi, m[0] * w_lo);
+    [w1 as f32, (w1 * x1) as f32, w2 as f32, (w2 * x2) as f32]
+}
+
+impl AzimuthalTable {
+    /// Cells of the largest table (an elliptical fiber's); GPU buffers are made this size once.
+    pub const MAX_CELLS: usize = 1
+        + (1 + TABLE_ETA_ECCENTRIC) * TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI
+        + 3 * TABLE_THETA_D * TABLE_DPHI;
+    pub const MAX_BYTES: u64 = (Self::MAX_CELLS * 16) as u64;
+
+    /// Builds the table for the fiber's eta and eccentricity (about 0.3 s on two cores for a round fiber).
+    pub fn build(eta: f32, eccentricity: f32) -> Self {
+        let (eta_lo, eta_hi) = eta_star_range(eta, eccentricity);
+        let eta_samples = if eta_lo == eta_hi {
+            1
+        } else {
+            TABLE_ETA_ECCENTRIC
+        };
+        let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
+        let box_cells = 3 * TABLE_THETA_D * TABLE_DPHI;
+        let total = box_base(eta_samples) + box_cells;
+        // Cell index -> its rule; the header is cell 0.
+        let cell = |i: usize| -> [f32; 4] {
+            if i == 0 {
+                return [eta_lo, eta_hi, eta_samples as f32, eta];
+            }
+            let gaussian = |p: u32, eta: f32, j: usize| {
+                let (it, rest) = (
+                    j / (TABLE_LAMBDA * TABLE_DPHI),
+                    j % (TABLE_LAMBDA * TABLE_DPHI),
+                );
+                let (il, ip) = (rest / TABLE_DPHI, rest % TABLE_DPHI);
+                let lp = axis_lambda(il);
+                let kappa = 2.0 / (lp * lp);
+                let theta_d = axis_theta_d(it);
+                let dphi = if p == 2 {
+                    let u = ip as f32 / (TABLE_DPHI - 1) as f32;
+                    trt_dphi(u, trt_knots(bravais_eta_prime(eta, theta_d)))
+                } else {
+                    axis_dphi(ip)
+                };
+                let rule = window_rule(p, eta, theta_d, dphi, kappa, (WINDOW * lp).min(PI));
+                let e = window_energy(lp);
+                rule.map(|v| v / e)
+            };
+            if i < trt_base() {
+                return gaussian(1, eta, i - 1);
+            }
+            if i < box_base(eta_samples) {
+                let j = i - trt_base();
+                let ie = j / per_lobe;
+                return gaussian(2, axis_eta(eta_lo, eta_hi, eta_samples, ie), j % per_lobe);
+            }
+            let j = i - box_base(eta_samples);
+            let (lobe, rest) = (
+                j / (TABLE_THETA_D * TABLE_DPHI),
+                j % (TABLE_THETA_D * TABLE_DPHI),
+            );
+            let (it, ip) = (rest / TABLE_DPHI, rest % TABLE_DPHI);
+            window_rule(
+                lobe as u32,
+                eta,
+                axis_theta_d(it),
+                axis_dphi(ip),
+                0.0,
+                FRAC_PI_2,
+            )
+            .map(|v| v / PI)
+        };
+        let cells = (0..total).into_par_iter().map(cell).collect();
+        Self {
+            eta,
+            eccentricity,
+            cells,
+        }
+    }
+
+    /// The table for fast parameters `p` (its eta and eccentricity).
+    pub fn for_params(p: &FastHairParams) -> Self {
+        Self::build(p.eta, p.eccentricity)
+    }
+
+    /// Whether this table was built for `p` (and needs no rebuild).
+    pub fn matches(&self, p: &FastHairParams) -> bool {
+        self.eta == p.eta && self.eccentricity == p.eccentricity
+    }
+
+    /// The cells as bytes for the GPU (vec4<f32> each).
+    pub fn as_bytes(&self) -> &[u8] {
+        bytemuck::cast_slice(&self.cells)
+    }
+
+    /// calN_TT (p = 1) or calN_TRT (p = 2) under the Gaussian window of bandwidth lambda' (Xu Eq. 12), for
+    /// absorption sigma_a (per unit radius, RGB) and, for TRT, the averaged index eta*-bar.
+    pub fn window_gaussian(
+        &self,
+        p: u32,
+        eta_star: f32,
+        sigma_a: Rgb32,
+        theta_d: f32,
+        lambda_prime: f32,
+        dphi: f32,
+    ) -> Rgb32 {
+        azimuthal_table_gaussian(
+            &self.cells,
+            p,
+            eta_star,
+            sigma_a,
+            theta_d,
+            lambda_prime,
+            dphi,
+        )
+    }
+
+    /// calN_t^G (Xu Eq. 28): the box window of half-width pi/2 over pi, lobe p = 0, 1, 2.
+    pub fn window_box(&self, p: u32, sigma_a: Rgb32, theta_d: f32, dphi: f32) -> Rgb32 {
+        azimuthal_table_box(&self.cells, p, sigma_a, theta_d, dphi)
+    }
+}
+
+/// Linear position on a uniform axis of `n` samples: (index, weight of the next).
+fn axis_position(x: f32, n: usize) -> (usize, f32) {
+    let x = x.clamp(0.0, (n - 1) as f32);
+    let i = (x as usize).min(n - 2);
+    (i, x - i as f32)
+}
+
+/// |dphi| wrapped into [0, pi].
+fn folded_dphi(dphi: f32) -> f32 {
+    let d = dphi + PI;
+    let wrapped = d - TAU * (d / TAU).floor() - PI;
+    wrapped.abs().min(PI)
+}
+
+/// calN(s) of an interpolated cell: w_1 e^(-s x_1) + w_2 e^(-s x_2), per channel.
+fn rule_value(c: [f32; 4], s: Rgb32) -> Rgb32 {
+    let x1 = if c[0] > 0.0 { c[1] / c[0] } else { 1.0 };
+    let x2 = if c[2] > 0.0 { c[3] / c[2] } else { 1.0 };
+    s.map(|s| c[0].max(0.0) * (-s * x1).exp() + c[2].max(0.0) * (-s * x2).exp())
+}
+
+/// WGSL's mix.
+fn lerp4(a: [f32; 4], b: [f32; 4], w: f32) -> [f32; 4] {
+    std::array::from_fn(|k| a[k] * (1.0 - w) + b[k] * w)
+}
+
+/// s = 2 p sigma_a' per channel.
+fn absorption_exponent(p: u32, eta: f32, sigma_a: Rgb32, theta_d: f32) -> Rgb32 {
+    sigma_a.map(|s| 2.0 * p as f32 * sigma_a_prime(s, eta, theta_d))
+}
+
+/// [`AzimuthalTable::window_gaussian`] on the raw cells (the WGSL twin's form).
+pub fn azimuthal_table_gaussian(
+    cells: &[[f32; 4]],
+    p: u32,
+    eta_star: f32,
+    sigma_a: Rgb32,
+    theta_d: f32,
+    lambda_prime: f32,
+    dphi: f32,
+) -> Rgb32 {
+    let header = cells[0];
+    let eta_samples = header[2] as usize;
+    let (t, wt) = axis_position(
+        theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
+        TABLE_THETA_D,
+    );
+    let lp = lambda_prime.clamp(LAMBDA_MIN, LAMBDA_MAX);
+    let (a, b) = (LAMBDA_MIN.ln(), LAMBDA_MAX.ln());
+    let (l, wl) = axis_position(
+        (lp.ln() - a) / (b - a) * (TABLE_LAMBDA - 1) as f32,
+        TABLE_LAMBDA,
+    );
+    let mut u = folded_dphi(dphi) / PI;
+    let (mut base, mut e, mut we, mut eta) = (1usize, 0usize, 0.0f32, header[3]);
+    if p == 2 {
+        base = trt_base();
+        eta = eta_star;
+        u = trt_u(
+            folded_dphi(dphi),
+            trt_knots(bravais_eta_prime(eta_star, theta_d)),
+        );
+        if eta_samples > 1 {
+            let x = (eta_star - header[0]) / (header[1] - header[0]) * (eta_samples - 1) as f32;
+            (e, we) = axis_position(x, eta_samples);
+        }
+    }
+    let (f, wf) = axis_position(u * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
+    let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
+    let at = |ie: usize, it: usize, il: usize, ip: usize| -> [f32; 4] {
+        cells[base + ie * per_lobe + (it * TABLE_LAMBDA + il) * TABLE_DPHI + ip]
+    };
+    let bilerp = |ie: usize, it: usize| {
+        let lo = lerp4(at(ie, it, l, f), at(ie, it, l, f + 1), wf);
+        let hi = lerp4(at(ie, it, l + 1, f), at(ie, it, l + 1, f + 1), wf);
+        lerp4(lo, hi, wl)
+    };
+    let slab = |ie: usize| lerp4(bilerp(ie, t), bilerp(ie, t + 1), wt);
+    let mut c = slab(e);
+    if we > 0.0 {
+        c = lerp4(c, slab(e + 1), we);
+    }
+    let energy = window_energy(lambda_prime);
+    rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d)).map(|v| energy * v)
+}
+
+/// [`AzimuthalTable::window_box`] on the raw cells (the WGSL twin's form).
+pub fn azimuthal_table_box(
+    cells: &[[f32; 4]],
+    p: u32,
+    sigma_a: Rgb32,
+    theta_d: f32,
+    dphi: f32,
+) -> Rgb32 {
+    let header = cells[0];
+    let base = box_base(header[2] as usize) + p as usize * TABLE_THETA_D * TABLE_DPHI;
+    let (t, wt) = axis_position(
+        theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
+        TABLE_THETA_D,
+    );
+    let (f, wf) = axis_position(folded_dphi(dphi) / PI * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
+    let at = |it: usize, ip: usize| cells[base + it * TABLE_DPHI + ip];
+    let lo = lerp4(at(t, f), at(t, f + 1), wf);
+    let hi = lerp4(at(t + 1, f), at(t + 1, f + 1), wf);
+    let c = lerp4(lo, hi, wt);
+    rule_value(c, absorption_exponent(p, header[3], sigma_a, theta_d))
+}
+
+/// calN_TT (p = 1) or calN_TRT (p = 2): the tabulated exact integral under narrow lights, the
+/// circular-Gaussian fit (Xu Eq. 16, 20) under wide ones, blended by a smoothstep in lambda' over
+/// [EXACT_BLEND_LO, EXACT_BLEND_HI]. `eta` is eta*-bar for TRT. `fit` builds the fit on demand.
+#[allow(clippy::too_many_arguments)]
+pub fn inner_integral_blended(
+    table: &AzimuthalTable,
+    p: u32,
+    eta: f32,
+    sigma_a: Rgb32,
+    theta_d: f32,
+    lambda_prime: f32,
+    dphi: f32,
+    fit: impl FnOnce() -> LobeFit,
+) -> Rgb32 {
+    let t = smoothstep(EXACT_BLEND_LO, EXACT_BLEND_HI, lambda_prime);
+    let mut out = [0.0; 3];
+    if t > 0.0 {
+        let g = inner_integral_lobes(&fit(), lambda_prime, dphi);
+        for c in 0..3 {
+            out[c] += t * g[c];
+        }
+    }
+    if t < 1.0 {
+        let e = table.window_gaussian(p, eta, sigma_a, theta_d, lambda_prime, dphi);
+        for c in 0..3 {
+            out[c] += (1.0 - t) * e[c];
+        }
+    }
+    out
+}
