@@ -117,7 +117,8 @@ fn azimuthal_table_gaussian(p: u32, eta_star: f32, sigma_a: vec3<f32>, theta_d: 
     if (p == 2u) {
         base = table_trt_base();
         eta = eta_star;
-        u = trt_u(folded_dphi(dphi), trt_knots(bravais_eta_prime(eta_star, theta_d)));
+        // The knots of the cells read: theta_d beyond the axis reads the last cells.
+        u = trt_u(folded_dphi(dphi), trt_knots(bravais_eta_prime(eta_star, min(abs(theta_d), THETA_D_MAX))));
         if (eta_samples > 1u) {
             e = axis_position((eta_star - header.x) / (header.y - header.x) * f32(eta_samples - 1u), eta_samples);
         }

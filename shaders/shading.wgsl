@@ -6,7 +6,7 @@
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
 // the grid) to MS.global and MS.local.
-// Prepended: circular_gaussian, lut, fast_azimuthal, fast_exact_azimuthal, fast_response,
+// Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response,
 // dual_response, shadow_grid, camera.
 
 const FLAG_SHADOWS: u32 = 1u;

@@ -9,6 +9,7 @@ use std::time::Duration;
 use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::progressive::WorkUnit;
+use strandlight::render::renderer::build_tables;
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::Preset;
@@ -162,4 +163,26 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
         Some(WorkUnit::ShadowGrid { first: 0, .. })
     ));
     assert_eq!(d, 0.0);
+
+    // A new eta handed over without its tables (the editor builds them on a worker): until they arrive
+    // the frame keeps the azimuthal table's index, so it is the previous look's image exactly (no frame
+    // reads a table made for another eta); with the tables, the new look's.
+    let mut eta_params = params;
+    eta_params.eta = 1.62;
+    let eta_look = strandlight::render::HairLook::new(eta_params);
+    assert!(progressive.set_params_deferred(&ctx, &eta_look));
+    refine_all(&mut progressive, &ctx);
+    let c = progressive.read_frame(&ctx).expect("read");
+    assert_eq!(difference(&b, &c), 0.0, "eta waits for its azimuthal table");
+    let tables = build_tables(&eta_params, Some(progressive.azimuthal_table()));
+    assert!(progressive.set_tables(&ctx, &eta_params, &tables));
+    refine_all(&mut progressive, &ctx);
+    let c = progressive.read_frame(&ctx).expect("read");
+    whole.set_params(&ctx, &eta_look);
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let d = difference(&a, &c);
+    println!("eta 1.55 -> 1.62 with its tables: difference to render_frame {d:.1e}");
+    assert_eq!(d, 0.0);
+    assert!(difference(&b, &c) > 1e-3, "the new eta changed the image");
 }

@@ -90,8 +90,29 @@ pub struct Answer {
     pub relative_error: Option<Rgb>,
 }
 
+/// Azimuthal tables by (eta, eccentricity), built once each for a batch of queries.
+#[derive(Default)]
+struct Tables(std::sync::Mutex<Vec<std::sync::Arc<AzimuthalTable>>>);
+
+impl Tables {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<std::sync::Arc<AzimuthalTable>>> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn get(&self, fp: &FastHairParams) -> std::sync::Arc<AzimuthalTable> {
+        if let Some(t) = self.lock().iter().find(|t| t.matches(fp)) {
+            return t.clone();
+        }
+        // Built outside the lock (the build runs on rayon's threads); a duplicate build is harmless.
+        let t = std::sync::Arc::new(AzimuthalTable::for_params(fp));
+        self.lock().push(t.clone());
+        t
+    }
+}
+
 fn evaluate(
     luts: &Luts,
+    tables: &Tables,
     q: &Query,
     defaults: &ParamArgs,
     segments: u32,
@@ -127,7 +148,7 @@ fn evaluate(
         phi: q.phi_j.to_radians() as f32,
         lambda: q.lambda as f32,
     };
-    let table = AzimuthalTable::for_params(&fp);
+    let table = tables.get(&fp);
     let fast = srbf_response(
         luts,
         &table,
@@ -177,6 +198,7 @@ fn evaluate(
 
 pub fn run(args: SrbfResponseArgs) -> anyhow::Result<()> {
     let luts = Luts::default_tables();
+    let tables = Tables::default();
     if args.stdin {
         let queries: Vec<Query> = read_stdin_queries("srbf-response")?;
         use rayon::prelude::*;
@@ -184,8 +206,15 @@ pub fn run(args: SrbfResponseArgs) -> anyhow::Result<()> {
             .par_iter()
             .enumerate()
             .map(|(k, q)| {
-                evaluate(&luts, q, &args.params, args.segments, args.reference)
-                    .with_context(|| format!("query {k}"))
+                evaluate(
+                    &luts,
+                    &tables,
+                    q,
+                    &args.params,
+                    args.segments,
+                    args.reference,
+                )
+                .with_context(|| format!("query {k}"))
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
         println!("{}", serde_json::to_string_pretty(&answers)?);
@@ -198,7 +227,14 @@ pub fn run(args: SrbfResponseArgs) -> anyhow::Result<()> {
             phi_o: args.phi_o,
             params: ParamArgs::default(),
         };
-        let a = evaluate(&luts, &q, &args.params, args.segments, args.reference)?;
+        let a = evaluate(
+            &luts,
+            &tables,
+            &q,
+            &args.params,
+            args.segments,
+            args.reference,
+        )?;
         println!("{}", serde_json::to_string_pretty(&a)?);
     }
     Ok(())

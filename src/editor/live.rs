@@ -351,10 +351,16 @@ impl LiveScene {
         // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
         // terms read them). Right after a parameter change the refinement shades with the old grid at
         // once: hand the tables over once that first image is on screen, so the change shows in about
-        // one light batch's time and its multiple scattering follows, or at once when the grid is being
-        // rebuilt anyway (one rebuild, not two).
-        if self.held_tables.is_some()
-            && (self.first_image_in.is_some() || self.renderer.shadow_grid_stale())
+        // one light batch's time and its multiple scattering follows; at once when the grid is being
+        // rebuilt anyway (one rebuild, not two), when the refinement has nothing left to show, or when
+        // the azimuthal table is new (an eta or eccentricity change shows only with its table).
+        let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
+            self.first_image_in.is_some()
+                || self.renderer.shadow_grid_stale()
+                || self.progress.is_some_and(|p| p.converged)
+                || !Arc::ptr_eq(&t.azimuthal, self.renderer.azimuthal_table())
+        });
+        if hand_over
             && let Some((params, tables)) = self.held_tables.take()
             && self.renderer.set_tables(&self.ctx, &params, &tables)
         {

@@ -391,9 +391,11 @@ pub fn azimuthal_table_gaussian(
     if p == 2 {
         base = trt_base();
         eta = eta_star;
+        // The knots of the cells read: theta_d beyond the axis reads the last cells.
+        let cells_theta_d = theta_d.abs().min(THETA_D_MAX);
         u = trt_u(
             folded_dphi(dphi),
-            trt_knots(bravais_eta_prime(eta_star, theta_d)),
+            trt_knots(bravais_eta_prime(eta_star, cells_theta_d)),
         );
         if eta_samples > 1 {
             let x = (eta_star - header[0]) / (header[1] - header[0]) * (eta_samples - 1) as f32;

@@ -12,8 +12,8 @@
 //!   amplitudes are then set from the energy, so each fitted lobe carries exactly the Taylor energy.
 //! - The caustic width w_c is Marschner's standard deviation; its circular Gaussians use bandwidth
 //!   sqrt(2) w_c.
-//! - Under narrow lights calN_TT and calN_TRT integrate the exact N_p instead of the fits
-//!   ([`super::fast_exact_azimuthal`]).
+//! - Under narrow lights calN_TT and calN_TRT are the exact integrals of N_p instead of the fits
+//!   ([`super::fast_exact_azimuthal`], read from [`super::azimuthal_table`]).
 //! - T and T^2 in the energies (Eq. 19, 23) are interpolated at Chebyshev nodes of h^2 instead of
 //!   Taylor-expanded at h = 0 (same even quartic form, same tables; [`attenuation_polynomial`]).
 //! - N_TRT(0) for b_2 (Eq. 21) is the full root sum: for sqrt(2) < eta' < 2 phi(2, h) = 0 has the roots

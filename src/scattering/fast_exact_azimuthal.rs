@@ -11,7 +11,8 @@
 //! (split at the TRT caustic). No singularity remains (the caustic is where dPhi/dt = 0). On each piece
 //! only the t-interval whose exit azimuth lies within 3.5 lambda' of dphi (mod 2 pi) matters; its ends
 //! are found by safeguarded Newton and it is integrated by 8-point Gauss-Legendre on two panels.
-//! f32, as the WGSL twin.
+//! f32. The renderer does not solve these per point: [`super::azimuthal_table`] tabulates them (built
+//! from [`for_each_window_node`]) and the WGSL reads that table.
 
 use super::circular_gaussian::asin_precise;
 use super::fast_azimuthal::{
