@@ -66,6 +66,12 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
+    /// Points shaded per frame (each pixel's distinct hair segments among its visibility samples).
+    shaded_points: usize,
+    /// The shading pass's median GPU time per light per shaded point, microseconds (all threads of
+    /// the GPU: compare with `bench-fast`'s one-thread CPU figure only as a ratio).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shading_us_per_light_per_point: Option<f64>,
     /// The whole shadow grid rebuilt alone and waited for (wall clock, once): lavapipe's timestamps
     /// bracket a compute dispatch's submission, not its work, so `gpu_ms_median.shadow_grid` reads ~0
     /// there after the first frame.
@@ -180,6 +186,22 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 per_pass.entry(name).or_default().push(ms);
             }
         }
+        // The points the shading pass shades: each pixel's distinct segments among its samples.
+        let frame = renderer.read_frame(&ctx)?;
+        let samples = (frame.samples as usize).min(4);
+        let shaded_points: usize = frame
+            .sample_ids
+            .iter()
+            .map(|ids| {
+                let ids = &ids[..samples];
+                (0..samples)
+                    .filter(|&k| ids[k] != 0 && !ids[..k].contains(&ids[k]))
+                    .count()
+            })
+            .sum();
+        let shading_us_per_light_per_point = per_pass
+            .get("shading")
+            .map(|v| median(v.clone()) * 1e3 / (lights.len() * shaded_points).max(1) as f64);
         let shadow_grid_wall_ms = if args.no_shadows {
             None
         } else {
@@ -243,6 +265,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             gpu_ms_total_min: totals.iter().copied().fold(f64::INFINITY, f64::min),
             gpu_ms_total_median: median(totals),
             wall_ms_median: median(walls),
+            shaded_points,
+            shading_us_per_light_per_point,
             shadow_grid_wall_ms,
             progressive,
         });
