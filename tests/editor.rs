@@ -239,6 +239,38 @@ fn middle_drag(
     h.step();
 }
 
+/// Steps until the first image of the refinement that started after `before`, counting the volume and
+/// shadow-grid units submitted meanwhile.
+fn rebuilds_before_first_image(
+    h: &mut Harness<'static, EditorApp>,
+    before: Instant,
+    what: &str,
+) -> usize {
+    let (mut rebuilds, t) = (0, Instant::now());
+    loop {
+        h.step();
+        let live = h.state().live.as_ref().expect("a scene");
+        if matches!(
+            live.progress.and_then(|p| p.submitted),
+            Some(WorkUnit::ShadowGrid { .. } | WorkUnit::Volume)
+        ) {
+            rebuilds += 1;
+        }
+        if live.refine_started > before && live.first_image_in.is_some() {
+            println!(
+                "{what}: first image after {:.2} s",
+                live.first_image_in.unwrap_or_default().as_secs_f64()
+            );
+            return rebuilds;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(120),
+            "{what}: no first image"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
 #[test]
 fn panel_edits_change_the_image_and_three_undos_restore_it() {
     let dir = tmp("edits");
@@ -248,8 +280,13 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     let before = image(&h);
     let brown = mean_luminance(&before);
 
-    // Raising sigma_a (the dark-brown preset) darkens the hair; blond lightens it.
+    // Raising sigma_a (the dark-brown preset) darkens the hair; blond lightens it. The new absorption
+    // is shaded before the volume and shadow grid are rebuilt for it (single scattering reads only the
+    // grid's transmittance, which absorption does not change).
+    let started = h.state().live.as_ref().expect("a scene").refine_started;
     click(&mut h, "dark brown");
+    let rebuilt = rebuilds_before_first_image(&mut h, started, "dark brown");
+    assert_eq!(rebuilt, 0, "the first image waited for the volume");
     converge(&mut h);
     let dark = mean_luminance(&image(&h));
     click(&mut h, "blond");
@@ -320,27 +357,8 @@ fn a_narrower_highlight_is_sharper() {
     // The new look shows before the shadow grid is rebuilt for the new tables (with dual scattering
     // their forward terms need it): the first image is shaded with the grid already built, and the
     // multiple scattering follows.
-    let (mut grid_units, t) = (0, Instant::now());
-    loop {
-        h.step();
-        let live = h.state().live.as_ref().expect("a scene");
-        if matches!(
-            live.progress.and_then(|p| p.submitted),
-            Some(WorkUnit::ShadowGrid { .. })
-        ) {
-            grid_units += 1;
-        }
-        if live.refine_started > before && live.first_image_in.is_some() {
-            println!(
-                "beta_R 7.5 -> 3 deg: first image after {:.2} s",
-                live.first_image_in.unwrap_or_default().as_secs_f64()
-            );
-            break;
-        }
-        assert!(t.elapsed() < Duration::from_secs(120), "no first image");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    assert_eq!(grid_units, 0, "the first image waited for the shadow grid");
+    let rebuilt = rebuilds_before_first_image(&mut h, before, "beta_R 7.5 -> 3 deg");
+    assert_eq!(rebuilt, 0, "the first image waited for the shadow grid");
     converge(&mut h);
     let narrow = r_peak(&image(&h));
     println!("R lobe p99: beta_R 7.5 deg {wide:.4}, 3 deg {narrow:.4}");

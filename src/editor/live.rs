@@ -222,7 +222,8 @@ impl LiveScene {
             let look = if absorption_changed {
                 let (sigma_a, look) =
                     absorption(&session.look, &self.hair, session.paint.as_deref())?;
-                self.renderer.set_absorption(&self.ctx, &sigma_a)?;
+                // Shown at once; the volume and grid follow the first image (`step`).
+                self.renderer.set_absorption_deferred(&self.ctx, &sigma_a)?;
                 self.mean_sigma_a = look.params.sigma_a;
                 look
             } else {
@@ -333,6 +334,8 @@ impl LiveScene {
         self.refine_started = Instant::now();
         self.converged_in = None;
         self.first_image_in = None;
+        // The last refinement's progress (converged, say) says nothing about this one.
+        self.progress = None;
     }
 
     /// One UI frame's work: takes finished tables, submits one bounded refinement unit and, when the
@@ -349,15 +352,19 @@ impl LiveScene {
             None => {}
         }
         // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
-        // terms read them). Right after a parameter change the refinement shades with the old grid at
-        // once: hand the tables over once that first image is on screen, so the change shows in about
-        // one light batch's time and its multiple scattering follows; at once when the grid is being
-        // rebuilt anyway (one rebuild, not two), when the refinement has nothing left to show, or when
-        // the azimuthal table is new (an eta or eccentricity change shows only with its table).
+        // terms read them), and so does a deferred absorption change (from the volume). Right after a
+        // change the refinement shades with the old grid at once: rebuild once that first image is on
+        // screen, so the change shows in about one light batch's time and its multiple scattering
+        // follows. Tables go over at once when the grid is being rebuilt anyway (one rebuild, not two)
+        // or when the azimuthal table is new (an eta or eccentricity change shows only with its table);
+        // anything waiting goes over when the refinement has nothing left to show.
+        let shown = self.first_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
+        if shown && self.renderer.rebuild_stale_volume() {
+            self.restarted();
+        }
         let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
-            self.first_image_in.is_some()
+            shown
                 || self.renderer.shadow_grid_stale()
-                || self.progress.is_some_and(|p| p.converged)
                 || !Arc::ptr_eq(&t.azimuthal, self.renderer.azimuthal_table())
         });
         if hand_over
@@ -417,8 +424,9 @@ impl LiveScene {
         Ok(progress)
     }
 
-    /// Whether tables are still being built or not yet handed to the renderer.
+    /// Whether tables are still being built or not yet handed to the renderer, or a deferred
+    /// absorption change still waits for its volume: the image is not the session's final one yet.
     pub fn tables_pending(&self) -> bool {
-        self.tables.is_some() || self.held_tables.is_some()
+        self.tables.is_some() || self.held_tables.is_some() || self.renderer.volume_stale()
     }
 }

@@ -241,6 +241,9 @@ pub struct Renderer {
     pub(super) shading_pass: ShadingPass,
     pub(super) resolve_pass: ResolvePass,
     pub(super) volume_dirty: bool,
+    /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
+    /// one ([`Renderer::set_absorption_deferred`]).
+    pub(super) volume_stale: bool,
     pub(super) shadow_grid_dirty: bool,
     pub(super) timer: Option<PassTimer>,
     pub(super) last_ran: Vec<&'static str>,
@@ -430,6 +433,7 @@ impl Renderer {
             shading_pass: ShadingPass::new(device),
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
+            volume_stale: false,
             shadow_grid_dirty: true,
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
@@ -590,6 +594,46 @@ impl Renderer {
         ctx: &GpuContext,
         sigma_a: &[[f32; 3]],
     ) -> Result<(), RenderError> {
+        self.upload_absorption(ctx, sigma_a)?;
+        self.volume_stale = false;
+        self.mark_volume_dirty();
+        Ok(())
+    }
+
+    /// New absorption per point for shading at once, the volume and shadow grid (whose forward terms
+    /// carry the crossed fibers' absorption) kept until [`Renderer::rebuild_stale_volume`]: single
+    /// scattering, which reads only the grid's transmittance (absorption-free), is exact meanwhile, and
+    /// the editor shows a dye or melanin change before spending the grid's rebuild on it.
+    pub fn set_absorption_deferred(
+        &mut self,
+        ctx: &GpuContext,
+        sigma_a: &[[f32; 3]],
+    ) -> Result<(), RenderError> {
+        self.upload_absorption(ctx, sigma_a)?;
+        if !self.volume_dirty {
+            self.volume_stale = true;
+        }
+        Ok(())
+    }
+
+    /// Whether a deferred absorption change still waits for its volume and grid.
+    pub fn volume_stale(&self) -> bool {
+        self.volume_stale
+    }
+
+    /// Rebuilds the volume and grid for a deferred absorption change (restarting the refinement);
+    /// false when there was none.
+    pub fn rebuild_stale_volume(&mut self) -> bool {
+        if !self.volume_stale {
+            return false;
+        }
+        self.volume_stale = false;
+        self.mark_volume_dirty();
+        self.restart_refinement();
+        true
+    }
+
+    fn upload_absorption(&self, ctx: &GpuContext, sigma_a: &[[f32; 3]]) -> Result<(), RenderError> {
         if sigma_a.len() != self.point_count {
             return Err(RenderError::AbsorptionCount {
                 points: self.point_count,
@@ -599,7 +643,6 @@ impl Renderer {
         let v: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
         ctx.queue
             .write_buffer(&self.hair.absorption, 0, bytemuck::cast_slice(&v));
-        self.mark_volume_dirty();
         Ok(())
     }
 
