@@ -105,7 +105,12 @@ impl Tables {
         }
         // Built outside the lock (the build runs on rayon's threads); a duplicate build is harmless.
         let t = std::sync::Arc::new(AzimuthalTable::for_params(fp));
-        self.lock().push(t.clone());
+        let mut tables = self.lock();
+        // 10-37 MB each: a sweep over many fibers keeps the last few.
+        if tables.len() >= 4 {
+            tables.remove(0);
+        }
+        tables.push(t.clone());
         t
     }
 }

@@ -13,6 +13,7 @@ use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
@@ -230,9 +231,23 @@ impl LiveScene {
                 session.look.validate().map_err(AssembleError::Look)?;
                 renderer_look(&session.look, self.mean_sigma_a)
             };
-            if self.renderer.set_params_deferred(&self.ctx, &look) {
+            let held_fits = self
+                .held_tables
+                .as_ref()
+                .is_some_and(|(p, _)| *p == look.params);
+            if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
                 let params = look.params;
-                let azimuthal = self.renderer.azimuthal_table().clone();
+                // The azimuthal table of the held tables when it fits (an eta change in the works),
+                // else the renderer's: rebuilt only for a new eta or eccentricity.
+                let fits = |t: &Arc<AzimuthalTable>| {
+                    t.eta == params.eta as f32 && t.eccentricity == params.eccentricity as f32
+                };
+                let azimuthal = self
+                    .held_tables
+                    .as_ref()
+                    .map(|(_, t)| t.azimuthal.clone())
+                    .filter(fits)
+                    .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
                 // A newer build replaces an older one; set_tables ignores stale tables anyway.
                 self.held_tables = None;
                 self.tables = Some(Job::spawn(
@@ -359,7 +374,8 @@ impl LiveScene {
         // or when the azimuthal table is new (an eta or eccentricity change shows only with its table);
         // anything waiting goes over when the refinement has nothing left to show.
         let shown = self.first_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
-        if shown && self.renderer.rebuild_stale_volume() {
+        // With tables on the way, the volume waits for them: they rebuild the grid too.
+        if shown && self.tables.is_none() && self.renderer.rebuild_stale_volume() {
             self.restarted();
         }
         let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {

@@ -244,6 +244,9 @@ pub struct Renderer {
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
     pub(super) volume_stale: bool,
+    /// The volume holds an old absorption that nothing reads now (multiple scattering off): rebuilt
+    /// when multiple scattering is turned on.
+    pub(super) volume_absorption_old: bool,
     pub(super) shadow_grid_dirty: bool,
     pub(super) timer: Option<PassTimer>,
     pub(super) last_ran: Vec<&'static str>,
@@ -434,6 +437,7 @@ impl Renderer {
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
             volume_stale: false,
+            volume_absorption_old: false,
             shadow_grid_dirty: true,
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
@@ -559,16 +563,19 @@ impl Renderer {
             0,
             bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
-        if !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal) {
+        let azimuthal_changed = !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal);
+        if azimuthal_changed {
             ctx.queue
                 .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.as_bytes());
             self.azimuthal = tables.azimuthal.clone();
             self.write_params(ctx);
         }
         self.tables_for = *params;
+        // The forward and dual tables are read only with multiple scattering (the grid's forward
+        // terms, the shading's dual terms); without it only a new azimuthal table changes the image.
         if self.settings.multiple_scattering {
             self.mark_shadow_grid_dirty();
-        } else {
+        } else if azimuthal_changed {
             self.restart_refinement();
         }
         true
@@ -595,7 +602,6 @@ impl Renderer {
         sigma_a: &[[f32; 3]],
     ) -> Result<(), RenderError> {
         self.upload_absorption(ctx, sigma_a)?;
-        self.volume_stale = false;
         self.mark_volume_dirty();
         Ok(())
     }
@@ -610,8 +616,14 @@ impl Renderer {
         sigma_a: &[[f32; 3]],
     ) -> Result<(), RenderError> {
         self.upload_absorption(ctx, sigma_a)?;
-        if !self.volume_dirty {
+        if self.volume_dirty {
+            return Ok(());
+        }
+        // Only the grid's forward terms read the volume's absorption.
+        if self.settings.shadows && self.settings.multiple_scattering && self.light_count > 0 {
             self.volume_stale = true;
+        } else {
+            self.volume_absorption_old = true;
         }
         Ok(())
     }
@@ -627,9 +639,7 @@ impl Renderer {
         if !self.volume_stale {
             return false;
         }
-        self.volume_stale = false;
         self.mark_volume_dirty();
-        self.restart_refinement();
         true
     }
 
@@ -677,6 +687,8 @@ impl Renderer {
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
+        self.volume_stale = false;
+        self.volume_absorption_old = false;
         self.mark_shadow_grid_dirty();
     }
 
@@ -751,6 +763,11 @@ impl Renderer {
         self.settings.shadows = shadows;
         self.settings.multiple_scattering = multiple_scattering;
         self.update_batches(&ctx.device);
+        // The grid's forward terms read the volume's absorption, and the grid is rebuilt now: the
+        // volume first, so that it is rebuilt once.
+        if self.volume_absorption_old && shadows && multiple_scattering {
+            self.mark_volume_dirty();
+        }
     }
 
     /// Exposure in stops applied by the resolve pass (and by `read_frame`).
