@@ -66,14 +66,18 @@ fn refine_all(r: &mut Renderer, ctx: &GpuContext) -> Vec<WorkUnit> {
     }
 }
 
+/// The project's sunny sky as 40 SRBF lights.
+fn sunny_lights() -> Vec<strandlight::envmap::SrbfLight> {
+    SrbfSet::read(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"))
+        .expect("fit")
+        .lights
+}
+
 #[test]
 fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let ctx = context();
     let luts = Luts::default_tables();
-    let lights =
-        SrbfSet::read(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"))
-            .expect("fit")
-            .lights;
+    let lights = sunny_lights();
     let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
     // A coarse grid keeps the unit count of the test small.
     scene.settings.shadow_grid_resolution = 12;
@@ -195,10 +199,7 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
 fn deferred_absorption_rebuilds_only_what_reads_it() {
     let ctx = context();
     let luts = Luts::default_tables();
-    let lights =
-        SrbfSet::read(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"))
-            .expect("fit")
-            .lights;
+    let lights = sunny_lights();
     for multiple in [false, true] {
         let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), multiple);
         scene.settings.shadow_grid_resolution = 12;

@@ -112,7 +112,8 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             ForwardTable::build(&s.params, REFERENCE_VARIANT),
             DualTables::build(&s.params, REFERENCE_VARIANT),
         );
-        let azimuthal = strandlight::render::renderer::azimuthal_table_for(&s.params);
+        let azimuthal =
+            strandlight::scattering::azimuthal_table::AzimuthalTable::for_hair(&s.params);
         let sources = GridSources {
             pyramid: &pyramid,
             forward: multiple.then_some((&volume, &forward)),

@@ -13,7 +13,6 @@ use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
-use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
@@ -239,14 +238,11 @@ impl LiveScene {
                 let params = look.params;
                 // The azimuthal table of the held tables when it fits (an eta change in the works),
                 // else the renderer's: rebuilt only for a new eta or eccentricity.
-                let fits = |t: &Arc<AzimuthalTable>| {
-                    t.eta == params.eta as f32 && t.eccentricity == params.eccentricity as f32
-                };
                 let azimuthal = self
                     .held_tables
                     .as_ref()
                     .map(|(_, t)| t.azimuthal.clone())
-                    .filter(fits)
+                    .filter(|t| t.fits_hair(&params))
                     .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
                 // A newer build replaces an older one; set_tables ignores stale tables anyway.
                 self.held_tables = None;

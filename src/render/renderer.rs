@@ -109,11 +109,6 @@ pub struct ParamTables {
     pub azimuthal: Arc<AzimuthalTable>,
 }
 
-/// The azimuthal table of `params` (the fast form's f32 eta and eccentricity).
-pub fn azimuthal_table_for(params: &HairParams) -> AzimuthalTable {
-    AzimuthalTable::build(params.eta as f32, params.eccentricity as f32)
-}
-
 /// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
     let ((forward, dual), azimuthal) = rayon::join(
@@ -124,12 +119,8 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
             )
         },
         || match reuse {
-            Some(t)
-                if t.eta == params.eta as f32 && t.eccentricity == params.eccentricity as f32 =>
-            {
-                t.clone()
-            }
-            _ => Arc::new(azimuthal_table_for(params)),
+            Some(t) if t.fits_hair(params) => t.clone(),
+            _ => Arc::new(AzimuthalTable::for_hair(params)),
         },
     );
     ParamTables {

@@ -31,6 +31,7 @@ use super::fast_azimuthal::{
 };
 use super::fast_exact_azimuthal::{EXACT_BLEND_HI, EXACT_BLEND_LO, for_each_window_node};
 use super::fast_params::FastHairParams;
+use super::params::HairParams;
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
@@ -300,36 +301,19 @@ impl AzimuthalTable {
         self.eta == p.eta && self.eccentricity == p.eccentricity
     }
 
+    /// The table of exact hair parameters (the fast form's f32 eta and eccentricity).
+    pub fn for_hair(p: &HairParams) -> Self {
+        Self::build(p.eta as f32, p.eccentricity as f32)
+    }
+
+    /// [`AzimuthalTable::matches`] for exact hair parameters.
+    pub fn fits_hair(&self, p: &HairParams) -> bool {
+        self.eta == p.eta as f32 && self.eccentricity == p.eccentricity as f32
+    }
+
     /// The cells as bytes for the GPU (vec4<f32> each).
     pub fn as_bytes(&self) -> &[u8] {
         bytemuck::cast_slice(&self.cells)
-    }
-
-    /// calN_TT (p = 1) or calN_TRT (p = 2) under the Gaussian window of bandwidth lambda' (Xu Eq. 12), for
-    /// absorption sigma_a (per unit radius, RGB) and, for TRT, the averaged index eta*-bar.
-    pub fn window_gaussian(
-        &self,
-        p: u32,
-        eta_star: f32,
-        sigma_a: Rgb32,
-        theta_d: f32,
-        lambda_prime: f32,
-        dphi: f32,
-    ) -> Rgb32 {
-        azimuthal_table_gaussian(
-            &self.cells,
-            p,
-            eta_star,
-            sigma_a,
-            theta_d,
-            lambda_prime,
-            dphi,
-        )
-    }
-
-    /// calN_t^G (Xu Eq. 28): the box window of half-width pi/2 over pi, lobe p = 0, 1, 2.
-    pub fn window_box(&self, p: u32, sigma_a: Rgb32, theta_d: f32, dphi: f32) -> Rgb32 {
-        azimuthal_table_box(&self.cells, p, sigma_a, theta_d, dphi)
     }
 }
 
@@ -364,83 +348,84 @@ fn absorption_exponent(p: u32, eta: f32, sigma_a: Rgb32, theta_d: f32) -> Rgb32 
     sigma_a.map(|s| 2.0 * p as f32 * sigma_a_prime(s, eta, theta_d))
 }
 
-/// [`AzimuthalTable::window_gaussian`] on the raw cells (the WGSL twin's form).
-pub fn azimuthal_table_gaussian(
-    cells: &[[f32; 4]],
-    p: u32,
-    eta_star: f32,
-    sigma_a: Rgb32,
-    theta_d: f32,
-    lambda_prime: f32,
-    dphi: f32,
-) -> Rgb32 {
-    let header = cells[0];
-    let eta_samples = header[2] as usize;
-    let (t, wt) = axis_position(
-        theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
-        TABLE_THETA_D,
-    );
-    let lp = lambda_prime.clamp(LAMBDA_MIN, LAMBDA_MAX);
-    let (a, b) = (LAMBDA_MIN.ln(), LAMBDA_MAX.ln());
-    let (l, wl) = axis_position(
-        (lp.ln() - a) / (b - a) * (TABLE_LAMBDA - 1) as f32,
-        TABLE_LAMBDA,
-    );
-    let mut u = folded_dphi(dphi) / PI;
-    let (mut base, mut e, mut we, mut eta) = (1usize, 0usize, 0.0f32, header[3]);
-    if p == 2 {
-        base = trt_base();
-        eta = eta_star;
-        // The knots of the cells read: theta_d beyond the axis reads the last cells.
-        let cells_theta_d = theta_d.abs().min(THETA_D_MAX);
-        u = trt_u(
-            folded_dphi(dphi),
-            trt_knots(bravais_eta_prime(eta_star, cells_theta_d)),
+impl AzimuthalTable {
+    /// calN_TT (p = 1) or calN_TRT (p = 2) under the Gaussian window of bandwidth lambda' (Xu Eq. 12), for
+    /// absorption sigma_a (per unit radius, RGB) and, for TRT, the averaged index eta*-bar (the WGSL
+    /// twin: `azimuthal_table_gaussian`).
+    pub fn window_gaussian(
+        &self,
+        p: u32,
+        eta_star: f32,
+        sigma_a: Rgb32,
+        theta_d: f32,
+        lambda_prime: f32,
+        dphi: f32,
+    ) -> Rgb32 {
+        let cells = &self.cells;
+        let header = cells[0];
+        let eta_samples = header[2] as usize;
+        let (t, wt) = axis_position(
+            theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
+            TABLE_THETA_D,
         );
-        if eta_samples > 1 {
-            let x = (eta_star - header[0]) / (header[1] - header[0]) * (eta_samples - 1) as f32;
-            (e, we) = axis_position(x, eta_samples);
+        let lp = lambda_prime.clamp(LAMBDA_MIN, LAMBDA_MAX);
+        let (a, b) = (LAMBDA_MIN.ln(), LAMBDA_MAX.ln());
+        let (l, wl) = axis_position(
+            (lp.ln() - a) / (b - a) * (TABLE_LAMBDA - 1) as f32,
+            TABLE_LAMBDA,
+        );
+        let mut u = folded_dphi(dphi) / PI;
+        let (mut base, mut e, mut we, mut eta) = (1usize, 0usize, 0.0f32, header[3]);
+        if p == 2 {
+            base = trt_base();
+            eta = eta_star;
+            // The knots of the cells read: theta_d beyond the axis reads the last cells.
+            let cells_theta_d = theta_d.abs().min(THETA_D_MAX);
+            u = trt_u(
+                folded_dphi(dphi),
+                trt_knots(bravais_eta_prime(eta_star, cells_theta_d)),
+            );
+            if eta_samples > 1 {
+                let x = (eta_star - header[0]) / (header[1] - header[0]) * (eta_samples - 1) as f32;
+                (e, we) = axis_position(x, eta_samples);
+            }
         }
+        let (f, wf) = axis_position(u * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
+        let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
+        let at = |ie: usize, it: usize, il: usize, ip: usize| -> [f32; 4] {
+            cells[base + ie * per_lobe + (it * TABLE_LAMBDA + il) * TABLE_DPHI + ip]
+        };
+        let bilerp = |ie: usize, it: usize| {
+            let lo = lerp4(at(ie, it, l, f), at(ie, it, l, f + 1), wf);
+            let hi = lerp4(at(ie, it, l + 1, f), at(ie, it, l + 1, f + 1), wf);
+            lerp4(lo, hi, wl)
+        };
+        let slab = |ie: usize| lerp4(bilerp(ie, t), bilerp(ie, t + 1), wt);
+        let mut c = slab(e);
+        if we > 0.0 {
+            c = lerp4(c, slab(e + 1), we);
+        }
+        let energy = window_energy(lambda_prime);
+        rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d)).map(|v| energy * v)
     }
-    let (f, wf) = axis_position(u * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
-    let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
-    let at = |ie: usize, it: usize, il: usize, ip: usize| -> [f32; 4] {
-        cells[base + ie * per_lobe + (it * TABLE_LAMBDA + il) * TABLE_DPHI + ip]
-    };
-    let bilerp = |ie: usize, it: usize| {
-        let lo = lerp4(at(ie, it, l, f), at(ie, it, l, f + 1), wf);
-        let hi = lerp4(at(ie, it, l + 1, f), at(ie, it, l + 1, f + 1), wf);
-        lerp4(lo, hi, wl)
-    };
-    let slab = |ie: usize| lerp4(bilerp(ie, t), bilerp(ie, t + 1), wt);
-    let mut c = slab(e);
-    if we > 0.0 {
-        c = lerp4(c, slab(e + 1), we);
-    }
-    let energy = window_energy(lambda_prime);
-    rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d)).map(|v| energy * v)
-}
 
-/// [`AzimuthalTable::window_box`] on the raw cells (the WGSL twin's form).
-pub fn azimuthal_table_box(
-    cells: &[[f32; 4]],
-    p: u32,
-    sigma_a: Rgb32,
-    theta_d: f32,
-    dphi: f32,
-) -> Rgb32 {
-    let header = cells[0];
-    let base = box_base(header[2] as usize) + p as usize * TABLE_THETA_D * TABLE_DPHI;
-    let (t, wt) = axis_position(
-        theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
-        TABLE_THETA_D,
-    );
-    let (f, wf) = axis_position(folded_dphi(dphi) / PI * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
-    let at = |it: usize, ip: usize| cells[base + it * TABLE_DPHI + ip];
-    let lo = lerp4(at(t, f), at(t, f + 1), wf);
-    let hi = lerp4(at(t + 1, f), at(t + 1, f + 1), wf);
-    let c = lerp4(lo, hi, wt);
-    rule_value(c, absorption_exponent(p, header[3], sigma_a, theta_d))
+    /// calN_t^G (Xu Eq. 28): the box window of half-width pi/2 over pi, lobe p = 0, 1, 2 (the WGSL twin:
+    /// `azimuthal_table_box`).
+    pub fn window_box(&self, p: u32, sigma_a: Rgb32, theta_d: f32, dphi: f32) -> Rgb32 {
+        let cells = &self.cells;
+        let header = cells[0];
+        let base = box_base(header[2] as usize) + p as usize * TABLE_THETA_D * TABLE_DPHI;
+        let (t, wt) = axis_position(
+            theta_d.abs() / THETA_D_MAX * (TABLE_THETA_D - 1) as f32,
+            TABLE_THETA_D,
+        );
+        let (f, wf) = axis_position(folded_dphi(dphi) / PI * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
+        let at = |it: usize, ip: usize| cells[base + it * TABLE_DPHI + ip];
+        let lo = lerp4(at(t, f), at(t, f + 1), wf);
+        let hi = lerp4(at(t + 1, f), at(t + 1, f + 1), wf);
+        let c = lerp4(lo, hi, wt);
+        rule_value(c, absorption_exponent(p, header[3], sigma_a, theta_d))
+    }
 }
 
 /// calN_TT (p = 1) or calN_TRT (p = 2): the tabulated exact integral under narrow lights, the
