@@ -84,32 +84,6 @@ fn crossings_at(p: vec3<f32>, omega: vec3<f32>, lod: f32) -> f32 {
     return crossings(e.a, e.m0, e.m1, omega);
 }
 
-// DensityPyramid::hair_near: whether any hair lies in the cube [p - r, p + r] (the voxels of the finest
-// level whose voxel is at least r / 2, or the coarsest, overlapping the cube; any extinction above zero).
-fn hair_near(p: vec3<f32>, r: f32) -> bool {
-    var level = pyramid_info.levels[pyramid_info.count - 1u];
-    for (var l = 0u; l < pyramid_info.count; l++) {
-        if (pyramid_info.levels[l].voxel >= 0.5 * r) {
-            level = pyramid_info.levels[l];
-            break;
-        }
-    }
-    let top = vec3<i32>(level.dims) - vec3<i32>(1);
-    let lo = max(vec3<i32>(floor((p - vec3<f32>(r) - pyramid_info.origin) / level.voxel)), vec3<i32>(0));
-    let hi = min(vec3<i32>(floor((p + vec3<f32>(r) - pyramid_info.origin) / level.voxel)), top);
-    for (var z = lo.z; z <= hi.z; z++) {
-        for (var y = lo.y; y <= hi.y; y++) {
-            for (var x = lo.x; x <= hi.x; x++) {
-                let v = pyramid_index(level, vec3<i32>(x, y, z));
-                if (v >= 0 && pyramid[2 * v].x > 0.0) {
-                    return true;
-                }
-            }
-        }
-    }
-    return false;
-}
-
 // Distance from p along omega (unit) to where the ray leaves the pyramid's box.
 fn pyramid_exit(p: vec3<f32>, omega: vec3<f32>) -> f32 {
     let l0 = pyramid_info.levels[0];

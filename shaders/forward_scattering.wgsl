@@ -54,57 +54,81 @@ fn forward_voxel_at(p: vec3<f32>) -> i32 {
     return i32((i.z * volume_info.dims.y + i.y) * volume_info.dims.x + i.x);
 }
 
+// The integrals of a shadow path (twin of PathIntegrals in src/shadow/forward.rs): tau = integral c ds,
+// per channel integral c (1 - a_f) ds, integral c a_f ds, integral c a_f beta_f^2 ds; per cm at a point.
+struct PathIntegrals {
+    tau: f32,
+    loss: vec3<f32>,
+    mass: vec3<f32>,
+    spread: vec3<f32>,
+}
+
+fn path_add_scaled(s: PathIntegrals, o: PathIntegrals, h: f32) -> PathIntegrals {
+    return PathIntegrals(s.tau + h * o.tau, s.loss + h * o.loss, s.mass + h * o.mass, s.spread + h * o.spread);
+}
+
+fn path_zero() -> PathIntegrals {
+    return PathIntegrals(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+// The integrands at x along omega, the pyramid read at level `lod`: crossing density and inclination
+// from the same (a, M), absorption from the level-0 voxel (an empty one holds its neighbours'); zero
+// outside the volume.
+fn forward_integrand(x: vec3<f32>, omega: vec3<f32>, lod: f32) -> PathIntegrals {
+    var out = path_zero();
+    let v = forward_voxel_at(x);
+    if (v < 0) {
+        return out;
+    }
+    let e = extinction_at(x, lod);
+    let c = crossings(e.a, e.m0, e.m1, omega);
+    if (c <= 0.0) {
+        return out;
+    }
+    let sig = volume[3 * v + 2].xyz;
+    let w = omega;
+    let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
+    let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
+    out.tau = c;
+    for (var ch = 0u; ch < 3u; ch++) {
+        let f1 = forward_lookup(theta, sig[ch]);
+        let f2 = forward_lookup(-theta, sig[ch]);
+        out.loss[ch] = c * (1.0 - 0.5 * (f1.x + f2.x));
+        out.mass[ch] = c * 0.5 * (f1.x + f2.x);
+        out.spread[ch] = c * 0.5 * (f1.x * f1.y + f2.x * f2.y);
+    }
+    return out;
+}
+
+// The direct fraction, T_f and sigma_f^2 of a path with these integrals.
+fn path_scattering(s: PathIntegrals) -> ForwardScattering {
+    var out: ForwardScattering;
+    out.direct_fraction = exp(-s.tau);
+    out.transmittance_f = exp(-s.loss);
+    for (var ch = 0u; ch < 3u; ch++) {
+        out.sigma_f2[ch] = forward_spread_weighted(s.mass[ch], s.spread[ch]);
+    }
+    return out;
+}
+
 // A cone of half-angle `half_angle` marched as cone_optical_depth marches it (steps of half its
 // width, pyramid levels of that width; 0: a thin ray on level 0), so the direct fraction is that
-// cone's exp(-tau).
+// cone's exp(-tau). The reference the shadow grid's sweeps replaced (tests).
 fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> ForwardScattering {
     let exit = pyramid_exit(p, omega);
     let tn = tan(min(half_angle, 1.5));
-    var tau = 0.0;
-    var loss = vec3<f32>(0.0);
-    var mass = vec3<f32>(0.0);
-    var spread = vec3<f32>(0.0);
+    var sums = path_zero();
     var s = skip;
     for (var it = 0; it < 4096; it++) {
         if (s >= exit) {
             break;
         }
         let st = cone_step(s, tn, exit);
-        let h = st.x;
-        let lod = st.y;
-        let x = p + omega * (s + 0.5 * h);
-        s = s + h;
-        let v = forward_voxel_at(x);
-        if (v < 0) {
-            continue;
-        }
-        // Crossing density and inclination from the same (a, M); absorption from the level-0 voxel
-        // (an empty one holds its neighbours').
-        let e = extinction_at(x, lod);
-        let c = crossings(e.a, e.m0, e.m1, omega);
-        if (c <= 0.0) {
-            continue;
-        }
-        let sig = volume[3 * v + 2].xyz;
-        let w = omega;
-        let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
-        let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
-        tau = tau + c * h;
-        for (var ch = 0u; ch < 3u; ch++) {
-            let f1 = forward_lookup(theta, sig[ch]);
-            let f2 = forward_lookup(-theta, sig[ch]);
-            loss[ch] = loss[ch] + c * h * (1.0 - 0.5 * (f1.x + f2.x));
-            mass[ch] = mass[ch] + c * h * 0.5 * (f1.x + f2.x);
-            spread[ch] = spread[ch] + c * h * 0.5 * (f1.x * f1.y + f2.x * f2.y);
-        }
+        let x = p + omega * (s + 0.5 * st.x);
+        s = s + st.x;
+        sums = path_add_scaled(sums, forward_integrand(x, omega, st.y), st.x);
     }
-    var out: ForwardScattering;
-    out.direct_fraction = exp(-tau);
-    out.transmittance_f = exp(-loss);
-    for (var ch = 0u; ch < 3u; ch++) {
-        out.sigma_f2[ch] = forward_spread_weighted(mass[ch], spread[ch]);
-    }
-    return out;
+    return path_scattering(sums);
 }
 
 // sigma_f^2 = T_f W / (T_f - direct) = W / (1 - exp(-A)), A = integral c a_f ds, W = integral c a_f beta_f^2 ds

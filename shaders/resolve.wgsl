@@ -22,6 +22,14 @@ struct ResolveInfo {
 @group(0) @binding(9) var<storage, read_write> beauty: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> view_depth: array<f32>;
 @group(0) @binding(11) var<storage, read_write> sample_ids: array<vec4<u32>>;
+// The rows resolved: [row0, row0 + rows) (a band after progressive refinement shaded it).
+struct ResolveRows {
+    row0: u32,
+    rows: u32,
+    _p0: u32,
+    _p1: u32,
+}
+@group(0) @binding(12) var<storage, read> band: ResolveRows;
 
 // Distance along the view axis of a [0, 1] depth (directx-style right-handed projection).
 fn linear_depth(d: f32) -> f32 {
@@ -29,7 +37,11 @@ fn linear_depth(d: f32) -> f32 {
 }
 
 @compute @workgroup_size(8, 8)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.y >= band.rows) {
+        return;
+    }
+    let id = vec3<u32>(gid.x, gid.y + band.row0, gid.z);
     if (id.x >= camera.size.x || id.y >= camera.size.y) {
         return;
     }

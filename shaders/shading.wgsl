@@ -1,7 +1,7 @@
 // Shading pass (Xu 2011 Sec. 5): for every pixel, the distinct hair segments among its visibility
 // samples are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
-// each light scaled by its transmittance (cone-marched through the fiber-density pyramid at the points
-// of the shadow grid, read trilinearly), and accumulated per lobe
+// each light scaled by its transmittance (swept through the fiber-density pyramid at the points of the
+// shadow grid, read trilinearly), and accumulated per lobe
 // weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on

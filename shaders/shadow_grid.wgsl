@@ -1,5 +1,5 @@
 // Per-light shadows on a coarse grid (twin of src/shadow/grid.rs): `build_shadow_grid` evaluates, at
-// every grid point for every light, the cone-marched transmittance and the forward-scattering terms;
+// every grid point for every light, the swept transmittance and the forward-scattering terms;
 // `grid_shadow` reads them trilinearly. Two vec4 per (point, light), light-major:
 // (ln transmittance, ln T_f RGB), (sigma_f^2 RGB, optical depth behind the point along the light's travel).
 

@@ -1,9 +1,9 @@
-// The shadow-grid build pass: one invocation per (grid point, light) entry of [first, first + count)
-// (all of them for a whole frame, a range per unit of progressive refinement). Writes the light's cone-marched
-// transmittance (the direct fraction for single scattering) and, when multiple scattering is on, the
-// forward-scattering terms T_f and sigma_f^2 averaged over the same seven cones (srbf_forward), and the
-// optical depth of the hair behind the point along the light's travel (the central cone marched away
-// from the light: how much hair there is to back-scatter, dual_response.wgsl's local term).
+// The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). One workgroup per light
+// (all lights for a whole frame, a range of their sweeps per unit of progressive refinement) sweeps the
+// grid slice by slice along each of the light's directions (sweep_direction), adding each
+// point's transmittance (and, when multiple scattering is on, the forward-scattering terms T_f and
+// sigma_f^2, and the optical depth of the hair behind the point along the light's travel) to the
+// point's entry, then turns the sums into what the shading pass reads (finish).
 // Prepended: circular_gaussian, density_pyramid, forward_scattering, shadow_grid.
 
 // The three descriptions are read as storage, not uniforms: lavapipe recompiles a shader whose loops
@@ -18,86 +18,311 @@
 @group(0) @binding(6) var<storage, read> volume: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> forward_table: array<vec2<f32>>;
 
-// The entries this dispatch writes, [first, first + count), and the dispatch's workgroups along x
+// The entries this dispatch builds, [first, first + count) (SWEEP_SLOTS per light, ordered by group of
+// lights, then slot, then light: a unit of a few entries sweeps several lights side by side; one
+// workgroup per light of the groups touched), and the dispatch's workgroups along x
 // (a small buffer per dispatch, so the grid's uniform stays the one the shading pass reads).
 struct BuildRange {
     first: u32,
     count: u32,
-    // Workgroups along x of the dispatch (dispatch_2d), in place of @builtin(num_workgroups).
+    // Workgroups along x of the dispatch, in place of @builtin(num_workgroups).
     groups_x: u32,
-    _pad: u32,
+    // Lights per group of entries (the shading pass's light batch).
+    group: u32,
+    // 1: one workgroup per entry (a unit of no more entries than a group has lights: each its own
+    // light, so the workgroups spread over the adapter's threads however it splits them), 0: one per
+    // light of the groups touched.
+    per_entry: u32,
+    _p0: u32,
+    _p1: u32,
+    _p2: u32,
 }
 @group(0) @binding(8) var<storage, read> build_range: BuildRange;
 
-// forward_scattering over the cones of srbf_transmittance (weights 1/2 for the centre, 1/12 for each
-// ring cone), each marched with its own width: the direct fraction is srbf_transmittance; sigma_f^2 is averaged per channel over the forward-scattered light (weights
-// w (T_f - direct)).
-fn srbf_forward(p: vec3<f32>, centre: vec3<f32>, lambda: f32, skip: f32) -> ForwardScattering {
+// Per light of the dispatch (from the first one's): two slices (the previous and the current one) of path
+// integrals, three vec4 per point: (tau, loss), (mass, 0), (spread, 0).
+@group(0) @binding(9) var<storage, read_write> sweep_scratch: array<vec4<f32>>;
+
+const SWEEP_GROUP: u32 = 128u;
+
+struct SweepDirection {
+    omega: vec3<f32>,
+    weight: f32,
+    behind: bool,
+}
+
+// The light's sweeps (sweep_directions in sweep.rs): srbf_cones' directions with their weights (one
+// of weight 1 when the inner half of G is narrower than 0.05 rad, else the centre (1/2) and six on the
+// ring (1/12 each)), then with multiple scattering the centre reversed.
+fn sweep_direction_count(lambda: f32, forward: bool) -> u32 {
     let kappa = 2.0 / (lambda * lambda);
     let e = exp(-2.0 * kappa);
     let inner = acos(clamp(1.0 + log(0.5 * (1.0 - e) + e) / kappa, -1.0, 1.0));
-    if (inner < 0.05) {
-        return forward_scattering(p, centre, max(inner, 1e-4), skip);
+    return select(7u, 1u, inner < 0.05) + select(0u, 1u, forward);
+}
+
+fn sweep_direction(centre: vec3<f32>, lambda: f32, j: u32, count: u32, forward: bool) -> SweepDirection {
+    if (forward && j + 1u == count) {
+        return SweepDirection(-centre, 1.0, true);
     }
-    let c = forward_scattering(p, centre, inner, skip);
+    let cones = count - select(0u, 1u, forward);
+    if (cones == 1u) {
+        return SweepDirection(centre, 1.0, false);
+    }
+    if (j == 0u) {
+        return SweepDirection(centre, 0.5, false);
+    }
+    let kappa = 2.0 / (lambda * lambda);
+    let e = exp(-2.0 * kappa);
     let ring = acos(clamp(1.0 + log(0.25 * (1.0 - e) + e) / kappa, -1.0, 1.0));
     var e1 = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(centre.x) < 0.9);
     e1 = normalize(e1 - centre * dot(centre, e1));
     let e2 = cross(centre, e1);
-    let sub = min(ring * PI / 6.0, ring);
-    var direct = 0.5 * c.direct_fraction;
-    var tf = 0.5 * c.transmittance_f;
-    var scattered = 0.5 * max(c.transmittance_f - vec3<f32>(c.direct_fraction), vec3<f32>(0.0));
-    var spread = scattered * c.sigma_f2;
-    for (var k = 0; k < 6; k++) {
-        let a = f32(k) * TAU / 6.0;
-        let d = normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring));
-        let f = forward_scattering(p, d, sub, skip);
-        let w = 0.5 / 6.0;
-        let s = w * max(f.transmittance_f - vec3<f32>(f.direct_fraction), vec3<f32>(0.0));
-        direct = direct + w * f.direct_fraction;
-        tf = tf + w * f.transmittance_f;
-        scattered = scattered + s;
-        spread = spread + s * f.sigma_f2;
-    }
-    return ForwardScattering(direct, tf, spread / max(scattered, vec3<f32>(1e-12)));
+    let a = f32(j - 1u) * TAU / 6.0;
+    return SweepDirection(normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring)), 0.5 / 6.0, false);
 }
 
-@compute @workgroup_size(64)
-fn build_shadow_grid(@builtin(global_invocation_id) id: vec3<u32>) {
-    let g = shadow_grid;
-    let local = id.x + id.y * build_range.groups_x * 64u;
-    if (local >= build_range.count) {
+// SweepAxes in sweep.rs: slices across axis a (omega's largest component, ties to the lower axis),
+// the others b < c; towards_high: the sweep starts at the high indices of a.
+struct SweepAxes {
+    a: u32,
+    b: u32,
+    c: u32,
+    towards_high: bool,
+    step: f32,
+    shift: vec2<f32>,
+}
+
+fn sweep_axes(g: ShadowGridInfo, omega: vec3<f32>) -> SweepAxes {
+    let m = abs(omega);
+    var a = 2u;
+    if (m.x >= m.y && m.x >= m.z) {
+        a = 0u;
+    } else if (m.y >= m.z) {
+        a = 1u;
+    }
+    let b = select(0u, 1u, a == 0u);
+    let c = select(2u, 1u, a == 2u);
+    let wa = max(m[a], 1e-6);
+    return SweepAxes(a, b, c, omega[a] > 0.0, g.spacing / wa, vec2<f32>(omega[b] / wa, omega[c] / wa));
+}
+
+// Without multiple scattering only tau is swept: one vec4 read and written per point.
+fn scratch_load(base: u32, i: u32, forward: bool) -> PathIntegrals {
+    let x0 = sweep_scratch[base + 3u * i];
+    if (!forward) {
+        return PathIntegrals(x0.x, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    }
+    let x1 = sweep_scratch[base + 3u * i + 1u];
+    let x2 = sweep_scratch[base + 3u * i + 2u];
+    return PathIntegrals(x0.x, x0.yzw, x1.xyz, x2.xyz);
+}
+
+fn scratch_store(base: u32, i: u32, f: PathIntegrals, forward: bool) {
+    sweep_scratch[base + 3u * i] = vec4<f32>(f.tau, f.loss);
+    if (forward) {
+        sweep_scratch[base + 3u * i + 1u] = vec4<f32>(f.mass, 0.0);
+        sweep_scratch[base + 3u * i + 2u] = vec4<f32>(f.spread, 0.0);
+    }
+}
+
+// slice_bilinear in sweep.rs: the previous slice at (u, v), zero outside it.
+fn slice_bilinear(base: u32, nb: u32, nc: u32, u: f32, v: f32, forward: bool) -> PathIntegrals {
+    let u0 = floor(u);
+    let v0 = floor(v);
+    let fu = u - u0;
+    let fv = v - v0;
+    var out = path_zero();
+    for (var corner = 0u; corner < 4u; corner++) {
+        let ou = f32(corner & 1u);
+        let ov = f32(corner >> 1u);
+        let iu = u0 + ou;
+        let iv = v0 + ov;
+        if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
+            continue;
+        }
+        let w = select(1.0 - fu, fu, ou == 1.0) * select(1.0 - fv, fv, ov == 1.0);
+        out = path_add_scaled(out, scratch_load(base, u32(iv) * nb + u32(iu), forward), w);
+    }
+    return out;
+}
+
+// accumulate in sweep.rs: one direction's path integrals added to the point's entry, (sum w direct,
+// sum w T_f), (sum w (T_f - direct) sigma_f^2, depth behind); the first direction writes it.
+fn accumulate(e: u32, d: SweepDirection, f: PathIntegrals, forward: bool, first: bool) {
+    let direct = exp(-f.tau);
+    if (!forward) {
+        // Only the direct fraction (v1 is written by finish).
+        var t = 0.0;
+        if (!first) {
+            t = shadow_values[2u * e].x;
+        }
+        shadow_values[2u * e] = vec4<f32>(t + d.weight * direct, 0.0, 0.0, 0.0);
         return;
     }
-    let k = build_range.first + local;
-    let n = g.dims.x * g.dims.y * g.dims.z;
-    if (k >= n * g.light_count) {
-        return;
+    var v0 = vec4<f32>(0.0);
+    var v1 = vec4<f32>(0.0);
+    if (!first) {
+        v0 = shadow_values[2u * e];
+        v1 = shadow_values[2u * e + 1u];
     }
-    let l = grid_lights[k / n];
-    let x = grid_point(g, k % n);
-    // No shading point reads a grid point with no hair within one spacing (plus a level-0 voxel: hair is
-    // deposited at samples a quarter voxel apart, ShadowGrid::value): it stays lit.
-    if (!hair_near(x, g.spacing + pyramid_info.levels[0].voxel)) {
-        shadow_values[2u * k] = vec4<f32>(0.0);
-        shadow_values[2u * k + 1u] = vec4<f32>(0.0);
-        return;
+    if (d.behind) {
+        v1.w = f.tau;
+    } else {
+        v0.x = v0.x + d.weight * direct;
+        for (var ch = 0u; ch < 3u; ch++) {
+            let tf = exp(-f.loss[ch]);
+            let s = d.weight * max(tf - direct, 0.0);
+            v0[1u + ch] = v0[1u + ch] + d.weight * tf;
+            v1[ch] = v1[ch] + s * forward_spread_weighted(f.mass[ch], f.spread[ch]);
+        }
     }
-    // Transmittances are stored as logarithms: attenuation falls off exponentially into the hair, so
-    // interpolating its logarithm follows it between grid points far better.
+    shadow_values[2u * e] = v0;
+    shadow_values[2u * e + 1u] = v1;
+}
+
+// finish in sweep.rs: the stored value from the sums (transmittances as logarithms: attenuation falls
+// off exponentially into the hair, so interpolating its logarithm follows it between grid points far
+// better).
+fn finish(e: u32, g: ShadowGridInfo) {
+    let v0 = shadow_values[2u * e];
+    let v1 = shadow_values[2u * e + 1u];
+    let t = log(max(v0.x, GRID_MIN_TRANSMITTANCE));
     if (g.forward == 0u) {
-        let t = log(max(srbf_transmittance(x, l.direction, l.lambda, g.skip), GRID_MIN_TRANSMITTANCE));
-        shadow_values[2u * k] = vec4<f32>(t, vec3<f32>(t));
-        shadow_values[2u * k + 1u] = vec4<f32>(0.0);
+        shadow_values[2u * e] = vec4<f32>(t, vec3<f32>(t));
+        shadow_values[2u * e + 1u] = vec4<f32>(0.0);
         return;
     }
-    // The forward march's direct fraction is srbf_transmittance: the same cones, steps and sums of
-    // c h, in the same order (marching them twice cost half the build), so d_f = d_b = 0 is single
-    // scattering up to rounding.
-    let f = srbf_forward(x, l.direction, l.lambda, g.skip);
-    let t = log(max(f.direct_fraction, GRID_MIN_TRANSMITTANCE));
-    shadow_values[2u * k] = vec4<f32>(t, log(max(f.transmittance_f, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
-    let behind = cone_optical_depth(x, -l.direction, srbf_centre_cone(l.lambda), g.skip);
-    shadow_values[2u * k + 1u] = vec4<f32>(f.sigma_f2, behind);
+    shadow_values[2u * e] = vec4<f32>(t, log(max(v0.yzw, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
+    shadow_values[2u * e + 1u] = vec4<f32>(v1.xyz / max(v0.yzw - vec3<f32>(v0.x), vec3<f32>(1e-12)), v1.w);
+}
+
+// A light's sweeps are slots 0-7 of its entries: 0 the centre, 1-6 the ring (empty for a narrow
+// light), 7 the centre reversed (empty without multiple scattering), after which its entries are
+// finished. A unit of refinement may hold part of a light's slots.
+const SWEEP_SLOTS: u32 = 8u;
+
+// The slot's direction, or none (weight 0) for an empty slot.
+fn slot_direction(l: GpuLight, slot: u32, forward: bool) -> SweepDirection {
+    let count = sweep_direction_count(l.lambda, forward);
+    let cones = count - select(0u, 1u, forward);
+    var j = slot;
+    if (slot == SWEEP_SLOTS - 1u) {
+        j = count - 1u;
+        if (!forward) {
+            return SweepDirection(l.direction, 0.0, false);
+        }
+    } else if (slot >= cones) {
+        return SweepDirection(l.direction, 0.0, false);
+    }
+    return sweep_direction(l.direction, l.lambda, j, count, forward);
+}
+
+@compute @workgroup_size(128)
+fn build_shadow_grid(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let g = shadow_grid;
+    let end = build_range.first + build_range.count;
+    let w = group.x + group.y * build_range.groups_x;
+    let group_entries = SWEEP_SLOTS * build_range.group;
+    var light = 0u;
+    var slot0 = 0u;
+    var slot1 = 0u;
+    var scratch_slot = w;
+    if (build_range.per_entry != 0u) {
+        if (w >= build_range.count) {
+            return;
+        }
+        // Entry e of its group: slot e / size, light e % size.
+        let e = build_range.first + w;
+        let group_first = e / group_entries * build_range.group;
+        let size = min(build_range.group, g.light_count - group_first);
+        let in_group = e - group_first * SWEEP_SLOTS;
+        light = group_first + in_group % size;
+        slot0 = in_group / size;
+        slot1 = slot0 + 1u;
+    } else {
+        let light0 = build_range.first / group_entries * build_range.group;
+        light = light0 + w;
+        scratch_slot = w;
+        if (light >= g.light_count) {
+            return;
+        }
+        // The light's slots inside [first, end): its entries are base + slot * size.
+        let group_first = light / build_range.group * build_range.group;
+        let size = min(build_range.group, g.light_count - group_first);
+        let base = group_first * SWEEP_SLOTS + (light - group_first);
+        if (build_range.first > base) {
+            slot0 = (build_range.first - base + size - 1u) / size;
+        }
+        if (end > base) {
+            slot1 = min((end - base + size - 1u) / size, SWEEP_SLOTS);
+        }
+    }
+    if (slot0 >= slot1) {
+        return;
+    }
+    let l = grid_lights[light];
+    let n = g.dims.x * g.dims.y * g.dims.z;
+    let forward = g.forward != 0u;
+    let area = max(max(g.dims.x * g.dims.y, g.dims.x * g.dims.z), g.dims.y * g.dims.z);
+    // sweep_lod in sweep.rs: the coarsest level whose voxel is at most half the spacing.
+    let lod = floor(max(log2(g.spacing / pyramid_info.levels[0].voxel) - 0.99, 0.0));
+    let scratch = 6u * area * scratch_slot;
+    for (var slot = slot0; slot < slot1; slot++) {
+        let d = slot_direction(l, slot, forward);
+        if (d.weight == 0.0) {
+            continue;
+        }
+        let ax = sweep_axes(g, d.omega);
+        let na = g.dims[ax.a];
+        let nb = g.dims[ax.b];
+        let nc = g.dims[ax.c];
+        // Unit steps and index strides along a, b, c (no dynamic vector indexing in the loop: lavapipe
+        // spills it to memory per invocation).
+        let unit = array<vec3<f32>, 3>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+        let strides = vec3<u32>(1u, g.dims.x, g.dims.x * g.dims.y);
+        let ea = unit[ax.a] * g.spacing;
+        let eb = unit[ax.b] * g.spacing;
+        let ec = unit[ax.c] * g.spacing;
+        let sa = strides[ax.a];
+        let sb = strides[ax.b];
+        let sc = strides[ax.c];
+        let x0 = g.origin + vec3<f32>(0.5 * g.spacing) + d.omega * (0.5 * ax.step);
+        for (var i = 0u; i < na; i++) {
+            let k = select(i, na - 1u - i, ax.towards_high);
+            let cur = scratch + 3u * area * (i & 1u);
+            let prev = scratch + 3u * area * ((i + 1u) & 1u);
+            for (var q = lid; q < nb * nc; q += SWEEP_GROUP) {
+                // q = ic nb + ib by float division (integer division is scalar on lavapipe): q + 1/2
+                // lies 1/2 from a multiple of nb, far beyond WGSL's 2.5 ulp while nb nc < 10^6 (a
+                // slice has at most 256^2 points).
+                let ic = u32((f32(q) + 0.5) / f32(nb));
+                let ib = q - ic * nb;
+                var up = path_zero();
+                if (i > 0u) {
+                    up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, forward);
+                }
+                let p = k * sa + ib * sb + ic * sc;
+                let x = x0 + f32(k) * ea + f32(ib) * eb + f32(ic) * ec;
+                var f = path_zero();
+                if (forward) {
+                    f = forward_integrand(x, d.omega, lod);
+                } else if (forward_voxel_at(x) >= 0) {
+                    // Zero outside the volume, as forward_integrand.
+                    f.tau = crossings_at(x, d.omega, lod);
+                }
+                scratch_store(cur, q, path_add_scaled(up, f, ax.step), forward);
+                accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
+            }
+            storageBarrier();
+        }
+    }
+    if (slot1 == SWEEP_SLOTS) {
+        for (var p = lid; p < n; p += SWEEP_GROUP) {
+            finish(light * n + p, g);
+        }
+    }
 }

@@ -256,6 +256,69 @@ fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
     assert!(worst < 0.04, "{worst}");
 }
 
+/// The shadow grid's light-space sweeps against the SRBF average of the exact transmittance (Monte
+/// Carlo over G of the volume's exp(-tau) along each direction), on the clump as the cone march above:
+/// the grid's reading at the same points.
+#[test]
+fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
+    use strandlight::shadow::DensityPyramid;
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::grid::{GridSources, GridValues, ShadowGrid};
+    let v = clump_volume();
+    let pyramid = DensityPyramid::build(&v);
+    let volume_grid = VolumeGrid {
+        origin: v.origin,
+        voxel: v.voxel,
+        dims: v.dims,
+    };
+    let src = GridSources {
+        pyramid: &pyramid,
+        forward: None,
+        skip: 0.0,
+    };
+    let lambdas = [0.01f32, 0.2, 0.5, 1.0];
+    let lights: Vec<(Vec3, f32)> = lambdas.iter().map(|&l| (Vec3::X, l)).collect();
+    let points = [
+        Vec3::new(0.9, 0.0, 0.0),
+        Vec3::new(0.5, 0.3, 0.2),
+        Vec3::new(0.0, 0.5, 0.0),
+        Vec3::new(-0.5, -0.4, 0.3),
+    ];
+    let mut r = Rng01::new(13);
+    for resolution in [48u32, 24] {
+        let grid = ShadowGrid::around(&volume_grid, resolution);
+        let values = GridValues::build(grid, &src, &lights);
+        let mut worst: f32 = 0.0;
+        for p in points {
+            for (k, &lambda) in lambdas.iter().enumerate() {
+                let swept = values.shadow(p, k).transmittance;
+                let n = if lambda < 0.05 { 1 } else { 4000 };
+                let mc: f32 = (0..n)
+                    .map(|_| {
+                        let w = if n == 1 {
+                            Vec3::X
+                        } else {
+                            sample_srbf(&mut r, Vec3::X, lambda)
+                        };
+                        v.transmittance(p, w, 0.0)
+                    })
+                    .sum::<f32>()
+                    / n as f32;
+                let cone = pyramid.srbf_transmittance(p, Vec3::X, lambda, 0.0);
+                worst = worst.max((swept - mc).abs());
+                println!(
+                    "grid {resolution} (spacing {:.3} cm), p {p:?} lambda {lambda}: swept {swept:.4}, Monte Carlo {mc:.4} ({:+.4}), cone {cone:.4} ({:+.4})",
+                    grid.spacing,
+                    swept - mc,
+                    cone - mc
+                );
+            }
+        }
+        println!("grid {resolution}: worst absolute difference {worst:.4}");
+        assert!(worst < 0.05, "{worst}");
+    }
+}
+
 /// Zinke's ray shooting (Sec. 4.1.1) through explicit fibers as the reference: per ray, the product of
 /// a_f(theta_k, sigma_a_k) over the fibers crossed and the sum of their beta_f^2, weighted by that product.
 #[test]
@@ -351,4 +414,96 @@ fn forward_scattering_matches_ray_shooting_through_explicit_fibers() {
     assert!((sv / sr - 1.0).abs() < 0.05);
     // The dye tints the forward-scattered light: green and blue lose more than red.
     assert!(tf_vol[0] > tf_vol[1] && tf_vol[1] > tf_vol[2]);
+}
+
+/// The light-space sweeps' forward-scattering terms against Zinke's ray shooting through the explicit
+/// fibers, as the cone march is tested above: narrow lights from eight directions, the grid's reading
+/// at random points against the rays from those points.
+#[test]
+fn swept_forward_scattering_matches_ray_shooting_through_explicit_fibers() {
+    use strandlight::scattering::{CausticModel, HairParams, ModelVariant};
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::forward::ForwardTable;
+    use strandlight::shadow::grid::{GridSources, GridValues, ShadowGrid};
+    let variant = ModelVariant {
+        caustic: CausticModel::None,
+        ..ModelVariant::XU
+    };
+    let table = ForwardTable::build(&HairParams::with_sigma_a([0.3; 3]), variant);
+    let size = 4.0;
+    let diameter = 0.02;
+    let fibers = random_fibers(1600, 1.0, size, false, 21);
+    let fiber_sigma: Vec<[f32; 3]> = (0..fibers.len())
+        .map(|k| {
+            if k % 4 == 0 {
+                [0.1, 1.5, 2.0]
+            } else {
+                [0.15, 0.25, 0.45]
+            }
+        })
+        .collect();
+    let hair = hair_of(&fibers, diameter);
+    let point_sigma: Vec<[f32; 3]> = fiber_sigma.iter().flat_map(|s| [*s, *s]).collect();
+    let volume = FiberDensity::build(&hair, &point_sigma, 0.25);
+    let pyramid = strandlight::shadow::DensityPyramid::build(&volume);
+    let mut r = Rng01::new(32);
+    let lights: Vec<(Vec3, f32)> = (0..8).map(|_| (r.unit(), 0.01)).collect();
+    let grid = ShadowGrid::around(
+        &VolumeGrid {
+            origin: volume.origin,
+            voxel: volume.voxel,
+            dims: volume.dims,
+        },
+        32,
+    );
+    let src = GridSources {
+        pyramid: &pyramid,
+        forward: Some((&volume, &table)),
+        skip: 0.0,
+    };
+    let values = GridValues::build(grid, &src, &lights);
+    let (mut tf_ref, mut tf_grid) = ([0f64; 3], [0f64; 3]);
+    let (mut direct_ref, mut direct_grid) = (0f64, 0f64);
+    let rays = 2400;
+    for k in 0..rays {
+        let light = k % lights.len();
+        let w = lights[light].0;
+        let p = Vec3::splat(0.35 * size) + Vec3::new(r.u(), r.u(), r.u()) * 0.3 * size;
+        let mut prod = [1f64; 3];
+        let mut n = 0;
+        for (j, &(a, b)) in fibers.iter().enumerate() {
+            if ray_segment_distance(p, w, 1e3, a, b) < 0.5 * diameter {
+                let u = (b - a).normalize();
+                let theta = w.dot(u).clamp(-1.0, 1.0).asin();
+                for c in 0..3 {
+                    prod[c] *= table.lookup(theta, fiber_sigma[j][c]).0 as f64;
+                }
+                n += 1;
+            }
+        }
+        let g = values.shadow(p, light);
+        for c in 0..3 {
+            tf_ref[c] += prod[c];
+            tf_grid[c] += g.transmittance_f[c] as f64;
+        }
+        direct_ref += (n == 0) as u8 as f64;
+        direct_grid += g.transmittance as f64;
+    }
+    let rays_f = rays as f64;
+    println!(
+        "direct fraction: rays {:.4} grid {:.4}",
+        direct_ref / rays_f,
+        direct_grid / rays_f
+    );
+    let mut worst: f64 = 0.0;
+    for c in 0..3 {
+        let (a, b) = (tf_ref[c] / rays_f, tf_grid[c] / rays_f);
+        worst = worst.max((b / a - 1.0).abs());
+        println!(
+            "T_f channel {c}: ray shooting {a:.4}, swept grid {b:.4} ({:+.3})",
+            b / a - 1.0
+        );
+    }
+    assert!(worst < 0.06, "T_f {worst}");
+    assert!((direct_grid / direct_ref - 1.0).abs() < 0.1);
 }

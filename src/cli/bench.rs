@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::progressive::WorkUnit;
+use strandlight::render::progressive::{UNIT_PASSES, WorkUnit};
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
@@ -86,8 +86,11 @@ struct SceneReport {
 struct ProgressiveReport {
     unit_budget_ms: f64,
     units: u32,
-    /// The longest unit, submission to completion (wall clock).
+    /// The longest unit, submission to completion (wall clock), and which.
     longest_unit_ms: f64,
+    longest_unit: String,
+    /// Submission to completion of each pass's units, summed (wall clock as the polling saw it).
+    pass_ms: std::collections::BTreeMap<&'static str, f64>,
     /// From the change until the first shading batch is complete (the strongest light batch at the
     /// first visibility sample, with its part of the shadow grid: the editor's first new image).
     first_image_ms: f64,
@@ -250,6 +253,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 unit_budget_ms: args.unit_budget_ms,
                 units: stats.units,
                 longest_unit_ms: stats.longest.as_secs_f64() * 1e3,
+                longest_unit: stats
+                    .longest_unit
+                    .map_or_else(String::new, |u| format!("{u:?}")),
+                pass_ms: UNIT_PASSES
+                    .iter()
+                    .zip(stats.pass_time)
+                    .map(|(&name, t)| (name, t.as_secs_f64() * 1e3))
+                    .collect(),
                 first_image_ms: first_image_ms.unwrap_or(converged_ms),
                 converged_ms,
             })

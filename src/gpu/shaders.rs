@@ -27,7 +27,7 @@ pub fn dual_eval_module() -> String {
 pub const SHADOW_GRID: &str = include_str!("../../shaders/shadow_grid.wgsl");
 pub const SHADOW_GRID_BUILD: &str = include_str!("../../shaders/shadow_grid_build.wgsl");
 
-/// The shadow-grid build pass: cone marching, forward scattering and the grid.
+/// The shadow-grid build pass: light-space sweeps, forward scattering and the grid.
 pub fn shadow_grid_build_module() -> String {
     [
         CIRCULAR_GAUSSIAN,

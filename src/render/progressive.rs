@@ -2,17 +2,18 @@
 //! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
 //! are sized from the measured cost of the units before them to a time budget, so egui, which shares the
 //! queue, does not wait behind a long submission (the volume and visibility units are whole passes, not
-//! sized; a unit of one row or one grid entry can still pass the budget). The units: the fiber-density
-//! volume (when geometry or absorption changed), the shadow grid in ranges of (light, grid point)
-//! entries (when the volume, the lights or the forward table changed), visibility, then every shading
+//! sized; a unit of one row or one sweep can still pass the budget). The units: the fiber-density
+//! volume (when geometry or absorption changed), the shadow grid in ranges of sweeps (eight entries per
+//! light, one per direction; when the volume, the lights or the forward table changed), visibility, then every shading
 //! batch (a light batch at one visibility sample) in bands of rows, each band followed by a resolve so
-//! the image fills in; the grid's entries for a light batch are built just before the first shading
+//! the image fills in; the grid's lights of a light batch are built just before the first shading
 //! batch that reads them, so the image appears after one light batch's grid, not the whole grid. Every pixel takes its batches in `render_frame`'s order, so the converged image is
 //! `render_frame`'s bit for bit. A change (parameters, camera, lights, absorption) restarts the plan; a
 //! camera move keeps what the shadow grid has built.
 
 use super::renderer::{RenderError, Renderer};
 use super::shading::{ShadeBatch, ShadingPass};
+use super::shadow_grid::SWEEP_SLOTS;
 use crate::gpu::GpuContext;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -22,8 +23,9 @@ use std::time::{Duration, Instant};
 pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 
 /// First guesses, before a unit of the kind has been measured: conservative (lavapipe on two cores
-/// builds about 10 us per grid entry and shades about 15 ms per row of a 16-light batch at 720 pixels).
-const GUESS_GRID_ENTRY_S: f64 = 20e-6;
+/// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a 16-light batch at
+/// 720 pixels).
+const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
 
 /// One bounded piece of a frame.
@@ -31,7 +33,7 @@ const GUESS_SHADE_ROW_S: f64 = 40e-3;
 pub enum WorkUnit {
     /// Fiber density and its pyramid.
     Volume,
-    /// Shadow-grid entries [first, first + count).
+    /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
     /// The visibility pass; the components are cleared.
     Visibility,
@@ -81,6 +83,10 @@ pub struct Refinement {
     /// Seconds per shadow-grid entry and per row of one shading batch (None: not measured yet).
     grid_cost: Option<f64>,
     shade_cost: Option<f64>,
+    /// Measured seconds per row of one shading batch, per image row (0: not measured yet). A row
+    /// costs about the same in every batch (the same pixels under as many lights), so a band is sized
+    /// from its own rows' costs, not from the mean of the (often empty) rows above it.
+    row_cost: Vec<f64>,
     /// Items of the last grid and shading units.
     grid_last: u32,
     shade_last: u32,
@@ -97,6 +103,7 @@ impl Default for Refinement {
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
             shade_cost: None,
+            row_cost: Vec::new(),
             grid_last: 1,
             shade_last: 1,
             in_flight: None,
@@ -112,8 +119,9 @@ impl Refinement {
     }
 
     /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
-    /// the previous unit of the kind (`last`: costs are uneven, empty rows and grid points cost almost
-    /// nothing, so one cheap unit must not size a huge next one); at least one, at most what remains.
+    /// the previous unit of the kind (`last`: costs are uneven, empty rows and empty sweep slots cost
+    /// almost nothing, so one cheap unit must not size a huge next one); at least one, at most what
+    /// remains.
     fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
         let per_item = per_item.unwrap_or(guess).max(1e-12);
         let n = (self.budget.as_secs_f64() / per_item)
@@ -124,12 +132,36 @@ impl Refinement {
             .min(remaining.max(1))
     }
 
+    /// Rows of a shading band from `row` (of `height`): as many as the budget holds by the rows' own
+    /// measured costs (the mean row's where not measured yet, then at most twice the last band); at
+    /// least one.
+    fn shade_rows(&self, row: u32, height: u32) -> u32 {
+        let fallback = self.shade_cost.unwrap_or(GUESS_SHADE_ROW_S).max(1e-12);
+        let budget = self.budget.as_secs_f64();
+        let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
+        for r in row..height {
+            let c = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
+            unknown |= c <= 0.0;
+            let c = if c > 0.0 { c } else { fallback };
+            if n > 0 && t + c > budget {
+                break;
+            }
+            t += c;
+            n += 1;
+        }
+        if unknown {
+            n = n.min(2 * self.shade_last.max(1));
+        }
+        n.max(1)
+    }
+
     /// The image width changed by `ratio`: a row costs about that much more (or less), and the next
     /// band starts small.
     pub(super) fn resized(&mut self, ratio: f64) {
         if let Some(c) = &mut self.shade_cost {
             *c *= ratio.max(1e-6);
         }
+        self.row_cost.clear();
         self.shade_last = 1;
     }
 
@@ -153,7 +185,14 @@ impl Refinement {
             WorkUnit::ShadowGrid { count, .. } => {
                 self.grid_cost = blend(self.grid_cost, per(count))
             }
-            WorkUnit::Shade { rows, .. } => self.shade_cost = blend(self.shade_cost, per(rows)),
+            WorkUnit::Shade { row0, rows, .. } => {
+                self.shade_cost = blend(self.shade_cost, per(rows));
+                let end = (row0 + rows) as usize;
+                if self.row_cost.len() < end {
+                    self.row_cost.resize(end, 0.0);
+                }
+                self.row_cost[row0 as usize..end].fill(per(rows));
+            }
             WorkUnit::Volume | WorkUnit::Visibility => {}
         }
     }
@@ -307,14 +346,11 @@ impl Renderer {
         }
     }
 
-    /// Shadow-grid entries that shading batch `batch` reads: the grid is light-major (entry =
-    /// light * points + point), so the lights up to the batch's last.
+    /// Shadow-grid entries that shading batch `batch` reads: the lights' up to the batch's last.
     fn grid_entries_for(&self, batch: u32) -> u32 {
         let total = self.shadow_grid.entry_count();
         match self.shading_pass.frame_batches().nth(batch as usize) {
-            Some(b) => {
-                ((b.first + b.count) * self.shadow_grid.grid.point_count() as u32).min(total)
-            }
+            Some(b) => ((b.first + b.count) * SWEEP_SLOTS).min(total),
             None => total,
         }
     }
@@ -374,7 +410,7 @@ impl Renderer {
                     return Some(unit);
                 }
                 let r = &mut self.refinement;
-                let mut rows = r.items(r.shade_cost, GUESS_SHADE_ROW_S, r.shade_last, height - row);
+                let mut rows = r.shade_rows(row, height);
                 // Whole workgroups (8 rows) where the budget allows.
                 if rows >= 8 && rows < height - row {
                     rows -= rows % 8;
@@ -441,7 +477,7 @@ impl Renderer {
                     None,
                 );
                 ShadingPass::clear(enc, &self.targets);
-                self.encode_resolve(device, enc);
+                self.encode_resolve(device, enc, 0..self.settings.height);
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
@@ -451,18 +487,24 @@ impl Renderer {
                 let inputs = self.shading_inputs();
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
-                self.encode_resolve(device, enc);
+                self.encode_resolve(device, enc, row0..row0 + rows);
             }
         }
     }
 
-    fn encode_resolve(&self, device: &wgpu::Device, enc: &mut wgpu::CommandEncoder) {
+    fn encode_resolve(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        rows: std::ops::Range<u32>,
+    ) {
         self.resolve_pass.encode(
             device,
             enc,
             &self.camera,
             &self.resolve_info,
             &self.targets,
+            rows,
             None,
         );
     }

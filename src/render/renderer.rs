@@ -148,7 +148,7 @@ pub struct RenderSettings {
     pub lights_per_pass: u32,
     /// Voxels along the hair's longest side for the fiber-density volume.
     pub volume_resolution: u32,
-    /// Shadow marches skip this many voxels at the shaded point (its own fiber's density).
+    /// Shadow paths skip this many voxels at the grid point (a shaded fiber's own density).
     pub shadow_skip_voxels: f32,
     /// Points of the per-light transmittance grid along the hair's longest side (48: on the blond-clump
     /// test against ray shooting the worst mean-colour error was 16 % at 32 points, 9.5 % at 48).
@@ -345,6 +345,10 @@ impl Renderer {
                 lights.len()
             ),
             grid.point_count() as u64 * lights.len().max(1) as u64 * 32,
+        )?;
+        check(
+            "the shadow sweeps' working memory",
+            grid.largest_slice() as u64 * 96 * lights.len().max(1) as u64,
         )?;
         let gpu_hair = GpuHair::new(device, hair, sigma_a);
         let grid = settings.volume_grid(hair);
@@ -783,6 +787,7 @@ impl Renderer {
             &self.camera,
             &self.resolve_info,
             &self.targets,
+            0..self.settings.height,
             None,
         );
         ctx.queue.submit([enc.finish()]);
@@ -805,6 +810,10 @@ impl Renderer {
             volume: &self.volume,
             forward_table: &self.forward_table,
             lights: &self.lights,
+            light_group: self
+                .settings
+                .lights_per_pass
+                .clamp(1, super::shading::MAX_LIGHTS_PER_PASS),
         }
     }
 
@@ -890,6 +899,7 @@ impl Renderer {
             &self.camera,
             &self.resolve_info,
             &self.targets,
+            0..self.settings.height,
             timer.and_then(|t| t.compute_writes("resolve")),
         );
         self.last_ran.extend(["visibility", "shading", "resolve"]);
@@ -969,5 +979,24 @@ impl Renderer {
             sample_ids: ctx.read_buffer(&t.sample_ids).map_err(RenderError::Gpu)?,
             components,
         })
+    }
+
+    /// The shadow grid as built (light-major, logarithms of the transmittances, as
+    /// [`crate::shadow::grid::GridValues`] holds them): tests compare it with the CPU twin.
+    pub fn read_shadow_grid(
+        &self,
+        ctx: &GpuContext,
+    ) -> Result<Vec<crate::shadow::grid::GridShadow>, RenderError> {
+        let v = ctx
+            .read_buffer::<[f32; 8]>(&self.shadow_grid.values)
+            .map_err(RenderError::Gpu)?;
+        Ok(v.into_iter()
+            .map(|e| crate::shadow::grid::GridShadow {
+                transmittance: e[0],
+                transmittance_f: [e[1], e[2], e[3]],
+                sigma_f2: [e[4], e[5], e[6]],
+                depth_behind: e[7],
+            })
+            .collect())
     }
 }

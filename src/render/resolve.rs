@@ -31,6 +31,10 @@ impl ResolvePass {
         }
     }
 
+    /// Encodes the resolve of image rows `rows` (all of them after visibility or an exposure change;
+    /// a band's after progressive refinement shaded it: at 720x480 on lavapipe a whole-image resolve
+    /// costs ~18 ms, which after every band was most of the refinement's time).
+    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -38,8 +42,21 @@ impl ResolvePass {
         camera: &wgpu::Buffer,
         info: &wgpu::Buffer,
         targets: &FrameTargets,
+        rows: std::ops::Range<u32>,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
+        let row0 = rows.start.min(targets.height);
+        let count = rows.end.min(targets.height).saturating_sub(row0);
+        // A storage buffer, not the uniform: lavapipe recompiles a shader per bind group whose
+        // uniforms it inlines (shadow_grid_build.wgsl).
+        let band = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("resolve rows"),
+                contents: bytemuck::cast_slice(&[row0, count, 0, 0]),
+                usage: wgpu::BufferUsages::STORAGE,
+            },
+        );
         let mut entries = vec![
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -69,6 +86,10 @@ impl ResolvePass {
                 resource: b.as_entire_binding(),
             });
         }
+        entries.push(wgpu::BindGroupEntry {
+            binding: 12,
+            resource: band.as_entire_binding(),
+        });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &self.pipeline.get_bind_group_layout(0),
@@ -80,6 +101,8 @@ impl ResolvePass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(targets.width.div_ceil(8), targets.height.div_ceil(8), 1);
+        if count > 0 {
+            pass.dispatch_workgroups(targets.width.div_ceil(8), count.div_ceil(8), 1);
+        }
     }
 }

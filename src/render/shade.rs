@@ -1,5 +1,5 @@
 //! The shading kernel on the CPU: the twin of `shaders/shading.wgsl` (same shading points, same fast
-//! response, same cone-marched transmittance) used to test the GPU end to end, and the pixel loop the
+//! response, same swept transmittance) used to test the GPU end to end, and the pixel loop the
 //! reference mode shares with it.
 
 use super::camera::{CameraUniform, closest_on_segment, pixel_ray};
@@ -15,7 +15,7 @@ use crate::scattering::dual_terms::DualTables;
 use crate::scattering::fast_params::FastHairParams;
 use crate::scattering::fast_response::{SrbfInFrame, srbf_response};
 use crate::scattering::lut::Luts;
-use crate::shadow::grid::{GridShadow, GridSources, ShadowGrid};
+use crate::shadow::grid::{GridShadow, GridValues};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -92,8 +92,9 @@ pub fn fiber_angles(frame: (Vec3, Vec3, Vec3), omega: Vec3) -> (f32, f32) {
     )
 }
 
-/// Where the shading pass reads shadows from: the grid and what it is built from.
-pub type GridShadows<'a> = (&'a ShadowGrid, &'a GridSources<'a>);
+/// Where the shading pass reads shadows from: the grid's values for the same lights, in order
+/// (`shade_point`'s light k reads the grid's light k).
+pub type GridShadows<'a> = &'a GridValues;
 
 /// `shade_point` of the WGSL: lights' R, TT, TRT radiance towards omega_o, each light scaled by its
 /// transmittance read from the shadow grid when shadows are given; with `dual` (the dual-scattering
@@ -114,7 +115,7 @@ pub fn shade_point(
     let frame = fiber_frame(sp.tangent);
     let (theta_o, phi_o) = fiber_angles(frame, omega_o);
     let mut out = [[0.0; 3]; 5];
-    for l in lights {
+    for (li, l) in lights.iter().enumerate() {
         let dir = l.dir().normalize().as_vec3();
         let lambda = l.lambda as f32;
         let (theta, phi) = fiber_angles(frame, dir);
@@ -125,7 +126,7 @@ pub fn shade_point(
                 sigma_f2: [0.0; 3],
                 depth_behind: f32::INFINITY,
             },
-            |(grid, src)| grid.shadow(src, sp.position, dir, lambda),
+            |g| g.shadow(sp.position, li),
         );
         let light = SrbfInFrame { theta, phi, lambda };
         let m = srbf_response(luts, table, &p, light, theta_o, phi_o);

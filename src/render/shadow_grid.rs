@@ -1,10 +1,11 @@
-//! The shadow-grid pass (`shaders/shadow_grid_build.wgsl`): every light's cone-marched transmittance
-//! and forward-scattering terms at every point of a coarse grid, rebuilt when the volume, the lights
-//! or the forward table change ([`crate::shadow::grid`] is the CPU twin).
+//! The shadow-grid pass (`shaders/shadow_grid_build.wgsl`): every light's transmittance and
+//! forward-scattering terms at every point of a coarse grid by light-space sweeps, one workgroup per
+//! light, rebuilt when the volume, the lights or the forward table change ([`crate::shadow::sweep`] is
+//! the CPU twin).
 
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::density_pyramid::GpuDensityPyramid;
-use crate::gpu::fiber_density::{GpuFiberDensity, dispatch_2d};
+use crate::gpu::fiber_density::GpuFiberDensity;
 use crate::gpu::shaders;
 use crate::shadow::grid::ShadowGrid;
 use bytemuck::{Pod, Zeroable};
@@ -31,6 +32,8 @@ pub struct GpuShadowGrid {
     pub grid: ShadowGrid,
     pub info: wgpu::Buffer,
     pub values: wgpu::Buffer,
+    /// Two slices of path integrals per light (three vec4 per point), the sweeps' working memory.
+    pub scratch: wgpu::Buffer,
     pub light_count: u32,
     pub forward: bool,
 }
@@ -66,14 +69,20 @@ impl GpuShadowGrid {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
+            scratch: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow sweep scratch"),
+                size: grid.largest_slice() as u64 * 2 * 48 * light_count.max(1) as u64,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
             light_count,
             forward,
         }
     }
 
-    /// Entries of the grid: (grid point, light) pairs.
+    /// Units of the build: [`SWEEP_SLOTS`] per light (its sweeps, then its values finished).
     pub fn entry_count(&self) -> u32 {
-        self.grid.point_count() as u32 * self.light_count
+        self.light_count * SWEEP_SLOTS
     }
 }
 
@@ -83,7 +92,14 @@ pub struct ShadowGridInputs<'a> {
     pub volume: &'a GpuFiberDensity,
     pub forward_table: &'a wgpu::Buffer,
     pub lights: &'a wgpu::Buffer,
+    /// Lights per group of entries (the shading pass's light batch): a group's entries run slot by
+    /// slot over its lights, so a unit of a few entries still sweeps several lights side by side.
+    pub light_group: u32,
 }
+
+/// Entries of a light in the build: its sweeps' slots (the centre, six on the ring, the centre
+/// reversed), some empty (`slot_direction` in `shaders/shadow_grid_build.wgsl`).
+pub const SWEEP_SLOTS: u32 = 8;
 
 pub struct ShadowGridPass {
     pipeline: wgpu::ComputePipeline,
@@ -100,8 +116,9 @@ impl ShadowGridPass {
         }
     }
 
-    /// Encodes the build of entries [first, first + count) (grid point fastest, light-major), the range
-    /// in a storage buffer (see `shadow_grid_build.wgsl`).
+    /// Encodes the build of entries [first, first + count) ([`SWEEP_SLOTS`] per light: its sweeps;
+    /// ordered by light group, then slot, then light; one workgroup per light of the groups touched),
+    /// the range in a storage buffer (see `shadow_grid_build.wgsl`).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -113,10 +130,23 @@ impl ShadowGridPass {
         count: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        let (x, y) = dispatch_2d(count);
+        let group = inputs.light_group.max(1);
+        let lights = target.light_count.max(1);
+        let g0 = first / (SWEEP_SLOTS * group);
+        let g1 = (first + count.max(1) - 1) / (SWEEP_SLOTS * group);
+        // The smallest group touched (only the last one may be short).
+        let smallest = group.min(lights - (g1 * group).min(lights - 1));
+        let per_entry = count <= smallest;
+        let workgroups = if per_entry {
+            count.max(1)
+        } else {
+            ((g1 + 1) * group).min(lights) - g0 * group
+        };
+        let x = workgroups.min(65535);
+        let y = workgroups.div_ceil(x);
         let range = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow grid range"),
-            contents: bytemuck::cast_slice(&[first, count, x, 0]),
+            contents: bytemuck::cast_slice(&[first, count, x, group, per_entry as u32, 0, 0, 0]),
             usage: wgpu::BufferUsages::STORAGE,
         });
         let buffers = [
@@ -129,6 +159,7 @@ impl ShadowGridPass {
             &inputs.volume.volume,
             inputs.forward_table,
             &range,
+            &target.scratch,
         ];
         let bind = bind_buffers(device, &self.pipeline, "shadow grid", &buffers, Vec::new());
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -137,6 +137,13 @@ impl DensityPyramid {
         }
     }
 
+    /// Whether p lies in the volume's box (level 0's), as `FiberDensity::voxel_at` finds it.
+    pub fn inside(&self, p: Vec3) -> bool {
+        let l = &self.levels[0];
+        let q = ((p - self.origin) / l.voxel).floor();
+        q.min_element() >= 0.0 && (0..3).all(|a| (q[a] as usize) < l.dims[a])
+    }
+
     /// Crossings per cm along omega at p, read at continuous level `lod` (linear between levels).
     pub fn crossings_at(&self, p: Vec3, omega: Vec3, lod: f32) -> f32 {
         let (a, m) = self.extinction_at(p, lod);
@@ -175,7 +182,8 @@ impl DensityPyramid {
 
     /// Whether any hair lies in the cube [p - r, p + r] (to the resolution of the finest level whose voxel
     /// is at least r / 2, or the coarsest: at most 5^3 voxels): the voxels of that level overlapping the
-    /// cube, any extinction above zero. A shadow-grid point with no hair within one grid spacing is read by no shading point.
+    /// cube, any extinction above zero. A shadow-grid point with no hair within one grid spacing plus a
+    /// voxel is read by no shading point (the tests compare the grid where it is read).
     pub fn hair_near(&self, p: Vec3, r: f32) -> bool {
         let Some(level) = self
             .levels

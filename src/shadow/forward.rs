@@ -113,12 +113,85 @@ pub struct ForwardScattering {
     pub sigma_f2: [f32; 3],
 }
 
-/// Marches a cone of half-angle `half_angle` from p towards the light (omega, unit) as
-/// [`DensityPyramid::cone_optical_depth`] does (steps of half the cone's width, pyramid levels of that
-/// width; a thin ray (0) walks level 0 at half-voxel steps), so its direct fraction is that cone's
-/// exp(-tau). The crossing density and the fibers' inclination come from the same (a, M); the
-/// absorption from the level-0 voxel at the step (an empty one holds its neighbours').
-#[allow(clippy::too_many_arguments)]
+/// The integrals of a shadow path (per cm when read at a point, `forward_integrand`; cm-weighted
+/// sums along a path): tau = integral c ds and per channel integral c (1 - a_f) ds, integral c a_f ds
+/// and integral c a_f beta_f^2 ds. Cone marches and light-space sweeps add them up alike.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PathIntegrals {
+    pub tau: f32,
+    pub loss: [f32; 3],
+    pub mass: [f32; 3],
+    pub spread: [f32; 3],
+}
+
+impl PathIntegrals {
+    /// self + h o.
+    pub fn add_scaled(&self, o: &PathIntegrals, h: f32) -> PathIntegrals {
+        PathIntegrals {
+            tau: self.tau + h * o.tau,
+            loss: std::array::from_fn(|c| self.loss[c] + h * o.loss[c]),
+            mass: std::array::from_fn(|c| self.mass[c] + h * o.mass[c]),
+            spread: std::array::from_fn(|c| self.spread[c] + h * o.spread[c]),
+        }
+    }
+
+    /// The direct fraction, T_f and sigma_f^2 of a path with these integrals.
+    pub fn scattering(&self) -> ForwardScattering {
+        ForwardScattering {
+            direct_fraction: (-self.tau).exp(),
+            transmittance_f: self.loss.map(|l| (-l).exp()),
+            sigma_f2: std::array::from_fn(|c| {
+                forward_spread_weighted(self.mass[c], self.spread[c])
+            }),
+        }
+    }
+}
+
+/// The integrands of [`PathIntegrals`] at x along omega (unit), the pyramid read at continuous level
+/// `lod`: crossings and inclination from the same (a, M), absorption from the level-0 voxel (an empty
+/// one holds its neighbours'). Zero outside the volume. Twin of `forward_integrand` in
+/// `shaders/forward_scattering.wgsl`.
+pub fn forward_integrand(
+    pyramid: &DensityPyramid,
+    volume: &FiberDensity,
+    table: &ForwardTable,
+    x: Vec3,
+    omega: Vec3,
+    lod: f32,
+) -> PathIntegrals {
+    let Some(v) = volume.voxel_at(x) else {
+        return PathIntegrals::default();
+    };
+    let (a, m) = pyramid.extinction_at(x, lod);
+    let c = crossings(a, m, omega);
+    if c <= 0.0 {
+        return PathIntegrals::default();
+    }
+    let w = omega;
+    let q = (m[0] * w.x * w.x
+        + m[1] * w.y * w.y
+        + m[2] * w.z * w.z
+        + 2.0 * (m[3] * w.x * w.y + m[4] * w.x * w.z + m[5] * w.y * w.z))
+        / a.max(1e-30);
+    let theta = q.clamp(0.0, 1.0).sqrt().asin();
+    let mut out = PathIntegrals {
+        tau: c,
+        ..Default::default()
+    };
+    for ch in 0..3 {
+        let sig = volume.absorption[v][ch];
+        let (af1, b1) = table.lookup(theta, sig);
+        let (af2, b2) = table.lookup(-theta, sig);
+        out.loss[ch] = c * (1.0 - 0.5 * (af1 + af2));
+        out.mass[ch] = c * 0.5 * (af1 + af2);
+        out.spread[ch] = c * 0.5 * (af1 * b1 + af2 * b2);
+    }
+    out
+}
+
+/// Forward scattering along the cone of half-angle `half_angle` about omega (unit) from p, marched as
+/// [`DensityPyramid::cone_optical_depth`] marches it (so the direct fraction is that cone's exp(-tau)),
+/// `skip` cm left out at the start. Twin of `forward_scattering` in `shaders/forward_scattering.wgsl`.
 pub fn forward_scattering(
     pyramid: &DensityPyramid,
     volume: &FiberDensity,
@@ -130,44 +203,15 @@ pub fn forward_scattering(
 ) -> ForwardScattering {
     let exit = pyramid.exit(p, omega);
     let tan = half_angle.min(1.5).tan();
-    let (mut tau, mut loss, mut mass, mut spread) = (0f32, [0f32; 3], [0f32; 3], [0f32; 3]);
+    let mut sums = PathIntegrals::default();
     let mut s = skip;
     while s < exit {
         let (h, lod) = pyramid.cone_step(s, tan, exit);
         let x = p + omega * (s + 0.5 * h);
         s += h;
-        let Some(v) = volume.voxel_at(x) else {
-            continue;
-        };
-        let (a, m) = pyramid.extinction_at(x, lod);
-        let c = crossings(a, m, omega);
-        if c <= 0.0 {
-            continue;
-        }
-        let w = omega;
-        let q = (m[0] * w.x * w.x
-            + m[1] * w.y * w.y
-            + m[2] * w.z * w.z
-            + 2.0 * (m[3] * w.x * w.y + m[4] * w.x * w.z + m[5] * w.y * w.z))
-            / a.max(1e-30);
-        let theta = q.clamp(0.0, 1.0).sqrt().asin();
-        tau += c * h;
-        for ch in 0..3 {
-            let sig = volume.absorption[v][ch];
-            let (af1, b1) = table.lookup(theta, sig);
-            let (af2, b2) = table.lookup(-theta, sig);
-            loss[ch] += c * h * (1.0 - 0.5 * (af1 + af2));
-            mass[ch] += c * h * 0.5 * (af1 + af2);
-            spread[ch] += c * h * 0.5 * (af1 * b1 + af2 * b2);
-        }
+        sums = sums.add_scaled(&forward_integrand(pyramid, volume, table, x, omega, lod), h);
     }
-    let direct = (-tau).exp();
-    let transmittance_f = loss.map(|l| (-l).exp());
-    ForwardScattering {
-        direct_fraction: direct,
-        transmittance_f,
-        sigma_f2: std::array::from_fn(|ch| forward_spread_weighted(mass[ch], spread[ch])),
-    }
+    sums.scattering()
 }
 
 /// sigma_f^2 = T_f W / (T_f - direct) with W = integral c a_f beta_f^2 ds. Since T_f = exp(-(tau - A)) with

@@ -1,10 +1,11 @@
-//! Per-light shadows on a coarse grid over the hair: every SRBF light's cone-marched transmittance
-//! and, for multiple scattering, its forward-scattering terms (T_f, sigma_f^2, averaged over the same
-//! cones) are evaluated once per grid point (when geometry, absorption, lights or the forward table
-//! change) and read trilinearly by the shading pass, instead of once per shaded sample and light. A
-//! camera move recomputes nothing. Twin of `shaders/shadow_grid.wgsl` and `shadow_grid_build.wgsl`.
+//! Per-light shadows on a coarse grid over the hair: every SRBF light's transmittance and, for multiple
+//! scattering, its forward-scattering terms (T_f, sigma_f^2) are evaluated once per grid point by
+//! light-space sweeps ([`super::sweep`]; when geometry, absorption, lights or the forward table change)
+//! and read trilinearly by the shading pass, instead of once per shaded sample and light. A camera
+//! move recomputes nothing. Twin of `shaders/shadow_grid.wgsl` and `shadow_grid_build.wgsl`.
+//! [`srbf_forward`] is the cone march the sweeps replaced, kept as their reference.
 
-use super::cone::{DensityPyramid, srbf_centre_cone, srbf_cones};
+use super::cone::{DensityPyramid, srbf_cones};
 use super::fiber_density::{FiberDensity, VolumeGrid};
 use super::forward::{ForwardScattering, ForwardTable, forward_scattering};
 use glam::Vec3;
@@ -15,20 +16,20 @@ pub const GRID_MIN_TRANSMITTANCE: f32 = 1e-8;
 /// What the shading pass reads per light at a point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GridShadow {
-    /// Cone-marched transmittance (the direct fraction of single scattering).
+    /// Transmittance (the direct fraction of single scattering).
     pub transmittance: f32,
     pub transmittance_f: [f32; 3],
     pub sigma_f2: [f32; 3],
-    /// Optical depth of the hair behind the point along the light's travel (the central cone of
-    /// [`srbf_cones`] marched away from the light): what the local back-scattering term has to work
-    /// with (`backscatter_depth_fraction`). 0 without multiple scattering.
+    /// Optical depth of the hair behind the point along the light's travel (a sweep along the
+    /// light's centre reversed): what the local back-scattering term has to work with
+    /// (`backscatter_depth_fraction`). 0 without multiple scattering.
     pub depth_behind: f32,
 }
 
-/// forward_scattering over the cones of `srbf_transmittance` (twin of `srbf_forward` in
-/// `shaders/shadow_grid_build.wgsl`), each cone marched with its own width, so the direct fraction is
-/// `srbf_transmittance` itself; sigma_f^2 is averaged per channel over the forward-scattered light,
-/// weights w (T_f - direct).
+/// forward_scattering over the cones of `srbf_transmittance`, each cone marched with its own width, so
+/// the direct fraction is `srbf_transmittance` itself; sigma_f^2 is averaged per channel over the
+/// forward-scattered light, weights w (T_f - direct). The cone march the grid's sweeps replaced, kept
+/// as their reference (tests).
 pub fn srbf_forward(
     pyramid: &DensityPyramid,
     volume: &FiberDensity,
@@ -84,6 +85,12 @@ impl ShadowGrid {
         }
     }
 
+    /// Points of the largest slice across an axis (a sweep's working set).
+    pub fn largest_slice(&self) -> usize {
+        let [x, y, z] = self.dims.map(|d| d as usize);
+        (x * y).max(x * z).max(y * z)
+    }
+
     pub fn point_count(&self) -> usize {
         self.dims.iter().map(|&d| d as usize).product()
     }
@@ -119,57 +126,34 @@ impl ShadowGrid {
             (i, w)
         })
     }
+}
 
-    /// What the build pass stores at grid point i for a light (transmittances as logarithms, floored
-    /// at [`GRID_MIN_TRANSMITTANCE`]).
-    /// A point with no hair within one spacing (plus a level-0 voxel: the volume deposits a segment at
-    /// samples a quarter voxel apart, so a shading point's hair may sit in the next voxel) is read by no
-    /// shading point: it is stored lit.
-    pub fn value(&self, src: &GridSources, i: usize, centre: Vec3, lambda: f32) -> GridShadow {
-        let x = self.point(i);
-        let reach = self.spacing + src.pyramid.levels.first().map_or(0.0, |l| l.voxel);
-        if !src.pyramid.hair_near(x, reach) {
-            return GridShadow::default();
-        }
-        let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
-        match src.forward {
-            None => {
-                let t = ln(src.pyramid.srbf_transmittance(x, centre, lambda, src.skip));
-                GridShadow {
-                    transmittance: t,
-                    transmittance_f: [t; 3],
-                    sigma_f2: [0.0; 3],
-                    depth_behind: 0.0,
-                }
-            }
-            Some((volume, table)) => {
-                // The forward march's direct fraction is srbf_transmittance (the same cones, steps
-                // and sums, in the same order): d_f = d_b = 0 is single scattering up to rounding.
-                let f = srbf_forward(src.pyramid, volume, table, x, centre, lambda, src.skip);
-                GridShadow {
-                    transmittance: ln(f.direct_fraction),
-                    transmittance_f: f.transmittance_f.map(ln),
-                    sigma_f2: f.sigma_f2,
-                    depth_behind: src.pyramid.cone_optical_depth(
-                        x,
-                        -centre,
-                        srbf_centre_cone(lambda),
-                        src.skip,
-                    ),
-                }
-            }
+/// Every light's stored values over the grid, built by light-space sweeps ([`super::sweep`]): the
+/// CPU twin of the GPU grid (light-major, logarithms of the transmittances).
+pub struct GridValues {
+    pub grid: ShadowGrid,
+    pub lights: Vec<Vec<GridShadow>>,
+}
+
+impl GridValues {
+    /// The values for lights given as (centre direction, lambda).
+    pub fn build(grid: ShadowGrid, src: &GridSources, lights: &[(Vec3, f32)]) -> Self {
+        Self {
+            grid,
+            lights: lights
+                .iter()
+                .map(|&(centre, lambda)| super::sweep::sweep_light(&grid, src, centre, lambda))
+                .collect(),
         }
     }
 
-    /// The grid's trilinear reading at p (of the logarithms, for the transmittances), each corner
-    /// evaluated on demand (tests).
-    pub fn shadow(&self, src: &GridSources, p: Vec3, centre: Vec3, lambda: f32) -> GridShadow {
+    /// The grid's trilinear reading at p for light `light` (of the logarithms, for the
+    /// transmittances): what the shading pass reads (`grid_shadow` in `shaders/shadow_grid.wgsl`).
+    pub fn shadow(&self, p: Vec3, light: usize) -> GridShadow {
+        let values = &self.lights[light];
         let mut out = GridShadow::default();
-        for (i, w) in self.corners(p) {
-            if w == 0.0 {
-                continue;
-            }
-            let v = self.value(src, i, centre, lambda);
+        for (i, w) in self.grid.corners(p) {
+            let v = values[i];
             out.transmittance += w * v.transmittance;
             out.depth_behind += w * v.depth_behind;
             for c in 0..3 {

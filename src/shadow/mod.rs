@@ -6,6 +6,7 @@ pub mod fiber_grid;
 pub mod forward;
 pub mod grid;
 pub mod ray_shooting;
+pub mod sweep;
 
 pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;
