@@ -171,9 +171,21 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
     let mut session = h.state().session.clone();
     session.render.width = viewport.width;
     session.render.height = viewport.height;
-    let path = dir.join("equal.slsession");
+    let cli = render_session(&dir, "equal", &session);
+    let d = max_relative_difference(&viewport, &cli);
+    println!(
+        "viewport {}x{} against render --session: max difference {d:.2e} of the peak",
+        viewport.width, viewport.height
+    );
+    assert!(d < 1e-4, "{d}");
+}
+
+/// `strandlight render --session` of `session` (saved as `dir/name.slsession`) at its render size:
+/// the EXR's beauty.
+fn render_session(dir: &Path, name: &str, session: &Session) -> Frame {
+    let path = dir.join(format!("{name}.slsession"));
     session.write(&path).expect("saved");
-    let exr = dir.join("equal.exr");
+    let exr = dir.join(format!("{name}.exr"));
     let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
         .args(["render", "--session"])
         .arg(&path)
@@ -183,13 +195,7 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    let cli = read_exr_beauty(&exr, viewport.width, viewport.height);
-    let d = max_relative_difference(&viewport, &cli);
-    println!(
-        "viewport {}x{} against render --session: max difference {d:.2e} of the peak",
-        viewport.width, viewport.height
-    );
-    assert!(d < 1e-4, "{d}");
+    read_exr_beauty(&exr, session.render.width, session.render.height)
 }
 
 /// RGBA of an EXR as a frame's beauty.
@@ -364,6 +370,36 @@ fn a_narrower_highlight_is_sharper() {
     println!("R lobe p99: beta_R 7.5 deg {wide:.4}, 3 deg {narrow:.4}");
     assert!((h.state().session.look.params.beta_r.to_degrees() - 3.0).abs() < 1e-9);
     assert!(narrow > 1.3 * wide);
+}
+
+/// The fibre thickness slider: thicker fibres shadow each other more (the hair darkens), the image
+/// equals a headless render of the same session, and undo restores the thickness.
+#[test]
+fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
+    let dir = tmp("thickness");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let thin = mean_luminance(&image(&h));
+    slider(&h, "thickness").set_value_accesskit(3.0);
+    h.step();
+    converge(&mut h);
+    let got = image(&h);
+    let thick = mean_luminance(&got);
+    println!("mean luminance: thickness x1 {thin:.4}, x3 {thick:.4}");
+    assert_eq!(h.state().session.look.thickness_scale, 3.0);
+    assert!(thick < thin, "thicker fibres shadow more");
+    // The same session rendered headless (the scene assembly scales the hair itself; the editor
+    // rewrote the renderer's points).
+    let mut session = h.state().session.clone();
+    session.render.width = got.width;
+    session.render.height = got.height;
+    let cli = render_session(&dir, "thick", &session);
+    let d = max_relative_difference(&got, &cli);
+    println!("editor against render --session: max difference {d:.2e} of the peak");
+    assert!(d < 1e-4, "{d}");
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(h.state().session.look.thickness_scale, 1.0);
 }
 
 #[test]

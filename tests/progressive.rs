@@ -256,3 +256,64 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
         assert_eq!(d, 0.0);
     }
 }
+
+/// A fiber thickness change (`set_thickness_scale`) rebuilds the volume and grid and converges to the
+/// frame of a renderer made with the scaled hair, exactly; thicker fibers darken the shadowed hair.
+#[test]
+fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
+    scene.settings.shadow_grid_resolution = 12;
+    let new = |hair: &strandlight::hair::Hair| {
+        Renderer::new(
+            &ctx,
+            scene.settings.clone(),
+            &luts,
+            hair,
+            &scene.sigma_a,
+            &scene.look,
+            &lights,
+            &scene.camera,
+        )
+        .expect("renderer")
+    };
+    let mut live = new(&scene.hair);
+    refine_all(&mut live, &ctx);
+    let before = live.read_frame(&ctx).expect("read");
+    live.set_thickness_scale(&ctx, &scene.hair, 3.0)
+        .expect("thickness");
+    let units = refine_all(&mut live, &ctx);
+    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    let got = live.read_frame(&ctx).expect("read");
+    let mut thick = scene.hair.clone();
+    thick.transform(|p| p, 3.0);
+    let mut fresh = new(&thick);
+    fresh.render_frame(&ctx);
+    let want = fresh.read_frame(&ctx).expect("read");
+    let d = difference(&want, &got);
+    let mean = |f: &strandlight::render::Frame| {
+        let n = f.covered().count().max(1) as f64;
+        f.covered().map(|i| f.beauty[i][1] as f64).sum::<f64>() / n
+    };
+    println!(
+        "thickness x3 against a renderer made with the scaled hair: {d:.1e}; mean G of hair pixels {:.4} -> {:.4}, hair pixels {} -> {}",
+        mean(&before),
+        mean(&got),
+        before.covered().count(),
+        got.covered().count()
+    );
+    assert_eq!(d, 0.0);
+    assert!(
+        mean(&got) < mean(&before),
+        "thicker fibers shadow each other more"
+    );
+    let wrong = strandlight::render::scene::generated_hair(
+        strandlight::hair::procedural::Style::Bob,
+        10,
+        4,
+        1,
+    );
+    assert!(live.set_thickness_scale(&ctx, &wrong, 2.0).is_err());
+}

@@ -68,6 +68,9 @@ pub struct RenderArgs {
     /// Per-strand variation of the absorption: log-normal with this standard deviation.
     #[arg(long, default_value_t = 0.0)]
     pub strand_variation: f32,
+    /// Multiplies every fiber's diameter (the file's, or 70 um): denser shadows, wider ribbons.
+    #[arg(long, default_value_t = 1.0)]
+    pub thickness_scale: f32,
     /// Seed of the per-strand variation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -235,6 +238,7 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
             d_f: args.d_f,
             d_b: args.d_b,
             longitudinal: args.params.longitudinal.unwrap_or_default(),
+            thickness_scale: args.thickness_scale,
         },
         camera: ViewCamera {
             yaw: args.yaw.unwrap_or(preset_yaw),

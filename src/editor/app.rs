@@ -129,6 +129,9 @@ pub struct EditorApp {
     painted_converged: bool,
     /// Set by wgpu when the device is lost (reason and message).
     device_lost: Arc<std::sync::Mutex<Option<String>>>,
+    /// The first GPU validation error since the last report (wgpu's default handler panics: a
+    /// resource made on a device that is being lost, say, must not take the session down).
+    gpu_error: Arc<std::sync::Mutex<Option<String>>>,
     last_frame: Option<Instant>,
     ctx: egui::Context,
 }
@@ -210,6 +213,7 @@ impl EditorApp {
             frame_ms: 0.0,
             painted_converged: false,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
+            gpu_error: Arc::new(std::sync::Mutex::new(None)),
             last_frame: None,
             ctx: cc.egui_ctx.clone(),
         };
@@ -221,6 +225,16 @@ impl EditorApp {
                 }
                 wake.request_repaint();
             });
+            let (first, wake) = (app.gpu_error.clone(), app.ctx.clone());
+            g.device
+                .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                    if let Ok(mut f) = first.lock()
+                        && f.is_none()
+                    {
+                        *f = Some(e.to_string());
+                    }
+                    wake.request_repaint();
+                }));
         }
         app.load_scene();
         app
@@ -230,7 +244,11 @@ impl EditorApp {
     /// (eframe owns the device; the editor cannot recreate it, a restart offers the recovery).
     fn check_device(&mut self) {
         let lost = self.device_lost.lock().ok().and_then(|mut f| f.take());
+        let error = self.gpu_error.lock().ok().and_then(|mut f| f.take());
         let Some(why) = lost else {
+            if let Some(e) = error {
+                self.message(Level::Error, format!("GPU error: {e}"));
+            }
             return;
         };
         self.export = None;

@@ -163,6 +163,9 @@ impl LiveScene {
             tables,
         )?;
         renderer.set_unit_budget(unit_budget(&ctx));
+        if session.look.thickness_scale != 1.0 {
+            renderer.set_thickness_scale(&ctx, &hair.hair, session.look.thickness_scale)?;
+        }
         let display = DisplayPass::new(&ctx.device, width, height);
         Ok(Self {
             bounds: hair.hair.bounds(),
@@ -216,8 +219,17 @@ impl LiveScene {
                 || new.strand_variation != old.strand_variation
                 || new.variation_seed != old.variation_seed
                 || session.paint != self.applied.paint;
+            let thickness_changed = new.thickness_scale != old.thickness_scale;
             // Applied before anything can fail, so a failure is reported once, not every frame.
             self.applied.look = session.look;
+            if thickness_changed {
+                session.look.validate().map_err(AssembleError::Look)?;
+                self.renderer.set_thickness_scale(
+                    &self.ctx,
+                    &self.hair,
+                    session.look.thickness_scale,
+                )?;
+            }
             self.applied.paint = session.paint.clone();
             let look = if absorption_changed {
                 let (sigma_a, look) =

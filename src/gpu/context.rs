@@ -210,6 +210,30 @@ pub fn compute_pipeline(
     })
 }
 
+/// A buffer holding `contents`, as `DeviceExt::create_buffer_init` makes it, except that a lost
+/// device does not panic: wgpu's helper unwraps the mapping, which fails once the device is gone, and
+/// the frame loop makes small buffers per unit (a lost device must reach the editor as an error).
+pub fn buffer_init(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let align = wgpu::COPY_BUFFER_ALIGNMENT;
+    let size = (contents.len() as u64).div_ceil(align).max(1) * align;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage,
+        mapped_at_creation: true,
+    });
+    if let Ok(mut view) = buffer.get_mapped_range_mut(..) {
+        view.slice(..contents.len()).copy_from_slice(contents);
+    }
+    buffer.unmap();
+    buffer
+}
+
 /// A bind group for group 0 of `pipeline`: `buffers` at bindings 0, 1, ... and the `extra` entries.
 pub fn bind_buffers(
     device: &wgpu::Device,

@@ -34,15 +34,23 @@ pub struct GpuHair {
 }
 
 impl GpuHair {
-    pub fn new(device: &wgpu::Device, hair: &Hair, sigma_a: &[[f32; 3]]) -> Self {
+    /// (xyz, diameter x `thickness_scale`) per point, as the points buffer holds them.
+    pub fn point_data(hair: &Hair, thickness_scale: f32) -> Vec<[f32; 4]> {
         let mut points = Vec::with_capacity(hair.point_count());
+        for s in 0..hair.strand_count() {
+            for p in hair.strand_range(s) {
+                let x = hair.positions[p];
+                points.push([x.x, x.y, x.z, hair.thickness_at(s, p) * thickness_scale]);
+            }
+        }
+        points
+    }
+
+    pub fn new(device: &wgpu::Device, hair: &Hair, sigma_a: &[[f32; 3]]) -> Self {
+        let points = Self::point_data(hair, 1.0);
         let mut segments = Vec::new();
         for s in 0..hair.strand_count() {
             let r = hair.strand_range(s);
-            for p in r.clone() {
-                let x = hair.positions[p];
-                points.push([x.x, x.y, x.z, hair.thickness_at(s, p)]);
-            }
             segments.extend((r.start as u32)..(r.end as u32 - 1));
         }
         let absorption: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();

@@ -1,15 +1,17 @@
 //! Progressive refinement, the editor's frame loop: a frame's work cut into units, at most one in
 //! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
-//! are sized from the measured cost of the units before them to a time budget, so egui, which shares the
-//! queue, does not wait behind a long submission (the volume and visibility units are whole passes, not
-//! sized; a unit of one row or one sweep can still pass the budget). The units: the fiber-density
-//! volume (when geometry or absorption changed), the shadow grid in ranges of sweeps (eight entries per
-//! light, one per direction; when the volume, the lights or the forward table changed), visibility, then every shading
-//! batch (a light batch at one visibility sample) in bands of rows, each band followed by a resolve so
-//! the image fills in; the grid's lights of a light batch are built just before the first shading
-//! batch that reads them, so the image appears after one light batch's grid, not the whole grid. Every pixel takes its batches in `render_frame`'s order, so the converged image is
-//! `render_frame`'s bit for bit. A change (parameters, camera, lights, absorption) restarts the plan; a
-//! camera move keeps what the shadow grid has built.
+//! are sized from the measured cost of the units before them (row bands from each row's own cost in
+//! earlier batches) to a time budget, so egui, which shares the queue, does not wait behind a long
+//! submission (the volume and visibility units are whole passes, not sized; a unit of one row or one
+//! sweep can still pass the budget). The units: the fiber-density volume (when geometry or absorption
+//! changed), the shadow grid in ranges of sweeps (eight entries per light, one per direction; when the
+//! volume, the lights or the forward table changed), visibility, then every shading batch (a light
+//! batch at one visibility sample) in bands of rows, each band followed by a resolve of its rows so the
+//! image fills in; the grid's entries for a light batch are built just before the first shading batch
+//! that reads them, so the image appears after one light batch's grid, not the whole grid. Every pixel
+//! takes its batches in `render_frame`'s order, so the converged image is `render_frame`'s bit for bit.
+//! A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what the
+//! shadow grid has built.
 
 use super::renderer::{RenderError, Renderer};
 use super::shading::{ShadeBatch, ShadingPass};

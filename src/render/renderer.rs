@@ -52,6 +52,8 @@ pub enum RenderError {
     Samples(u32),
     #[error("{points} points in the hair but {absorption} absorption values")]
     AbsorptionCount { points: usize, absorption: usize },
+    #[error("the renderer has {renderer} hair points, the hair given has {given}")]
+    HairPoints { renderer: usize, given: usize },
     #[error("{0} hair segments; the visibility pass names at most 2^24")]
     TooManySegments(usize),
     #[error("{what} needs {bytes} bytes, more than the GPU binds in one buffer ({limit})")]
@@ -677,6 +679,28 @@ impl Renderer {
         }
         self.mark_shadow_grid_dirty();
         self.update_batches(&ctx.device);
+    }
+
+    /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
+    /// the one the renderer was made with): the points are rewritten and the volume, and with it the
+    /// shadow grid, rebuilt; the ribbons in the view follow at once.
+    pub fn set_thickness_scale(
+        &mut self,
+        ctx: &GpuContext,
+        hair: &Hair,
+        thickness_scale: f32,
+    ) -> Result<(), RenderError> {
+        if hair.point_count() != self.point_count {
+            return Err(RenderError::HairPoints {
+                renderer: self.point_count,
+                given: hair.point_count(),
+            });
+        }
+        let points = GpuHair::point_data(hair, thickness_scale);
+        ctx.queue
+            .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        self.mark_volume_dirty();
+        Ok(())
     }
 
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).

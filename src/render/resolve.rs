@@ -1,7 +1,7 @@
 //! The resolve pass (`shaders/resolve.wgsl`): coverage, depth, sample ids and the exposed beauty.
 
 use super::targets::FrameTargets;
-use crate::gpu::context::compute_pipeline;
+use crate::gpu::context::{buffer_init, compute_pipeline};
 use crate::gpu::shaders;
 use bytemuck::{Pod, Zeroable};
 
@@ -49,13 +49,11 @@ impl ResolvePass {
         let count = rows.end.min(targets.height).saturating_sub(row0);
         // A storage buffer, not the uniform: lavapipe recompiles a shader per bind group whose
         // uniforms it inlines (shadow_grid_build.wgsl).
-        let band = wgpu::util::DeviceExt::create_buffer_init(
+        let band = buffer_init(
             device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("resolve rows"),
-                contents: bytemuck::cast_slice(&[row0, count, 0, 0]),
-                usage: wgpu::BufferUsages::STORAGE,
-            },
+            "resolve rows",
+            bytemuck::cast_slice(&[row0, count, 0, 0]),
+            wgpu::BufferUsages::STORAGE,
         );
         let mut entries = vec![
             wgpu::BindGroupEntry {

@@ -7,7 +7,6 @@ use super::targets::FrameTargets;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
@@ -63,11 +62,12 @@ pub struct ShadingPass {
 }
 
 fn batch_uniform(device: &wgpu::Device, b: &ShadeBatch) -> wgpu::Buffer {
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("shade batch"),
-        contents: bytemuck::bytes_of(b),
-        usage: wgpu::BufferUsages::UNIFORM,
-    })
+    crate::gpu::context::buffer_init(
+        device,
+        "shade batch",
+        bytemuck::bytes_of(b),
+        wgpu::BufferUsages::UNIFORM,
+    )
 }
 
 impl ShadingPass {

@@ -3,7 +3,7 @@
 //! light, rebuilt when the volume, the lights or the forward table change ([`crate::shadow::sweep`] is
 //! the CPU twin).
 
-use crate::gpu::context::{bind_buffers, compute_pipeline};
+use crate::gpu::context::{bind_buffers, buffer_init, compute_pipeline};
 use crate::gpu::density_pyramid::GpuDensityPyramid;
 use crate::gpu::fiber_density::GpuFiberDensity;
 use crate::gpu::shaders;
@@ -144,11 +144,12 @@ impl ShadowGridPass {
         };
         let x = workgroups.min(65535);
         let y = workgroups.div_ceil(x);
-        let range = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shadow grid range"),
-            contents: bytemuck::cast_slice(&[first, count, x, group, per_entry as u32, 0, 0, 0]),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let range = buffer_init(
+            device,
+            "shadow grid range",
+            bytemuck::cast_slice(&[first, count, x, group, per_entry as u32, 0, 0, 0]),
+            wgpu::BufferUsages::STORAGE,
+        );
         let buffers = [
             &inputs.pyramid.info_buffer,
             &inputs.pyramid.pyramid,

@@ -184,11 +184,13 @@ impl Scene {
     /// The scene from an already loaded hair and environment (the editor reloads only what changed).
     pub fn from_parts(
         session: &Session,
-        hair: LoadedHairSource,
+        mut hair: LoadedHairSource,
         mut environment: Environment,
         env_warning: Option<String>,
     ) -> Result<Self, AssembleError> {
         let (sigma_a, look) = absorption(&session.look, &hair.hair, session.paint.as_deref())?;
+        // The look's thickness scale (after absorption, which validated the look).
+        hair.hair.transform(|p| p, session.look.thickness_scale);
         environment.lights = turned_lights(&environment.lights, session.env_yaw);
         let r = &session.render;
         let (lo, hi) = hair.hair.bounds();

@@ -106,10 +106,18 @@ pub struct Look {
     pub d_b: f32,
     #[serde(default)]
     pub longitudinal: LongitudinalModel,
+    /// Multiplies every fiber's diameter (the file's, or 70 um): the fiber density volume's optical
+    /// depth and the ribbons' width in the view scale with it.
+    #[serde(default = "unit_scale")]
+    pub thickness_scale: f32,
 }
 
 fn one() -> u64 {
     1
+}
+
+fn unit_scale() -> f32 {
+    1.0
 }
 
 impl Look {
@@ -123,6 +131,7 @@ impl Look {
             d_f: 0.7,
             d_b: 0.7,
             longitudinal: LongitudinalModel::Normalized,
+            thickness_scale: 1.0,
         }
     }
 
@@ -139,6 +148,12 @@ impl Look {
             return Err(format!(
                 "d_f and d_b lie in [0, 1], got {} and {}",
                 self.d_f, self.d_b
+            ));
+        }
+        if !(self.thickness_scale.is_finite() && (0.05..=20.0).contains(&self.thickness_scale)) {
+            return Err(format!(
+                "the fiber thickness scale lies in [0.05, 20], got {}",
+                self.thickness_scale
             ));
         }
         if !(self.strand_variation.is_finite() && (0.0..=2.0).contains(&self.strand_variation)) {

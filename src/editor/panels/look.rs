@@ -48,6 +48,18 @@ pub fn panel(ui: &mut egui::Ui, current: &Look) -> Option<(Look, bool)> {
     ui.separator();
 
     ui.strong("Fibre");
+    c = c.or(slider32(
+        ui,
+        "thickness",
+        &mut look.thickness_scale,
+        0.25..=4.0,
+        "×",
+        2,
+        defaults.thickness_scale,
+        "Multiplies every fibre's diameter (the file's, or 70 µm): thicker fibres shadow each other \
+         more (the fibre-density volume's optical depth grows with the diameter) and their ribbons in \
+         the view widen (at least a pixel)",
+    ));
     let p = &mut look.params;
     let d = &defaults.params;
     c = c.or(slider(
