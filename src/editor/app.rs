@@ -132,6 +132,8 @@ pub struct EditorApp {
     /// The first GPU validation error since the last report (wgpu's default handler panics: a
     /// resource made on a device that is being lost, say, must not take the session down).
     gpu_error: Arc<std::sync::Mutex<Option<String>>>,
+    /// A GPU error was shown (one message, not one per frame).
+    gpu_error_shown: bool,
     last_frame: Option<Instant>,
     ctx: egui::Context,
 }
@@ -214,6 +216,7 @@ impl EditorApp {
             painted_converged: false,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
+            gpu_error_shown: false,
             last_frame: None,
             ctx: cc.egui_ctx.clone(),
         };
@@ -246,7 +249,10 @@ impl EditorApp {
         let lost = self.device_lost.lock().ok().and_then(|mut f| f.take());
         let error = self.gpu_error.lock().ok().and_then(|mut f| f.take());
         let Some(why) = lost else {
-            if let Some(e) = error {
+            if let Some(e) = error
+                && !self.gpu_error_shown
+            {
+                self.gpu_error_shown = true;
                 self.message(Level::Error, format!("GPU error: {e}"));
             }
             return;

@@ -112,6 +112,8 @@ pub struct LiveScene {
     pub display: DisplayPass,
     pub texture: Option<egui::TextureId>,
     applied: Applied,
+    /// The fibre thickness scale the renderer's points have.
+    thickness_scale: f32,
     /// The mean absorption of the points (the dual tables' sigma_a), kept while only the look's other
     /// parameters change.
     mean_sigma_a: [f64; 3],
@@ -178,6 +180,7 @@ impl LiveScene {
             display,
             texture: None,
             mean_sigma_a: look.params.sigma_a,
+            thickness_scale: session.look.thickness_scale,
             applied: Applied {
                 look: session.look,
                 paint: session.paint.clone(),
@@ -219,17 +222,8 @@ impl LiveScene {
                 || new.strand_variation != old.strand_variation
                 || new.variation_seed != old.variation_seed
                 || session.paint != self.applied.paint;
-            let thickness_changed = new.thickness_scale != old.thickness_scale;
             // Applied before anything can fail, so a failure is reported once, not every frame.
             self.applied.look = session.look;
-            if thickness_changed {
-                session.look.validate().map_err(AssembleError::Look)?;
-                self.renderer.set_thickness_scale(
-                    &self.ctx,
-                    &self.hair,
-                    session.look.thickness_scale,
-                )?;
-            }
             self.applied.paint = session.paint.clone();
             let look = if absorption_changed {
                 let (sigma_a, look) =
@@ -287,6 +281,21 @@ impl LiveScene {
         if *camera != self.applied.camera {
             self.renderer.set_camera(&self.ctx, camera);
             self.applied.camera = *camera;
+            changed = true;
+        }
+        // The fibre thickness, against what the renderer has (not the applied look: a look that failed
+        // validation for another field must not leave the renderer's diameters behind).
+        let t = session.look.thickness_scale;
+        if t != self.thickness_scale {
+            self.thickness_scale = t;
+            if !(t.is_finite() && (0.05..=20.0).contains(&t)) {
+                return Err(AssembleError::Look(format!(
+                    "the fiber thickness scale lies in [0.05, 20], got {t}"
+                ))
+                .into());
+            }
+            self.renderer
+                .set_thickness_scale(&self.ctx, &self.hair, t)?;
             changed = true;
         }
         if changed {

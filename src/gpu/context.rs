@@ -227,10 +227,12 @@ pub fn buffer_init(
         usage,
         mapped_at_creation: true,
     });
+    // On a lost device the buffer is invalid and never mapped: unmapping it would be one more error.
     if let Ok(mut view) = buffer.get_mapped_range_mut(..) {
         view.slice(..contents.len()).copy_from_slice(contents);
+        drop(view);
+        buffer.unmap();
     }
-    buffer.unmap();
     buffer
 }
 

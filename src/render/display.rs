@@ -7,7 +7,6 @@ use super::targets::FrameTargets;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
-use wgpu::util::DeviceExt;
 
 pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -149,11 +148,13 @@ impl DisplayPass {
         let info = DisplayInfo::new(width, height, ViewTransform::Filmic, 0.0, [0.0; 3]);
         Self {
             pipeline: compute_pipeline(device, &module, "display"),
-            info: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("display info"),
-                contents: bytemuck::bytes_of(&info),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            }),
+            // Made at every viewport resize: without wgpu's panicking helper (buffer_init).
+            info: crate::gpu::context::buffer_init(
+                device,
+                "display info",
+                bytemuck::bytes_of(&info),
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            ),
             view: texture.create_view(&Default::default()),
             texture,
             width,

@@ -657,13 +657,12 @@ impl Renderer {
         let v = gpu_lights(lights);
         let bytes: &[u8] = bytemuck::cast_slice(&v);
         if bytes.len() as u64 > self.lights.size() {
-            self.lights = ctx
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("lights"),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                });
+            self.lights = crate::gpu::context::buffer_init(
+                &ctx.device,
+                "lights",
+                bytes,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            );
         } else {
             ctx.queue.write_buffer(&self.lights, 0, bytes);
         }

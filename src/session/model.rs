@@ -108,7 +108,7 @@ pub struct Look {
     pub longitudinal: LongitudinalModel,
     /// Multiplies every fiber's diameter (the file's, or 70 um): the fiber density volume's optical
     /// depth and the ribbons' width in the view scale with it.
-    #[serde(default = "unit_scale")]
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub thickness_scale: f32,
 }
 
@@ -118,6 +118,10 @@ fn one() -> u64 {
 
 fn unit_scale() -> f32 {
     1.0
+}
+
+fn is_unit_scale(s: &f32) -> bool {
+    *s == 1.0
 }
 
 impl Look {

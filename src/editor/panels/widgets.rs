@@ -38,7 +38,9 @@ pub fn slider(
                     .text(label)
                     .suffix(suffix)
                     .fixed_decimals(decimals)
-                    .clamping(egui::SliderClamping::Always),
+                    // Only the user's edits: with Always, drawing a session's value outside the
+                    // range (or with more decimals) rewrote it and recorded an edit.
+                    .clamping(egui::SliderClamping::Edits),
             )
             .on_hover_text(tooltip);
         out.changed |= r.changed();
