@@ -309,6 +309,23 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
         mean(&got) < mean(&before),
         "thicker fibers shadow each other more"
     );
+    // Deferred (the editor's slider): back to 1x, the first image rebuilds no volume, then the
+    // stale volume is rebuilt and the frame is the first renderer's again.
+    live.set_thickness_scale_deferred(&ctx, &scene.hair, 1.0)
+        .expect("thickness");
+    assert!(live.volume_stale());
+    let units = refine_all(&mut live, &ctx);
+    assert!(
+        units
+            .iter()
+            .all(|u| matches!(u, WorkUnit::Visibility | WorkUnit::Shade { .. })),
+        "the first image rebuilds nothing"
+    );
+    assert!(live.rebuild_stale_volume());
+    let units = refine_all(&mut live, &ctx);
+    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    let back = live.read_frame(&ctx).expect("read");
+    assert_eq!(difference(&before, &back), 0.0);
     let wrong = strandlight::render::scene::generated_hair(
         strandlight::hair::procedural::Style::Bob,
         10,

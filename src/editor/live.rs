@@ -294,8 +294,9 @@ impl LiveScene {
                 ))
                 .into());
             }
+            // Shown at once with the old volume and grid, which follow the first image (`step`).
             self.renderer
-                .set_thickness_scale(&self.ctx, &self.hair, t)?;
+                .set_thickness_scale_deferred(&self.ctx, &self.hair, t)?;
             changed = true;
         }
         if changed {

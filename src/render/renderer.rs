@@ -702,6 +702,38 @@ impl Renderer {
         Ok(())
     }
 
+    /// [`Renderer::set_thickness_scale`] for the editor: the ribbons' new width shows at once and, with
+    /// shadows, the first image is shaded with the old volume and grid, which
+    /// [`Renderer::rebuild_stale_volume`] rebuilds after it (a slider drag is not a volume rebuild
+    /// per frame). Without shadows nothing reads the volume until they are turned on: it is rebuilt
+    /// then.
+    pub fn set_thickness_scale_deferred(
+        &mut self,
+        ctx: &GpuContext,
+        hair: &Hair,
+        thickness_scale: f32,
+    ) -> Result<(), RenderError> {
+        if hair.point_count() != self.point_count {
+            return Err(RenderError::HairPoints {
+                renderer: self.point_count,
+                given: hair.point_count(),
+            });
+        }
+        let points = GpuHair::point_data(hair, thickness_scale);
+        ctx.queue
+            .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        if self.volume_dirty {
+            return Ok(());
+        }
+        if self.settings.shadows && self.light_count > 0 {
+            self.volume_stale = true;
+            self.restart_refinement();
+        } else {
+            self.mark_volume_dirty();
+        }
+        Ok(())
+    }
+
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
