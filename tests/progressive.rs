@@ -195,6 +195,28 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
 /// (the editor's dye and melanin edits) shades at once, rebuilds no volume or grid, and converges to
 /// the image of a renderer that rebuilt both. With multiple scattering the volume waits for
 /// `rebuild_stale_volume`, and then the image is the new absorption's.
+/// A renderer of `scene` with its settings, look and camera, on `hair` with `sigma_a`.
+fn bob_renderer(
+    ctx: &GpuContext,
+    luts: &Luts,
+    scene: &common::BobScene,
+    hair: &strandlight::hair::Hair,
+    sigma_a: &[[f32; 3]],
+    lights: &[strandlight::envmap::SrbfLight],
+) -> Renderer {
+    Renderer::new(
+        ctx,
+        scene.settings.clone(),
+        luts,
+        hair,
+        sigma_a,
+        &scene.look,
+        lights,
+        &scene.camera,
+    )
+    .expect("renderer")
+}
+
 #[test]
 fn deferred_absorption_rebuilds_only_what_reads_it() {
     let ctx = context();
@@ -203,19 +225,8 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
     for multiple in [false, true] {
         let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), multiple);
         scene.settings.shadow_grid_resolution = 12;
-        let new = |sigma_a: &[[f32; 3]]| {
-            Renderer::new(
-                &ctx,
-                scene.settings.clone(),
-                &luts,
-                &scene.hair,
-                sigma_a,
-                &scene.look,
-                &lights,
-                &scene.camera,
-            )
-            .expect("renderer")
-        };
+        let new =
+            |sigma_a: &[[f32; 3]]| bob_renderer(&ctx, &luts, &scene, &scene.hair, sigma_a, &lights);
         let mut live = new(&scene.sigma_a);
         refine_all(&mut live, &ctx);
         // Darker tips: the second half of every strand's points.
@@ -267,17 +278,7 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
     scene.settings.shadow_grid_resolution = 12;
     let new = |hair: &strandlight::hair::Hair| {
-        Renderer::new(
-            &ctx,
-            scene.settings.clone(),
-            &luts,
-            hair,
-            &scene.sigma_a,
-            &scene.look,
-            &lights,
-            &scene.camera,
-        )
-        .expect("renderer")
+        bob_renderer(&ctx, &luts, &scene, hair, &scene.sigma_a, &lights)
     };
     let mut live = new(&scene.hair);
     refine_all(&mut live, &ctx);

@@ -680,11 +680,9 @@ impl Renderer {
         self.update_batches(&ctx.device);
     }
 
-    /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
-    /// the one the renderer was made with): the points are rewritten and the volume, and with it the
-    /// shadow grid, rebuilt; the ribbons in the view follow at once.
-    pub fn set_thickness_scale(
-        &mut self,
+    /// Rewrites the points buffer with `hair`'s diameters times `thickness_scale`.
+    fn write_thickness(
+        &self,
         ctx: &GpuContext,
         hair: &Hair,
         thickness_scale: f32,
@@ -698,6 +696,19 @@ impl Renderer {
         let points = GpuHair::point_data(hair, thickness_scale);
         ctx.queue
             .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        Ok(())
+    }
+
+    /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
+    /// the one the renderer was made with): the points are rewritten and the volume, and with it the
+    /// shadow grid, rebuilt; the ribbons in the view follow at once.
+    pub fn set_thickness_scale(
+        &mut self,
+        ctx: &GpuContext,
+        hair: &Hair,
+        thickness_scale: f32,
+    ) -> Result<(), RenderError> {
+        self.write_thickness(ctx, hair, thickness_scale)?;
         self.mark_volume_dirty();
         Ok(())
     }
@@ -713,15 +724,7 @@ impl Renderer {
         hair: &Hair,
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
-        if hair.point_count() != self.point_count {
-            return Err(RenderError::HairPoints {
-                renderer: self.point_count,
-                given: hair.point_count(),
-            });
-        }
-        let points = GpuHair::point_data(hair, thickness_scale);
-        ctx.queue
-            .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        self.write_thickness(ctx, hair, thickness_scale)?;
         if self.volume_dirty {
             return Ok(());
         }
