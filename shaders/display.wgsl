@@ -1,6 +1,7 @@
 // Display pass: the resolved beauty (linear, premultiplied by coverage) through the viewport's view
 // transform into an 8-bit sRGB-encoded image over a flat background (egui samples it as Rgba8Unorm).
-// The EXR never passes here. CPU twin: render/display.rs (`display_pixel`).
+// A smaller image (the preview) is sampled bilinearly, premultiplied. The EXR never passes here.
+// CPU twin: render/display.rs (`source_sample`, `display_pixel`).
 
 struct DisplayInfo {
     width: u32,
@@ -13,6 +14,8 @@ struct DisplayInfo {
     exposure_scale: f32,
     // 2^EV of the render's exposure (the beauty has it; the components do not).
     render_scale: f32,
+    // Size of the image read (the display's, or the preview's).
+    source: vec2<u32>,
     // Background, display-encoded.
     background: vec3<f32>,
 }
@@ -60,11 +63,39 @@ fn display_pixel(beauty_px: vec4<f32>, solo_px: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(mix(info.background, c, a), 1.0);
 }
 
+struct SourceTaps {
+    i00: u32,
+    i10: u32,
+    i01: u32,
+    i11: u32,
+    f: vec2<f32>,
+}
+
+// The source pixels under display pixel `id` and their bilinear weights (pixel centres aligned).
+fn source_taps(id: vec2<u32>) -> SourceTaps {
+    let s = max(info.source, vec2<u32>(1u));
+    let p = max((vec2<f32>(id) + 0.5) * vec2<f32>(s) / vec2<f32>(f32(info.width), f32(info.height)) - 0.5, vec2<f32>(0.0));
+    let c0 = min(vec2<u32>(floor(p)), s - 1u);
+    let c1 = min(c0 + 1u, s - 1u);
+    return SourceTaps(c0.y * s.x + c0.x, c0.y * s.x + c1.x, c1.y * s.x + c0.x, c1.y * s.x + c1.x, p - floor(p));
+}
+
+fn bilinear(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, f: vec2<f32>) -> vec4<f32> {
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
 @compute @workgroup_size(8, 8)
 fn display(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= info.width || id.y >= info.height {
         return;
     }
-    let i = id.y * info.width + id.x;
-    textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i]));
+    if all(info.source == vec2<u32>(info.width, info.height)) {
+        let i = id.y * info.width + id.x;
+        textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i]));
+        return;
+    }
+    let t = source_taps(id.xy);
+    let b = bilinear(beauty[t.i00], beauty[t.i10], beauty[t.i01], beauty[t.i11], t.f);
+    let c = bilinear(component[t.i00], component[t.i10], component[t.i01], component[t.i11], t.f);
+    textureStore(image, vec2<i32>(id.xy), display_pixel(b, c));
 }

@@ -11,6 +11,8 @@
 
 const FLAG_SHADOWS: u32 = 1u;
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
+// `ShadeBatch.slot` of the preview's dispatches: every pixel shades one segment, not each distinct one.
+const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 
 struct ShadeBatch {
     first: u32,
@@ -128,20 +130,38 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = y * camera.size.x + id.x;
     // This dispatch handles visibility sample `batch.slot` of every pixel: its segment is shaded if no
     // earlier sample of the pixel holds the same segment, weighted by the fraction of samples it
-    // covers. (One shading call per invocation: looping over a pixel's segments inside one invocation
+    // covers (or, for the preview, the pixel's representative sample). (One shading call per invocation: looping over a pixel's segments inside one invocation
     // gave wrong sums on lavapipe.)
-    let v = u32(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
-    if (v == 0u) {
-        return;
-    }
+    var v = 0u;
     var count = 0u;
-    for (var s = 0u; s < batch.samples; s++) {
-        let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
-        if (other == v) {
-            if (s < batch.slot) {
-                return;
+    if (batch.slot == SLOT_REPRESENTATIVE) {
+        // The preview: one shading per pixel, the first covered sample's segment standing for every
+        // covered sample (representative_sample in shade.rs).
+        for (var s = 0u; s < batch.samples; s++) {
+            let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
+            if (other != 0u) {
+                if (v == 0u) {
+                    v = other;
+                }
+                count = count + 1u;
             }
-            count = count + 1u;
+        }
+        if (v == 0u) {
+            return;
+        }
+    } else {
+        v = u32(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
+        if (v == 0u) {
+            return;
+        }
+        for (var s = 0u; s < batch.samples; s++) {
+            let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
+            if (other == v) {
+                if (s < batch.slot) {
+                    return;
+                }
+                count = count + 1u;
+            }
         }
     }
     let ray = pixel_ray(camera, f32(xy.x) + 0.5, f32(xy.y) + 0.5);

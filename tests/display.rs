@@ -1,9 +1,11 @@
-//! The viewport's display pass (shaders/display.wgsl) against its CPU twin `display_pixel`, on lavapipe:
-//! both view transforms, the viewport exposure, partial coverage over the background, and a solo
-//! component.
+//! The viewport's display pass (shaders/display.wgsl) against its CPU twin (`source_sample`,
+//! `display_pixel`), on lavapipe: both view transforms, the viewport exposure, partial coverage over the
+//! background, a solo component, and a smaller image (the preview) enlarged bilinearly.
 
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform, display_pixel};
+use strandlight::render::display::{
+    DisplayInfo, DisplayPass, Solo, ViewTransform, display_pixel, source_sample,
+};
 use strandlight::render::targets::FrameTargets;
 
 #[test]
@@ -28,34 +30,42 @@ fn the_display_pass_matches_its_cpu_twin() {
         .write_buffer(&targets.beauty, 0, bytemuck::cast_slice(&beauty));
     ctx.queue
         .write_buffer(&targets.components[1], 0, bytemuck::cast_slice(&component));
-    let pass = DisplayPass::new(&ctx.device, w, h);
     let mut worst = 0.0f32;
-    for (transform, ev, solo) in [
-        (ViewTransform::Filmic, 0.0, Solo::Beauty),
-        (ViewTransform::Standard, 0.0, Solo::Beauty),
-        (ViewTransform::Filmic, 1.5, Solo::Beauty),
-        (ViewTransform::Standard, -1.0, Solo::Component(1)),
-    ] {
-        let info = DisplayInfo {
-            render_scale: 2.0,
-            ..DisplayInfo::new(w, h, transform, ev, [0.2, 0.3, 0.4])
-        };
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        pass.encode(&ctx.device, &ctx.queue, &mut enc, &targets, &info, solo);
-        let (buffer, row) = pass.copy_to_buffer(&ctx.device, &mut enc);
-        ctx.queue.submit([enc.finish()]);
-        let bytes: Vec<u8> = ctx.read_buffer(&buffer).expect("read back");
-        let cpu_info = DisplayInfo {
-            solo: matches!(solo, Solo::Component(_)) as u32,
-            ..info
-        };
-        for y in 0..h as usize {
-            for x in 0..w as usize {
-                let i = y * w as usize + x;
-                let want = display_pixel(&cpu_info, beauty[i], component[i]);
-                for c in 0..4 {
-                    let got = bytes[y * row as usize + 4 * x + c] as f32 / 255.0;
-                    worst = worst.max((got - want[c]).abs());
+    // The display at the image's size, and larger than it (a preview: 3x wider, not a whole multiple).
+    for (dw, dh) in [(w, h), (3 * w - 2, 3 * h + 1)] {
+        let pass = DisplayPass::new(&ctx.device, dw, dh);
+        for (transform, ev, solo) in [
+            (ViewTransform::Filmic, 0.0, Solo::Beauty),
+            (ViewTransform::Standard, 0.0, Solo::Beauty),
+            (ViewTransform::Filmic, 1.5, Solo::Beauty),
+            (ViewTransform::Standard, -1.0, Solo::Component(1)),
+        ] {
+            let info = DisplayInfo {
+                render_scale: 2.0,
+                ..DisplayInfo::new(dw, dh, transform, ev, [0.2, 0.3, 0.4])
+            };
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            pass.encode(&ctx.device, &ctx.queue, &mut enc, &targets, &info, solo);
+            let (buffer, row) = pass.copy_to_buffer(&ctx.device, &mut enc);
+            ctx.queue.submit([enc.finish()]);
+            let bytes: Vec<u8> = ctx.read_buffer(&buffer).expect("read back");
+            let cpu_info = DisplayInfo {
+                solo: matches!(solo, Solo::Component(_)) as u32,
+                source: [w, h],
+                ..info
+            };
+            for y in 0..dh {
+                for x in 0..dw {
+                    let want = display_pixel(
+                        &cpu_info,
+                        source_sample(&cpu_info, &beauty, x, y),
+                        source_sample(&cpu_info, &component, x, y),
+                    );
+                    for c in 0..4 {
+                        let got =
+                            bytes[y as usize * row as usize + 4 * x as usize + c] as f32 / 255.0;
+                        worst = worst.max((got - want[c]).abs());
+                    }
                 }
             }
         }

@@ -253,8 +253,8 @@ fn middle_drag(
     h.step();
 }
 
-/// Steps until the first image of the refinement that started after `before`, counting the volume and
-/// shadow-grid units submitted meanwhile.
+/// Steps until the full image's first pass of the refinement that started after `before`, counting
+/// the volume and shadow-grid units submitted meanwhile; the preview, when there is one, comes first.
 fn rebuilds_before_first_image(
     h: &mut Harness<'static, EditorApp>,
     before: Instant,
@@ -264,18 +264,24 @@ fn rebuilds_before_first_image(
     loop {
         h.step();
         let live = h.state().live.as_ref().expect("a scene");
+        // A rebuild submitted in the step that showed the full image came after it.
+        if live.refine_started > before
+            && let Some(full) = live.full_image_in
+        {
+            let first = live.first_image_in.unwrap_or(full);
+            println!(
+                "{what}: first image (preview) after {:.2} s, full image after {:.2} s",
+                first.as_secs_f64(),
+                full.as_secs_f64()
+            );
+            assert!(first <= full);
+            return rebuilds;
+        }
         if matches!(
             live.progress.and_then(|p| p.submitted),
             Some(WorkUnit::ShadowGrid { .. } | WorkUnit::Volume)
         ) {
             rebuilds += 1;
-        }
-        if live.refine_started > before && live.first_image_in.is_some() {
-            println!(
-                "{what}: first image after {:.2} s",
-                live.first_image_in.unwrap_or_default().as_secs_f64()
-            );
-            return rebuilds;
         }
         assert!(
             t.elapsed() < Duration::from_secs(120),
@@ -473,6 +479,44 @@ fn navigation_orbits_zooms_and_frames() {
     assert!(h.state().session.camera.target.is_none());
     // Camera moves are not edits.
     assert!(!h.state().history.can_undo());
+
+    // A slow orbit (a move per UI frame) shows previews while the button is held: each move waits
+    // for the preview under way instead of restarting it.
+    converge(&mut h);
+    let shown = h.state().live.as_ref().expect("live").previews_shown;
+    h.hover_at(centre);
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: centre,
+        button: egui::PointerButton::Middle,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    for k in 1..=60 {
+        h.event(egui::Event::PointerMoved(
+            centre + egui::vec2(k as f32, 0.0),
+        ));
+        h.step();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let during = h.state().live.as_ref().expect("live").previews_shown - shown;
+    h.event(egui::Event::PointerButton {
+        pos: centre + egui::vec2(60.0, 0.0),
+        button: egui::PointerButton::Middle,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    let live = h.state().live.as_ref().expect("live");
+    println!(
+        "previews shown during a 60-frame orbit: {during} ({}x{}, preview divisor {})",
+        live.display.width,
+        live.display.height,
+        live.renderer.preview_factor()
+    );
+    assert!(during >= 2, "the viewport froze during the orbit");
+    converge(&mut h);
 }
 
 #[test]

@@ -8,7 +8,8 @@ use std::path::PathBuf;
 use std::time::Duration;
 use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::progressive::WorkUnit;
+use strandlight::render::preview::PreviewMode;
+use strandlight::render::progressive::{ImageReady, WorkUnit};
 use strandlight::render::renderer::build_tables;
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
@@ -334,4 +335,172 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
         1,
     );
     assert!(live.set_thickness_scale(&ctx, &wrong, 2.0).is_err());
+}
+
+/// Refines to convergence, returning each call's submitted unit and the image it reported ready.
+fn refine_events(
+    r: &mut Renderer,
+    ctx: &GpuContext,
+) -> Vec<(Option<WorkUnit>, Option<ImageReady>)> {
+    let mut events = Vec::new();
+    loop {
+        let p = r.refine(ctx).expect("refine");
+        events.push((p.submitted, p.ready));
+        if p.converged {
+            return events;
+        }
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+    }
+}
+
+/// Sum of the beauty's RGB over the image, per unit of image area (a preview pixel covers factor^2
+/// of the frame's).
+fn radiance(f: &Frame, factor: u32) -> f64 {
+    let sum: f64 = f.beauty.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum();
+    sum * (factor * factor) as f64
+}
+
+/// With a preview, a change shows first a reduced-resolution image under every light (before the
+/// volume and the grid), then the full image from its first pass (every light at the first sample);
+/// the converged image is still `render_frame`'s. Its radiance is the frame's within a few percent.
+/// New tables refine the change already shown: no new preview. A restart in the middle of the grid's
+/// rebuild previews the groups part-way through unshadowed (finite values, not half-summed entries).
+#[test]
+fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let mut scene = common::bob_scene(300, 96, 72, Preset::Blond.params(), true);
+    scene.settings.shadow_grid_resolution = 12;
+    let new = || bob_renderer(&ctx, &luts, &scene, &scene.hair, &scene.sigma_a, &lights);
+    let mut whole = new();
+    let mut progressive = new();
+    progressive.set_unit_budget(Duration::from_millis(10));
+    progressive.set_preview(PreviewMode::Fixed(3));
+    assert_eq!(progressive.preview_factor(), 3);
+
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let events = refine_events(&mut progressive, &ctx);
+    let units: Vec<WorkUnit> = events.iter().filter_map(|e| e.0).collect();
+    let first_ready = |image| events.iter().position(|e| e.1 == Some(image));
+    let volume = units.iter().position(|u| *u == WorkUnit::Volume);
+    println!(
+        "first frame: {} units, first {:?}; preview ready at call {:?}, full at {:?}, volume unit {volume:?}",
+        units.len(),
+        units.first(),
+        first_ready(ImageReady::Preview),
+        first_ready(ImageReady::Full)
+    );
+    assert_eq!(units.first(), Some(&WorkUnit::PreviewVisibility));
+    assert!(matches!(
+        units.get(1),
+        Some(WorkUnit::Preview { row0: 0, .. })
+    ));
+    let (preview_at, full_at) = (
+        first_ready(ImageReady::Preview).expect("a preview"),
+        first_ready(ImageReady::Full).expect("a full image"),
+    );
+    assert!(preview_at < full_at);
+    // The full image is ready only once every light batch has shaded the first sample.
+    let light_batches = lights.len().div_ceil(16) as u32;
+    let shaded_before_full = events[..full_at]
+        .iter()
+        .filter_map(|e| match e.0 {
+            Some(WorkUnit::Shade { batch, .. }) => Some(batch),
+            _ => None,
+        })
+        .max();
+    assert_eq!(shaded_before_full, Some(light_batches - 1));
+    let b = progressive.read_frame(&ctx).expect("read");
+    assert_eq!(
+        difference(&a, &b),
+        0.0,
+        "the converged image is render_frame's"
+    );
+
+    // A camera "move" to the same place: a preview with the finished grid, against the frame.
+    progressive.set_camera(&ctx, &scene.camera);
+    let events = refine_events(&mut progressive, &ctx);
+    assert_eq!(events[0].0, Some(WorkUnit::PreviewVisibility));
+    let (preview, _) = progressive
+        .read_preview(&ctx)
+        .expect("read")
+        .expect("a preview");
+    assert_eq!((preview.width, preview.height), (32, 24));
+    let (p, f) = (radiance(&preview, 3), radiance(&a, 1));
+    println!(
+        "radiance: preview {p:.4}, frame {f:.4} ({:+.1} %)",
+        100.0 * (p / f - 1.0)
+    );
+    assert!(
+        (p / f - 1.0).abs() < 0.1,
+        "the preview's radiance is the frame's"
+    );
+
+    // A parameter change without its tables: a preview first (the camera's visibility kept); the
+    // tables then refine it (the grid's rebuild first, no second preview).
+    let mut params = scene.look.params;
+    params.beta_r = 4f64.to_radians();
+    let look = strandlight::render::HairLook::new(params);
+    assert!(progressive.set_params_deferred(&ctx, &look));
+    let first = progressive.refine(&ctx).expect("refine").submitted;
+    assert!(matches!(first, Some(WorkUnit::Preview { row0: 0, .. })));
+    // The preview is seen (its units finished) before the tables arrive.
+    loop {
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+        let p = progressive.refine(&ctx).expect("refine");
+        if p.ready == Some(ImageReady::Preview) {
+            break;
+        }
+        assert!(matches!(p.submitted, Some(WorkUnit::Preview { .. })));
+    }
+    let tables = build_tables(&params, Some(progressive.azimuthal_table()));
+    assert!(progressive.set_tables(&ctx, &params, &tables));
+    let mut units = Vec::new();
+    for _ in 0..6 {
+        let p = progressive.refine(&ctx).expect("refine");
+        units.extend(p.submitted);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+    }
+    println!("after the tables: {units:?}");
+    assert!(
+        units.iter().all(|u| !matches!(u, WorkUnit::Preview { .. })),
+        "the tables owe no preview"
+    );
+    assert!(
+        units
+            .iter()
+            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. }))
+    );
+    // A camera move in the middle of the grid's rebuild: a preview, finite everywhere.
+    let turned = Camera {
+        yaw: scene.camera.yaw + 30.0,
+        ..scene.camera
+    };
+    progressive.set_camera(&ctx, &turned);
+    let events = refine_events(&mut progressive, &ctx);
+    assert_eq!(events[0].0, Some(WorkUnit::PreviewVisibility));
+    let (preview, _) = progressive
+        .read_preview(&ctx)
+        .expect("read")
+        .expect("a preview");
+    let finite = preview
+        .beauty
+        .iter()
+        .flatten()
+        .all(|v| v.is_finite() && *v >= 0.0);
+    assert!(finite, "a preview during the grid's rebuild");
+    whole.set_params(&ctx, &look);
+    whole.set_camera(&ctx, &turned);
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let b = progressive.read_frame(&ctx).expect("read");
+    assert_eq!(difference(&a, &b), 0.0);
 }

@@ -9,12 +9,17 @@ use strandlight::envmap::{EnvMap, SrbfSet, load_env};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::Style;
+use strandlight::render::camera::CameraUniform;
+use strandlight::render::preview::PreviewMode;
+use strandlight::render::progressive::ImageReady;
 use strandlight::render::reference::REFERENCE_VARIANT;
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, importance_sample_env, reference_frame,
 };
 use strandlight::render::scene::generated_hair;
-use strandlight::render::shade::{ShadingHair, shade_pixels, shade_point};
+use strandlight::render::shade::{
+    DISTINCT, REPRESENTATIVE, SampleChoice, ShadingHair, shade_pixels, shade_point,
+};
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
 use strandlight::scattering::lut::Luts;
@@ -93,18 +98,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
     for (shadows, multiple) in [(false, false), (true, true)] {
         let mut s = scene(400, 64, 48, shadows, Preset::Blond);
         s.settings.multiple_scattering = multiple;
-        let (_, frame) = render(&ctx, &luts, &s, &lights);
-        let covered: Vec<usize> = frame.covered().collect();
-        assert!(
-            covered.len() > 200,
-            "the hair covers {} pixels",
-            covered.len()
-        );
-        let pixels: Vec<usize> = covered
-            .iter()
-            .copied()
-            .step_by(covered.len() / 150)
-            .collect();
+        let (mut renderer, frame) = render(&ctx, &luts, &s, &lights);
         let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
         let pyramid = DensityPyramid::build(&volume);
         let (forward, dual) = (
@@ -125,47 +119,83 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .collect();
         let values = GridValues::build(s.settings.shadow_grid(&s.hair), &sources, &light_dirs);
         let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
-        let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
-        let cpu = shade_pixels(&frame, &cam, &shading_hair, &pixels, |sp, wo| {
-            shade_point(
-                &luts,
-                &azimuthal,
-                &s.look.fast,
-                sp,
-                wo,
-                &lights.lights,
-                shadows.then_some(&values),
-                multiple.then_some(&dual),
-            )
-        });
-        let mut errors = Vec::new();
-        let scale = pixels
-            .iter()
-            .map(|&i| frame.beauty[i][0] + frame.beauty[i][1] + frame.beauty[i][2])
-            .fold(0.0f32, f32::max);
-        let mut ms_share = 0.0f32;
-        for (k, &i) in pixels.iter().enumerate() {
-            ms_share += (cpu[k][3][1] + cpu[k][4][1]) / frame.beauty[i][1].max(1e-12);
-            for t in 0..5 {
-                for c in 0..3 {
-                    let (g, r) = (frame.components[t][i][c], cpu[k][t][c]);
-                    // Relative, with a floor of 1e-3 of the brightest pixel (dark TT pixels).
-                    errors.push((g - r).abs() / r.abs().max(1e-3 * scale));
+        let twin = |frame: &Frame, cam: &CameraUniform, choose: SampleChoice, what: &str| {
+            let covered: Vec<usize> = frame.covered().collect();
+            assert!(
+                covered.len() > 100,
+                "{what}: the hair covers {} pixels",
+                covered.len()
+            );
+            let pixels: Vec<usize> = covered
+                .iter()
+                .copied()
+                .step_by((covered.len() / 150).max(1))
+                .collect();
+            let cpu = shade_pixels(frame, cam, &shading_hair, &pixels, choose, |sp, wo| {
+                shade_point(
+                    &luts,
+                    &azimuthal,
+                    &s.look.fast,
+                    sp,
+                    wo,
+                    &lights.lights,
+                    shadows.then_some(&values),
+                    multiple.then_some(&dual),
+                )
+            });
+            let mut errors = Vec::new();
+            let scale = pixels
+                .iter()
+                .map(|&i| frame.beauty[i][0] + frame.beauty[i][1] + frame.beauty[i][2])
+                .fold(0.0f32, f32::max);
+            let mut ms_share = 0.0f32;
+            for (k, &i) in pixels.iter().enumerate() {
+                ms_share += (cpu[k][3][1] + cpu[k][4][1]) / frame.beauty[i][1].max(1e-12);
+                for t in 0..5 {
+                    for c in 0..3 {
+                        let (g, r) = (frame.components[t][i][c], cpu[k][t][c]);
+                        // Relative, with a floor of 1e-3 of the brightest pixel (dark TT pixels).
+                        errors.push((g - r).abs() / r.abs().max(1e-3 * scale));
+                    }
                 }
             }
+            errors.sort_by(f32::total_cmp);
+            let (median, p99, max) = (
+                errors[errors.len() / 2],
+                errors[errors.len() * 99 / 100],
+                errors[errors.len() - 1],
+            );
+            println!(
+                "{what}, shadows {shadows}, multiple scattering {multiple}: {} pixels x 5 components x RGB: median {median:.2e}, p99 {p99:.2e}, max {max:.2e}; mean MS share of G {:.3}",
+                pixels.len(),
+                ms_share / pixels.len() as f32
+            );
+            assert!(
+                max <= 0.01,
+                "{what}: GPU and CPU twin differ by {max} (> 1%)"
+            );
+        };
+        let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
+        twin(&frame, &cam, DISTINCT, "frame");
+        // The preview (half resolution, each pixel's representative sample), after a change.
+        renderer.set_preview(PreviewMode::Fixed(2));
+        renderer.set_camera(&ctx, &s.camera);
+        loop {
+            let p = renderer.refine(&ctx).expect("refine");
+            if p.ready == Some(ImageReady::Preview) {
+                break;
+            }
+            assert!(!p.converged, "no preview");
+            ctx.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .expect("poll");
         }
-        errors.sort_by(f32::total_cmp);
-        let (median, p99, max) = (
-            errors[errors.len() / 2],
-            errors[errors.len() * 99 / 100],
-            errors[errors.len() - 1],
-        );
-        println!(
-            "shadows {shadows}, multiple scattering {multiple}: {} pixels x 5 components x RGB: median {median:.2e}, p99 {p99:.2e}, max {max:.2e}; mean MS share of G {:.3}",
-            pixels.len(),
-            ms_share / pixels.len() as f32
-        );
-        assert!(max <= 0.01, "GPU and CPU twin differ by {max} (> 1%)");
+        let (preview, preview_cam) = renderer
+            .read_preview(&ctx)
+            .expect("read back")
+            .expect("a preview");
+        assert_eq!((preview.width, preview.height), (32, 24));
+        twin(&preview, &preview_cam, REPRESENTATIVE, "preview");
     }
 }
 

@@ -9,7 +9,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::progressive::{UNIT_PASSES, WorkUnit};
+use strandlight::render::preview::PreviewMode;
+use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
+use strandlight::render::renderer::build_tables;
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
@@ -42,6 +44,9 @@ pub struct BenchArgs {
     /// Skip the progressive-refinement run (one more frame, refined in bounded units).
     #[arg(long)]
     pub no_progressive: bool,
+    /// Progressive refinement without its preview (the editor's reduced-resolution first image).
+    #[arg(long)]
+    pub no_preview: bool,
     /// Progressive refinement's time budget per unit, milliseconds.
     #[arg(long, default_value_t = 30.0)]
     pub unit_budget_ms: f64,
@@ -85,17 +90,94 @@ struct SceneReport {
 #[derive(Serialize)]
 struct ProgressiveReport {
     unit_budget_ms: f64,
+    /// The preview's resolution divisor at the end (automatic: adapted to its measured time).
+    preview_factor: u32,
     units: u32,
     /// The longest unit, submission to completion (wall clock), and which.
     longest_unit_ms: f64,
     longest_unit: String,
     /// Submission to completion of each pass's units, summed (wall clock as the polling saw it).
     pass_ms: std::collections::BTreeMap<&'static str, f64>,
-    /// From the change until the first shading batch is complete (the strongest light batch at the
-    /// first visibility sample, with its part of the shadow grid: the editor's first new image).
-    first_image_ms: f64,
+    /// From the change until the preview is complete (reduced resolution, every light, the shadow
+    /// grid as it stood), and until the full image's first pass is (every light at the first
+    /// visibility sample, with the shadow grid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    preview_ms: Option<f64>,
+    first_pass_ms: f64,
     /// From the change to the converged image (wall clock, including the CPU between units).
     converged_ms: f64,
+    /// Parameter changes after convergence, as the editor makes them (beta_R halved, then restored:
+    /// the second with the preview's divisor adapted by the first).
+    edits: Vec<EditReport>,
+}
+
+/// A parameter change as the editor makes it: the uniform at once, the tables on a worker thread,
+/// handed over once the full image's first pass is shown.
+#[derive(Serialize)]
+struct EditReport {
+    /// The preview's resolution divisor.
+    preview_factor: u32,
+    /// CPU milliseconds of the change on the calling (UI) thread.
+    cpu_ms: f64,
+    /// CPU milliseconds of the tables on the worker.
+    tables_ms: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    preview_ms: Option<f64>,
+    first_pass_ms: f64,
+    converged_ms: f64,
+    longest_unit_ms: f64,
+}
+
+/// What one refinement to convergence measured (times from its start, wall clock).
+struct RefineRun {
+    stats: strandlight::render::progressive::RefineStats,
+    preview_ms: Option<f64>,
+    first_pass_ms: Option<f64>,
+    converged_ms: f64,
+    /// The longest unit over the whole run (a refining restart resets the stats).
+    longest_ms: f64,
+}
+
+/// Refines to convergence, waiting for each unit, calling `between` after each call (the editor's
+/// hand-over of tables).
+fn refine_run(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    mut between: impl FnMut(&mut Renderer, &RefineRun),
+) -> anyhow::Result<RefineRun> {
+    let t = Instant::now();
+    let mut run = RefineRun {
+        stats: Default::default(),
+        preview_ms: None,
+        first_pass_ms: None,
+        converged_ms: 0.0,
+        longest_ms: 0.0,
+    };
+    loop {
+        let p = renderer.refine(ctx)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        run.longest_ms = run.longest_ms.max(p.stats.longest.as_secs_f64() * 1e3);
+        match p.ready {
+            Some(ImageReady::Preview) => {
+                run.preview_ms.get_or_insert(ms);
+            }
+            Some(ImageReady::Full) => {
+                run.first_pass_ms.get_or_insert(ms);
+            }
+            None => {}
+        }
+        if p.converged {
+            run.stats = p.stats;
+            run.converged_ms = ms;
+            return Ok(run);
+        }
+        between(renderer, &run);
+        if p.submitted.is_some() || p.busy {
+            ctx.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -110,6 +192,59 @@ fn median(mut v: Vec<f64>) -> f64 {
         return f64::NAN;
     }
     v[v.len() / 2]
+}
+
+/// Changes the look to `edited` as the editor would (the uniform now, the tables on a worker thread,
+/// handed over once the full image's first pass is shown) and refines to convergence.
+fn edit_run(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    edited: &HairLook,
+) -> anyhow::Result<EditReport> {
+    let params = edited.params;
+    let preview_factor = renderer.preview_factor();
+    let t = Instant::now();
+    let needs_tables = renderer.set_params_deferred(ctx, edited);
+    let cpu_ms = t.elapsed().as_secs_f64() * 1e3;
+    let azimuthal = renderer.azimuthal_table().clone();
+    let mut worker = needs_tables.then(|| {
+        std::thread::spawn(move || {
+            let t = Instant::now();
+            let tables = build_tables(&params, Some(&azimuthal));
+            (tables, t.elapsed().as_secs_f64() * 1e3)
+        })
+    });
+    let mut tables_ms = 0.0;
+    let mut hand_over = |r: &mut Renderer, worker: &mut Option<std::thread::JoinHandle<_>>| {
+        if let Some(w) = worker.take()
+            && let Ok((tables, ms)) = w.join()
+        {
+            tables_ms = ms;
+            r.set_tables(ctx, &params, &tables);
+        }
+    };
+    let run = refine_run(ctx, renderer, |r, run| {
+        if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
+            hand_over(r, &mut worker);
+        }
+    })?;
+    let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
+    if worker.is_some() {
+        // Converged before the tables came: they refine it once more.
+        hand_over(renderer, &mut worker);
+        let again = refine_run(ctx, renderer, |_, _| {})?;
+        converged_ms = t.elapsed().as_secs_f64() * 1e3;
+        longest_ms = longest_ms.max(again.longest_ms);
+    }
+    Ok(EditReport {
+        preview_factor,
+        cpu_ms,
+        tables_ms,
+        preview_ms: run.preview_ms,
+        first_pass_ms: run.first_pass_ms.unwrap_or(run.converged_ms),
+        converged_ms,
+        longest_unit_ms: longest_ms,
+    })
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -216,41 +351,48 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             renderer.set_unit_budget(std::time::Duration::from_secs_f64(
                 args.unit_budget_ms.max(0.1) * 1e-3,
             ));
+            renderer.set_preview(if args.no_preview {
+                PreviewMode::Off
+            } else {
+                PreviewMode::Auto
+            });
             if args.keep_volume {
                 renderer.set_camera(&ctx, &camera);
             } else {
                 renderer.mark_volume_dirty();
             }
-            let t = Instant::now();
-            // As refine_to_convergence, noting when the first shading batch (the strongest light
-            // batch at the first visibility sample: the editor's first new image) was complete.
-            let mut first_image_ms = None;
-            let stats = loop {
-                let p = renderer.refine(&ctx)?;
-                if p.converged {
-                    break p.stats;
-                }
-                if first_image_ms.is_none()
-                    && matches!(p.submitted, Some(WorkUnit::Shade { batch, .. }) if batch >= 1)
-                {
-                    first_image_ms = Some(t.elapsed().as_secs_f64() * 1e3);
-                }
-                if p.submitted.is_some() || p.busy {
-                    ctx.device
-                        .poll(wgpu::PollType::wait_indefinitely())
-                        .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
-                }
-            };
-            let converged_ms = t.elapsed().as_secs_f64() * 1e3;
+            let run = refine_run(&ctx, &mut renderer, |_, _| {})?;
+            let stats = run.stats;
+            let first_pass_ms = run.first_pass_ms.unwrap_or(run.converged_ms);
             eprintln!(
-                "{} progressive: {} units, longest {:.1} ms, first image {:.0} ms, converged in {converged_ms:.0} ms",
+                "{} progressive: {} units, longest {:.1} ms, preview {}, first pass {first_pass_ms:.0} ms, converged in {:.0} ms",
                 scene.name,
                 stats.units,
                 stats.longest.as_secs_f64() * 1e3,
-                first_image_ms.unwrap_or(converged_ms)
+                run.preview_ms
+                    .map_or_else(|| "none".into(), |t| format!("{t:.0} ms")),
+                run.converged_ms
             );
+            let mut narrow = look.params;
+            narrow.beta_r *= 0.5;
+            let mut edits = Vec::new();
+            for (what, params) in [("beta_R halved", narrow), ("beta_R restored", look.params)] {
+                let edit = edit_run(&ctx, &mut renderer, &HairLook::new(params))?;
+                eprintln!(
+                    "{} edit ({what}): {:.2} ms CPU, preview {} at 1/{}, first pass {:.0} ms, converged in {:.0} ms",
+                    scene.name,
+                    edit.cpu_ms,
+                    edit.preview_ms
+                        .map_or_else(|| "none".into(), |t| format!("{t:.0} ms")),
+                    edit.preview_factor,
+                    edit.first_pass_ms,
+                    edit.converged_ms
+                );
+                edits.push(edit);
+            }
             Some(ProgressiveReport {
                 unit_budget_ms: args.unit_budget_ms,
+                preview_factor: renderer.preview_factor(),
                 units: stats.units,
                 longest_unit_ms: stats.longest.as_secs_f64() * 1e3,
                 longest_unit: stats
@@ -261,8 +403,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     .zip(stats.pass_time)
                     .map(|(&name, t)| (name, t.as_secs_f64() * 1e3))
                     .collect(),
-                first_image_ms: first_image_ms.unwrap_or(converged_ms),
-                converged_ms,
+                preview_ms: run.preview_ms,
+                first_pass_ms,
+                converged_ms: run.converged_ms,
+                edits,
             })
         };
         reports.push(SceneReport {

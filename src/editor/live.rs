@@ -8,7 +8,8 @@ use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
 use crate::hair::Hair;
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
-use crate::render::progressive::{Progress, WorkUnit};
+use crate::render::preview::PreviewMode;
+use crate::render::progressive::{ImageReady, Progress};
 use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
@@ -125,10 +126,18 @@ pub struct LiveScene {
     /// When the current refinement started, and how long it took to converge.
     pub refine_started: Instant,
     pub converged_in: Option<Duration>,
-    /// When the first shading batch after the last change was complete (the first new image).
+    /// When the first image of the last change was shown (its preview, or the full image's first
+    /// pass), and when the full image's first pass was.
     pub first_image_in: Option<Duration>,
-    /// The refinement whose converged image was displayed.
-    shown_converged: Option<Instant>,
+    pub preview_in: Option<Duration>,
+    pub full_image_in: Option<Duration>,
+    /// The image the display shows, and how many previews it has shown.
+    showing: ImageReady,
+    pub previews_shown: u64,
+    /// Restarts of the refinement (a change or a refinement of it), and the one whose converged
+    /// image was displayed.
+    restarts: u64,
+    shown_converged: Option<u64>,
 }
 
 impl LiveScene {
@@ -165,6 +174,7 @@ impl LiveScene {
             tables,
         )?;
         renderer.set_unit_budget(unit_budget(&ctx));
+        renderer.set_preview(PreviewMode::Auto);
         if session.look.thickness_scale != 1.0 {
             renderer.set_thickness_scale(&ctx, &hair.hair, session.look.thickness_scale)?;
         }
@@ -195,6 +205,11 @@ impl LiveScene {
             refine_started: Instant::now(),
             converged_in: None,
             first_image_in: None,
+            preview_in: None,
+            full_image_in: None,
+            showing: ImageReady::Full,
+            previews_shown: 0,
+            restarts: 0,
             shown_converged: None,
             ctx,
         })
@@ -278,7 +293,9 @@ impl LiveScene {
             self.view = None;
         }
         self.applied.render = session.render;
-        if *camera != self.applied.camera {
+        // During a drag the camera waits for the preview under way (a move per UI frame would restart
+        // it before it is ever shown); the latest goes over when it is complete.
+        if *camera != self.applied.camera && !self.renderer.preview_under_way() {
             self.renderer.set_camera(&self.ctx, camera);
             self.applied.camera = *camera;
             changed = true;
@@ -363,17 +380,31 @@ impl LiveScene {
         }
     }
 
+    /// A change the image does not show yet: times are measured from here.
     fn restarted(&mut self) {
         self.refine_started = Instant::now();
-        self.converged_in = None;
         self.first_image_in = None;
+        self.preview_in = None;
+        self.full_image_in = None;
+        self.refined();
+    }
+
+    /// A restart that refines the change on screen (its tables, its volume): its times still count
+    /// from the change.
+    fn refined(&mut self) {
+        self.converged_in = None;
+        self.restarts += 1;
         // The last refinement's progress (converged, say) says nothing about this one.
         self.progress = None;
     }
 
-    /// One UI frame's work: takes finished tables, submits one bounded refinement unit and, when the
-    /// image or the view changed, the display pass. Never waits for the GPU.
+    /// One UI frame's work: shows the image a finished unit left, takes finished tables, submits one
+    /// bounded refinement unit and, when the image or the view changed, the display pass. Never waits
+    /// for the GPU.
     pub fn step(&mut self, view: ViewSettings) -> Result<Progress, LiveError> {
+        // The image the last unit finished goes to the display before the next unit is queued.
+        let ready = self.renderer.poll_refinement(&self.ctx)?;
+        self.note_ready(ready);
         let finished = self.tables.as_mut().and_then(|job| job.poll());
         match finished {
             Some(Ok(tables)) => {
@@ -386,16 +417,13 @@ impl LiveScene {
         }
         // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
         // terms read them), and so does a deferred absorption change (from the volume). Right after a
-        // change the refinement shades with the old grid at once: rebuild once that first image is on
-        // screen, so the change shows in about one light batch's time and its multiple scattering
-        // follows. Tables go over at once when the grid is being rebuilt anyway (one rebuild, not two)
-        // or when the azimuthal table is new (an eta or eccentricity change shows only with its table);
-        // anything waiting goes over when the refinement has nothing left to show.
-        let shown = self.first_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
-        // With tables on the way, the volume waits for them: they rebuild the grid too.
-        if shown && self.tables.is_none() && self.renderer.rebuild_stale_volume() {
-            self.restarted();
-        }
+        // change the refinement shows a preview, then the full image with the old grid: rebuild once
+        // that full image is on screen, so the change shows sharp in about one pass's time and its
+        // multiple scattering follows. Tables go over at once when the grid is being rebuilt anyway
+        // (one rebuild, not two) or when the azimuthal table is new (an eta or eccentricity change
+        // shows only with its table); anything waiting goes over when the refinement has nothing left
+        // to show.
+        let shown = self.full_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
         let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
             shown
                 || self.renderer.shadow_grid_stale()
@@ -405,57 +433,79 @@ impl LiveScene {
             && let Some((params, tables)) = self.held_tables.take()
             && self.renderer.set_tables(&self.ctx, &params, &tables)
         {
-            self.restarted();
+            self.refined();
+        }
+        // With tables on the way, the volume waits for them: they rebuild the grid too.
+        let tables_waiting = self.tables.is_some() || self.held_tables.is_some();
+        if shown && !tables_waiting && self.renderer.rebuild_stale_volume() {
+            self.refined();
         }
         let progress = self.renderer.refine(&self.ctx)?;
+        // Converged without a unit in flight (nothing changed since) shows nothing new.
         if progress.converged && self.converged_in.is_none() {
             self.converged_in = Some(self.refine_started.elapsed());
         }
-        // The display keeps the last image until the first shading batch of the new one is complete
-        // (the strongest light batch at the first visibility sample: most of the picture), instead of
-        // showing the cleared image filling in band by band.
-        let first_batch_done = match progress.submitted {
-            Some(WorkUnit::Shade { batch, .. }) => batch >= 1,
-            Some(WorkUnit::ShadowGrid { .. }) => self.first_image_in.is_some(),
-            _ => false,
-        };
-        if first_batch_done && self.first_image_in.is_none() {
-            self.first_image_in = Some(self.refine_started.elapsed());
-        }
-        let converged_now = progress.converged && self.shown_converged != Some(self.refine_started);
+        let converged_now = progress.converged && self.shown_converged != Some(self.restarts);
         if converged_now {
-            self.shown_converged = Some(self.refine_started);
+            self.shown_converged = Some(self.restarts);
+            self.showing = ImageReady::Full;
         }
-        if first_batch_done || converged_now || self.view != Some(view) {
-            let info = DisplayInfo {
-                render_scale: self.renderer.settings.exposure.exp2(),
-                ..DisplayInfo::new(
-                    self.display.width,
-                    self.display.height,
-                    view.transform,
-                    view.exposure,
-                    BACKGROUND,
-                )
-            };
-            let mut enc = self
-                .ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("display"),
-                });
-            self.display.encode(
-                &self.ctx.device,
-                &self.ctx.queue,
-                &mut enc,
-                self.renderer.targets(),
-                &info,
-                view.solo,
-            );
-            self.ctx.queue.submit([enc.finish()]);
-            self.view = Some(view);
+        if ready.is_some() || converged_now || self.view != Some(view) {
+            self.show(view);
         }
         self.progress = Some(progress);
         Ok(progress)
+    }
+
+    /// A finished unit left `ready` worth showing: it becomes the image shown, and the times of the
+    /// first images of this change are noted (the renderer counts only units planned after it).
+    fn note_ready(&mut self, ready: Option<ImageReady>) {
+        let Some(image) = ready else {
+            return;
+        };
+        self.showing = image;
+        self.previews_shown += (image == ImageReady::Preview) as u64;
+        let stats = self.renderer.refine_stats();
+        let since = self.refine_started.elapsed();
+        if stats.preview.is_some() {
+            self.preview_in.get_or_insert(since);
+        }
+        if stats.first_pass.is_some() {
+            self.full_image_in.get_or_insert(since);
+        }
+        if stats.preview.is_some() || stats.first_pass.is_some() {
+            self.first_image_in.get_or_insert(since);
+        }
+    }
+
+    /// The display pass of the image shown, through the view transform.
+    fn show(&mut self, view: ViewSettings) {
+        let info = DisplayInfo {
+            render_scale: self.renderer.settings.exposure.exp2(),
+            ..DisplayInfo::new(
+                self.display.width,
+                self.display.height,
+                view.transform,
+                view.exposure,
+                BACKGROUND,
+            )
+        };
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("display"),
+            });
+        self.display.encode(
+            &self.ctx.device,
+            &self.ctx.queue,
+            &mut enc,
+            self.renderer.image(self.showing),
+            &info,
+            view.solo,
+        );
+        self.ctx.queue.submit([enc.finish()]);
+        self.view = Some(view);
     }
 
     /// Whether tables are still being built or not yet handed to the renderer, or a deferred

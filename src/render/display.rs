@@ -41,7 +41,8 @@ pub struct DisplayInfo {
     pub solo: u32,
     pub exposure_scale: f32,
     pub render_scale: f32,
-    pub _pad1: [f32; 2],
+    /// Size of the image read: the display's, or smaller (the preview, sampled bilinearly).
+    pub source: [u32; 2],
     pub background: [f32; 3],
     pub _pad2: f32,
 }
@@ -63,7 +64,7 @@ impl DisplayInfo {
             solo: 0,
             exposure_scale: exposure_ev.exp2(),
             render_scale: 1.0,
-            _pad1: [0.0; 2],
+            source: [width, height],
             background,
             _pad2: 0.0,
         }
@@ -111,6 +112,30 @@ pub fn display_pixel(info: &DisplayInfo, beauty: [f32; 4], component: [f32; 4]) 
         b[2] + a * (c[2] - b[2]),
         1.0,
     ]
+}
+
+/// The premultiplied value of `image` (a `info.source`-sized image) under display pixel (x, y):
+/// itself at the same size, bilinear with pixel centres aligned otherwise (twin of the WGSL
+/// `source_taps` and `bilinear`).
+pub fn source_sample(info: &DisplayInfo, image: &[[f32; 4]], x: u32, y: u32) -> [f32; 4] {
+    let [sw, sh] = info.source.map(|v| v.max(1));
+    if [sw, sh] == [info.width, info.height] {
+        return image[(y * info.width + x) as usize];
+    }
+    let axis = |i: u32, s: u32, d: u32| {
+        let p = ((i as f32 + 0.5) * s as f32 / d as f32 - 0.5).max(0.0);
+        let c0 = (p.floor() as u32).min(s - 1);
+        (c0, (c0 + 1).min(s - 1), p - p.floor())
+    };
+    let (x0, x1, fx) = axis(x, sw, info.width);
+    let (y0, y1, fy) = axis(y, sh, info.height);
+    let at = |x: u32, y: u32| image[(y * sw + x) as usize];
+    let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * fx;
+        let bottom = c[k] + (d[k] - c[k]) * fx;
+        top + (bottom - top) * fy
+    })
 }
 
 /// The display texture for one image size and the pass that fills it.
@@ -195,8 +220,8 @@ impl DisplayPass {
         (buffer, row)
     }
 
-    /// Encodes the transform of `targets.beauty` or one component (which must have this pass's size)
-    /// into the texture.
+    /// Encodes the transform of `targets.beauty` or one component into the texture (bilinearly
+    /// enlarged when the targets are smaller: the preview).
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -211,8 +236,9 @@ impl DisplayPass {
             Solo::Component(k) => (1, &targets.components[k.min(targets.components.len() - 1)]),
         };
         let info = DisplayInfo {
-            width: self.width.min(targets.width),
-            height: self.height.min(targets.height),
+            width: self.width,
+            height: self.height,
+            source: [targets.width, targets.height],
             solo: flag,
             ..*info
         };

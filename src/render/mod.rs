@@ -5,6 +5,7 @@ pub mod camera;
 pub mod display;
 pub mod frame;
 pub mod path_trace;
+pub mod preview;
 pub mod progressive;
 pub mod reference;
 pub mod reference_lights;

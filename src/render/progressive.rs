@@ -3,19 +3,27 @@
 //! are sized from the measured cost of the units before them (row bands from each row's own cost in
 //! earlier batches) to a time budget, so egui, which shares the queue, does not wait behind a long
 //! submission (the volume and visibility units are whole passes, not sized; a unit of one row or one
-//! sweep can still pass the budget). The units: the fiber-density volume (when geometry or absorption
-//! changed), the shadow grid in ranges of sweeps (eight entries per light, one per direction; when the
-//! volume, the lights or the forward table changed), visibility, then every shading batch (a light
-//! batch at one visibility sample) in bands of rows, each band followed by a resolve of its rows so the
-//! image fills in; the grid's entries for a light batch are built just before the first shading batch
-//! that reads them, so the image appears after one light batch's grid, not the whole grid. Every pixel
-//! takes its batches in `render_frame`'s order, so the converged image is `render_frame`'s bit for bit.
-//! A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what the
-//! shadow grid has built.
+//! sweep can still pass the budget).
+//!
+//! The plan after a change: first, when the renderer has one ([`Renderer::set_preview`]), a preview of
+//! the change (reduced resolution, one shading per pixel, all lights, the shadow grid as it stands:
+//! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed), the
+//! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
+//! lights or the forward table changed), visibility, then every shading batch (a light batch at one
+//! visibility sample, every light batch at the first sample before any at the second) in bands of
+//! rows, each band followed by a resolve of its rows; the grid's entries for a light batch are built
+//! just before the first shading batch that reads them. [`Progress::ready`] says when a finished unit
+//! left an image worth showing: the complete preview, then the full image once every light has shaded
+//! the first visibility sample (the "first pass"), updated unit by unit until converged. Every pixel
+//! takes its batches in `render_frame`'s order, so the converged image is `render_frame`'s bit for
+//! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
+//! the shadow grid has built.
 
+use super::preview::PREVIEW_TARGET;
 use super::renderer::{RenderError, Renderer};
 use super::shading::{ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
+use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -25,10 +33,12 @@ use std::time::{Duration, Instant};
 pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 
 /// First guesses, before a unit of the kind has been measured: conservative (lavapipe on two cores
-/// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a 16-light batch at
-/// 720 pixels).
+/// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a
+/// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
+/// The row width of that guess.
+const GUESS_ROW_PIXELS: f64 = 720.0;
 
 /// One bounded piece of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,10 +51,25 @@ pub enum WorkUnit {
     Visibility,
     /// Frame batch `batch` (its lights at its visibility sample) over rows [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
+    /// The preview's visibility pass (after a camera move; a parameter change reuses the last).
+    PreviewVisibility,
+    /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
+    Preview { row0: u32, rows: u32 },
+}
+
+/// Which image a finished unit left worth showing ([`Renderer::image`] gives its targets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageReady {
+    /// The preview of the latest change is complete.
+    Preview,
+    /// The full-resolution image: every light has shaded the first visibility sample (or more).
+    Full,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage {
+    PreviewVisibility,
+    Preview { row: u32 },
     Volume,
     ShadowGrid,
     Visibility,
@@ -56,6 +81,8 @@ struct InFlight {
     unit: WorkUnit,
     submitted: Instant,
     done: Arc<Mutex<Option<Instant>>>,
+    /// The restart it was planned under ([`Refinement::restarts`]).
+    restart: u64,
 }
 
 /// What refinement has measured since its last restart.
@@ -68,32 +95,109 @@ pub struct RefineStats {
     pub longest_unit: Option<WorkUnit>,
     /// Time spent per pass since the restart, submission to completion of its units (wall clock as
     /// the polling saw it: an upper bound of GPU time), in [`UNIT_PASSES`] order.
-    pub pass_time: [Duration; 4],
+    pub pass_time: [Duration; 5],
+    /// From the restart to the completion of the preview, and the first pass of the full image.
+    pub preview: Option<Duration>,
+    pub first_pass: Option<Duration>,
 }
 
 /// The passes the units belong to, in [`RefineStats::pass_time`] order.
-pub const UNIT_PASSES: [&str; 4] = ["volume", "shadow grid", "visibility", "shading"];
+pub const UNIT_PASSES: [&str; 5] = ["preview", "volume", "shadow grid", "visibility", "shading"];
+
+/// Row bands of one image (the frame's or the preview's), sized from measured costs.
+#[derive(Default)]
+struct Bands {
+    /// Mean seconds per row of one unit's work (None: not measured yet).
+    cost: Option<f64>,
+    /// Measured seconds per row, per image row (0: not measured yet). A row costs about the same in
+    /// every batch (the same pixels under as many lights), so a band is sized from its own rows'
+    /// costs, not from the mean of the (often empty) rows above it.
+    row_cost: Vec<f64>,
+    /// Rows of the last band.
+    last: u32,
+}
+
+impl Bands {
+    /// Rows of a band from `row` (of `height`): as many as `budget` holds by the rows' own measured
+    /// costs (the mean row's, or `guess`, where not measured yet, then at most twice the last band);
+    /// at least one; whole workgroups (8 rows) where the budget allows.
+    fn rows(&self, row: u32, height: u32, budget: f64, guess: f64) -> u32 {
+        let fallback = self.cost.unwrap_or(guess).max(1e-12);
+        let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
+        for r in row..height {
+            let c = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
+            unknown |= c <= 0.0;
+            let c = if c > 0.0 { c } else { fallback };
+            if n > 0 && t + c > budget {
+                break;
+            }
+            t += c;
+            n += 1;
+        }
+        if unknown {
+            n = n.min(2 * self.last.max(1));
+        }
+        let mut n = n.max(1);
+        if n >= 8 && n < height - row {
+            n -= n % 8;
+        }
+        n
+    }
+
+    /// A band of `rows` rows from `row0` took `elapsed` seconds.
+    fn measured(&mut self, row0: u32, rows: u32, elapsed: f64) {
+        let per = elapsed / rows.max(1) as f64;
+        self.cost = Some(self.cost.map_or(per, |o| 0.5 * (o + per)));
+        let end = (row0 + rows) as usize;
+        if self.row_cost.len() < end {
+            self.row_cost.resize(end, 0.0);
+        }
+        self.row_cost[row0 as usize..end].fill(per);
+    }
+
+    /// The image width changed by `ratio`: a row costs about that much more (or less), and the next
+    /// band starts small.
+    fn resized(&mut self, ratio: f64) {
+        if let Some(c) = &mut self.cost {
+            *c *= ratio.max(1e-6);
+        }
+        self.row_cost.clear();
+        self.last = 1;
+    }
+}
 
 /// Where progressive refinement stands (owned by the [`Renderer`]).
 pub struct Refinement {
     stage: Stage,
     /// Shadow-grid entries built for the current volume, lights and tables.
     pub(super) grid_done: u32,
+    /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
+    /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
+    /// preview shades those lights unshadowed).
+    pub(super) grid_partial: Vec<bool>,
     /// Rows of shading batches submitted since the restart.
     rows_done: u64,
     budget: Duration,
-    /// Seconds per shadow-grid entry and per row of one shading batch (None: not measured yet).
+    /// Seconds per shadow-grid entry (None: not measured yet).
     grid_cost: Option<f64>,
-    shade_cost: Option<f64>,
-    /// Measured seconds per row of one shading batch, per image row (0: not measured yet). A row
-    /// costs about the same in every batch (the same pixels under as many lights), so a band is sized
-    /// from its own rows' costs, not from the mean of the (often empty) rows above it.
-    row_cost: Vec<f64>,
-    /// Items of the last grid and shading units.
+    /// The frame's shading bands and the preview's.
+    bands: Bands,
+    preview_bands: Bands,
+    /// Items of the last grid unit.
     grid_last: u32,
-    shade_last: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
+    /// When the plan was last restarted, and how many times (a finished unit planned before the
+    /// latest restart still shows its image, but does not show the latest change).
+    started: Instant,
+    pub(super) restarts: u64,
+    /// A change since the last image shown (preview or full): the plan starts with a preview.
+    pub(super) preview_owed: bool,
+    /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
+    pub(super) preview_auto_factor: Option<u32>,
+    /// A preview unit was submitted since the restart, and the time its shading units took.
+    preview_started: bool,
+    preview_shading: Duration,
 }
 
 impl Default for Refinement {
@@ -101,15 +205,21 @@ impl Default for Refinement {
         Self {
             stage: Stage::Visibility,
             grid_done: 0,
+            grid_partial: Vec::new(),
             rows_done: 0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
-            shade_cost: None,
-            row_cost: Vec::new(),
+            bands: Bands::default(),
+            preview_bands: Bands::default(),
             grid_last: 1,
-            shade_last: 1,
             in_flight: None,
             stats: RefineStats::default(),
+            started: Instant::now(),
+            restarts: 0,
+            preview_owed: false,
+            preview_auto_factor: None,
+            preview_started: false,
+            preview_shading: Duration::ZERO,
         }
     }
 }
@@ -118,6 +228,7 @@ impl Refinement {
     /// `render_frame` did the whole frame.
     pub(super) fn complete_frame(&mut self) {
         self.stage = Stage::Converged;
+        self.preview_owed = false;
     }
 
     /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
@@ -134,37 +245,15 @@ impl Refinement {
             .min(remaining.max(1))
     }
 
-    /// Rows of a shading band from `row` (of `height`): as many as the budget holds by the rows' own
-    /// measured costs (the mean row's where not measured yet, then at most twice the last band); at
-    /// least one.
-    fn shade_rows(&self, row: u32, height: u32) -> u32 {
-        let fallback = self.shade_cost.unwrap_or(GUESS_SHADE_ROW_S).max(1e-12);
-        let budget = self.budget.as_secs_f64();
-        let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
-        for r in row..height {
-            let c = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
-            unknown |= c <= 0.0;
-            let c = if c > 0.0 { c } else { fallback };
-            if n > 0 && t + c > budget {
-                break;
-            }
-            t += c;
-            n += 1;
-        }
-        if unknown {
-            n = n.min(2 * self.shade_last.max(1));
-        }
-        n.max(1)
+    /// The preview's targets were made anew: its rows' costs are unknown.
+    pub(super) fn preview_bands_reset(&mut self) {
+        self.preview_bands = Bands::default();
     }
 
-    /// The image width changed by `ratio`: a row costs about that much more (or less), and the next
-    /// band starts small.
+    /// The image width changed by `ratio`.
     pub(super) fn resized(&mut self, ratio: f64) {
-        if let Some(c) = &mut self.shade_cost {
-            *c *= ratio.max(1e-6);
-        }
-        self.row_cost.clear();
-        self.shade_last = 1;
+        self.bands.resized(ratio);
+        self.preview_bands = Bands::default();
     }
 
     /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
@@ -175,27 +264,39 @@ impl Refinement {
             self.stats.longest_unit = Some(unit);
         }
         let pass = match unit {
-            WorkUnit::Volume => 0,
-            WorkUnit::ShadowGrid { .. } => 1,
-            WorkUnit::Visibility => 2,
-            WorkUnit::Shade { .. } => 3,
+            WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility => 0,
+            WorkUnit::Volume => 1,
+            WorkUnit::ShadowGrid { .. } => 2,
+            WorkUnit::Visibility => 3,
+            WorkUnit::Shade { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
-        let per = |n: u32| elapsed.as_secs_f64() / n.max(1) as f64;
-        let blend = |old: Option<f64>, new: f64| Some(old.map_or(new, |o| 0.5 * (o + new)));
+        let seconds = elapsed.as_secs_f64();
         match unit {
             WorkUnit::ShadowGrid { count, .. } => {
-                self.grid_cost = blend(self.grid_cost, per(count))
+                let per = seconds / count.max(1) as f64;
+                self.grid_cost = Some(self.grid_cost.map_or(per, |o| 0.5 * (o + per)));
             }
-            WorkUnit::Shade { row0, rows, .. } => {
-                self.shade_cost = blend(self.shade_cost, per(rows));
-                let end = (row0 + rows) as usize;
-                if self.row_cost.len() < end {
-                    self.row_cost.resize(end, 0.0);
-                }
-                self.row_cost[row0 as usize..end].fill(per(rows));
+            WorkUnit::Shade { row0, rows, .. } => self.bands.measured(row0, rows, seconds),
+            WorkUnit::Preview { row0, rows } => {
+                self.preview_shading += elapsed;
+                self.preview_bands.measured(row0, rows, seconds)
             }
-            WorkUnit::Volume | WorkUnit::Visibility => {}
+            WorkUnit::Volume | WorkUnit::Visibility | WorkUnit::PreviewVisibility => {}
+        }
+    }
+
+    /// Records a grid unit over entries [first, first + count) of `total`, in groups of
+    /// `group_entries` (the last may be shorter): a group it leaves part-way is partial, one it
+    /// completes is not.
+    fn grid_built(&mut self, first: u32, count: u32, group_entries: u32, total: u32) {
+        let g = group_entries.max(1);
+        let groups = total.div_ceil(g);
+        self.grid_partial.resize(groups as usize, false);
+        let end = first + count;
+        for group in first / g..end.div_ceil(g).min(groups) {
+            let group_end = ((group + 1) * g).min(total);
+            self.grid_partial[group as usize] = end < group_end;
         }
     }
 }
@@ -209,6 +310,9 @@ pub struct Progress {
     pub busy: bool,
     /// Every unit of the frame has finished: the image is `render_frame`'s.
     pub converged: bool,
+    /// The unit that finished since the last call left this image worth showing (the preview, or
+    /// the full image from its first pass on).
+    pub ready: Option<ImageReady>,
     /// Estimated fraction of the frame's work done (by the measured costs).
     pub fraction: f32,
     pub stats: RefineStats,
@@ -236,45 +340,113 @@ impl Renderer {
         self.grid_used() && self.shadow_grid_dirty
     }
 
-    /// Starts the frame's plan again from the first stage that a change made stale.
+    /// A change the image on screen does not show yet: the frame's plan starts again from the first
+    /// stage the change made stale, with a preview first.
     pub(super) fn restart_refinement(&mut self) {
-        let grid_needed = self.grid_needed();
-        let r = &mut self.refinement;
-        r.rows_done = 0;
-        r.stats = RefineStats::default();
-        r.stage = if self.volume_dirty {
+        self.refinement.preview_owed = true;
+        self.replan();
+    }
+
+    /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
+    /// no new preview is owed for it (new tables, a deferred volume rebuild).
+    pub(super) fn refining(&mut self, change: impl FnOnce(&mut Self)) {
+        let owed = self.refinement.preview_owed;
+        change(self);
+        self.refinement.preview_owed = owed;
+        self.replan();
+    }
+
+    /// The first stage of the frame's plan after the preview.
+    fn main_stage(&self) -> Stage {
+        if self.volume_dirty {
             Stage::Volume
-        } else if grid_needed {
+        } else if self.grid_needed() {
             Stage::ShadowGrid
         } else {
             Stage::Visibility
+        }
+    }
+
+    pub(super) fn replan(&mut self) {
+        let stage = if self.refinement.preview_owed && self.preview_factor() > 1 {
+            Stage::PreviewVisibility
+        } else {
+            self.main_stage()
         };
+        let r = &mut self.refinement;
+        r.preview_started = false;
+        r.preview_shading = Duration::ZERO;
+        r.rows_done = 0;
+        r.stats = RefineStats::default();
+        r.started = Instant::now();
+        r.restarts += 1;
+        r.stage = stage;
+    }
+
+    /// Notices whether the unit in flight has finished (without waiting): folds its time into the
+    /// costs and says which image it left worth showing. [`Renderer::refine`] calls it first; the
+    /// editor calls it before, to draw that image before the next unit is queued behind it.
+    pub fn poll_refinement(&mut self, ctx: &GpuContext) -> Result<Option<ImageReady>, RenderError> {
+        ctx.device
+            .poll(wgpu::PollType::Poll)
+            .map_err(|e| RenderError::Gpu(format!("polling: {e}")))?;
+        let Some(f) = &self.refinement.in_flight else {
+            return Ok(None);
+        };
+        let done = *f
+            .done
+            .lock()
+            .map_err(|_| RenderError::Gpu("poisoned".into()))?;
+        let Some(t) = done else {
+            return Ok(None);
+        };
+        let (unit, elapsed, restart) =
+            (f.unit, t.saturating_duration_since(f.submitted), f.restart);
+        self.refinement.in_flight = None;
+        self.refinement.measured(unit, elapsed);
+        let ready = match unit {
+            WorkUnit::Preview { row0, rows } => {
+                let height = self.preview.as_ref().map_or(0, |p| p.targets.height);
+                (row0 + rows >= height).then_some(ImageReady::Preview)
+            }
+            WorkUnit::Shade { batch, row0, rows } => {
+                let first_pass = self.first_pass_batches();
+                let after = batch + 1 > first_pass
+                    || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
+                after.then_some(ImageReady::Full)
+            }
+            _ => None,
+        };
+        let r = &mut self.refinement;
+        if ready.is_some() && restart == r.restarts {
+            // The image shows the latest change.
+            r.preview_owed = false;
+            let since = r.started.elapsed();
+            match ready {
+                Some(ImageReady::Preview) => {
+                    r.stats.preview.get_or_insert(since);
+                    let shading = r.preview_shading;
+                    self.adapt_preview(shading);
+                }
+                _ => {
+                    r.stats.first_pass.get_or_insert(since);
+                }
+            }
+        }
+        Ok(ready)
     }
 
     /// Does the next bounded piece of the frame: returns at once if the previous piece is still
     /// running (the caller draws the last resolved image), otherwise submits one unit sized to the
     /// budget. Call it every UI frame; it never waits for the GPU.
     pub fn refine(&mut self, ctx: &GpuContext) -> Result<Progress, RenderError> {
-        ctx.device
-            .poll(wgpu::PollType::Poll)
-            .map_err(|e| RenderError::Gpu(format!("polling: {e}")))?;
-        if let Some(f) = &self.refinement.in_flight {
-            let done = *f
-                .done
-                .lock()
-                .map_err(|_| RenderError::Gpu("poisoned".into()))?;
-            match done {
-                None => return Ok(self.progress(None, true)),
-                Some(t) => {
-                    let (unit, elapsed) = (f.unit, t.saturating_duration_since(f.submitted));
-                    self.refinement.in_flight = None;
-                    self.refinement.measured(unit, elapsed);
-                }
-            }
+        let ready = self.poll_refinement(ctx)?;
+        if self.refinement.in_flight.is_some() {
+            return Ok(self.progress(None, true, ready));
         }
         self.last_ran.clear(); // pass_times belongs to render_frame
-        let Some(unit) = self.next_unit() else {
-            return Ok(self.progress(None, false));
+        let Some(unit) = self.next_unit(&ctx.device) else {
+            return Ok(self.progress(None, false, ready));
         };
         let mut enc = ctx
             .device
@@ -290,13 +462,16 @@ impl Renderer {
                 *d = Some(Instant::now());
             }
         });
+        self.refinement.preview_started |=
+            matches!(unit, WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility);
         self.refinement.in_flight = Some(InFlight {
             unit,
             submitted: Instant::now(),
             done,
+            restart: self.refinement.restarts,
         });
         self.refinement.stats.units += 1;
-        Ok(self.progress(Some(unit), false))
+        Ok(self.progress(Some(unit), false, ready))
     }
 
     /// Refines until converged, waiting for each unit (tests, benchmarks and the CLI).
@@ -314,10 +489,50 @@ impl Renderer {
         }
     }
 
-    fn progress(&self, submitted: Option<WorkUnit>, busy: bool) -> Progress {
+    /// What refinement has measured since its last restart.
+    pub fn refine_stats(&self) -> RefineStats {
+        self.refinement.stats
+    }
+
+    /// Whether a preview is part-way (its first unit submitted, its last not finished).
+    pub fn preview_under_way(&self) -> bool {
+        let r = &self.refinement;
+        let planned = matches!(r.stage, Stage::PreviewVisibility | Stage::Preview { .. });
+        let in_flight = r.in_flight.as_ref().is_some_and(|f| {
+            f.restart == r.restarts
+                && matches!(
+                    f.unit,
+                    WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility
+                )
+        });
+        in_flight || (planned && r.preview_started)
+    }
+
+    /// The targets holding `image` (the preview's, or the frame's).
+    pub fn image(&self, image: ImageReady) -> &FrameTargets {
+        match (image, &self.preview) {
+            (ImageReady::Preview, Some(p)) => &p.targets,
+            _ => &self.targets,
+        }
+    }
+
+    /// Shading batches of the first pass: every light batch at the first visibility sample.
+    fn first_pass_batches(&self) -> u32 {
+        self.shading_pass
+            .frame_batches()
+            .take_while(|b| b.slot == 0)
+            .count() as u32
+    }
+
+    fn progress(
+        &self,
+        submitted: Option<WorkUnit>,
+        busy: bool,
+        ready: Option<ImageReady>,
+    ) -> Progress {
         let r = &self.refinement;
         let grid_cost = r.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
-        let shade_cost = r.shade_cost.unwrap_or(GUESS_SHADE_ROW_S);
+        let shade_cost = r.bands.cost.unwrap_or(GUESS_SHADE_ROW_S);
         let entries = self.shadow_grid.entry_count() as f64;
         let grid_total = if self.grid_used() {
             entries * grid_cost
@@ -343,6 +558,11 @@ impl Renderer {
             submitted,
             busy,
             converged,
+            ready: if converged {
+                Some(ImageReady::Full)
+            } else {
+                ready
+            },
             fraction,
             stats: r.stats,
         }
@@ -378,13 +598,38 @@ impl Renderer {
     /// The next unit of the plan (sized to the budget); advances the plan past it. The shadow grid is
     /// built light batch by light batch, each just before the first shading batch that reads it: the
     /// first light batch's part before the visibility pass clears the image (the last image stays on
-    /// screen meanwhile), the others between shading batches, so the image fills in light batch by
-    /// light batch instead of after the whole grid.
-    fn next_unit(&mut self) -> Option<WorkUnit> {
+    /// screen meanwhile), the others between shading batches.
+    fn next_unit(&mut self, device: &wgpu::Device) -> Option<WorkUnit> {
         let height = self.settings.height;
         let batches = self.shading_pass.frame_batches().count() as u32;
         let grid_needed = self.grid_needed();
         match self.refinement.stage {
+            Stage::PreviewVisibility => {
+                let Some(valid) = self.prepare_preview(device).map(|_| self.preview_visible())
+                else {
+                    self.refinement.stage = self.main_stage();
+                    return self.next_unit(device);
+                };
+                self.refinement.stage = Stage::Preview { row: 0 };
+                if valid {
+                    self.next_unit(device)
+                } else {
+                    Some(WorkUnit::PreviewVisibility)
+                }
+            }
+            Stage::Preview { row } => {
+                let Some(p) = self.prepare_preview(device) else {
+                    self.refinement.stage = self.main_stage();
+                    return self.next_unit(device);
+                };
+                let rows = self.preview_rows(row, p);
+                self.refinement.stage = if row + rows < p {
+                    Stage::Preview { row: row + rows }
+                } else {
+                    self.main_stage()
+                };
+                Some(WorkUnit::Preview { row0: row, rows })
+            }
             Stage::Volume => {
                 self.refinement.stage = Stage::ShadowGrid;
                 Some(WorkUnit::Volume)
@@ -394,7 +639,7 @@ impl Renderer {
                     return Some(unit);
                 }
                 self.refinement.stage = Stage::Visibility;
-                self.next_unit()
+                self.next_unit(device)
             }
             Stage::Visibility => {
                 self.refinement.stage = if batches == 0 {
@@ -412,13 +657,11 @@ impl Renderer {
                     return Some(unit);
                 }
                 let r = &mut self.refinement;
-                let mut rows = r.shade_rows(row, height);
-                // Whole workgroups (8 rows) where the budget allows.
-                if rows >= 8 && rows < height - row {
-                    rows -= rows % 8;
-                }
+                let rows = r
+                    .bands
+                    .rows(row, height, r.budget.as_secs_f64(), GUESS_SHADE_ROW_S);
                 r.rows_done += rows as u64;
-                r.shade_last = rows;
+                r.bands.last = rows;
                 r.stage = if row + rows < height {
                     Stage::Shade {
                         batch,
@@ -442,9 +685,31 @@ impl Renderer {
         }
     }
 
+    /// Rows of a preview band from `row` (of `height`).
+    fn preview_rows(&mut self, row: u32, height: u32) -> u32 {
+        // Before the preview is measured: the frame's cost of a row under every light batch, scaled
+        // to the preview's width.
+        let factor = self.preview.as_ref().map_or(1, |p| p.factor) as f64;
+        let light_batches = self.first_pass_batches().max(1) as f64;
+        let width = self.settings.width as f64 / factor;
+        let r = &mut self.refinement;
+        let guess = r.bands.cost.map_or(
+            GUESS_SHADE_ROW_S * light_batches * width / GUESS_ROW_PIXELS,
+            |c| c * light_batches / factor,
+        );
+        // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
+        // unit saved), even past a shorter unit budget.
+        let budget = r.budget.max(PREVIEW_TARGET).as_secs_f64();
+        let rows = r.preview_bands.rows(row, height, budget, guess);
+        r.preview_bands.last = rows;
+        rows
+    }
+
     fn encode_unit(&mut self, ctx: &GpuContext, enc: &mut wgpu::CommandEncoder, unit: WorkUnit) {
         let device = &ctx.device;
         match unit {
+            WorkUnit::PreviewVisibility => self.encode_preview_visibility(ctx, enc),
+            WorkUnit::Preview { row0, rows } => self.encode_preview(ctx, enc, row0, rows),
             WorkUnit::Volume => {
                 self.density_pass
                     .encode(device, enc, &self.hair, &self.volume, None);
@@ -465,19 +730,26 @@ impl Renderer {
                     count,
                     None,
                 );
-                if first + count >= self.shadow_grid.entry_count() {
+                let total = self.shadow_grid.entry_count();
+                let group = inputs.light_group * SWEEP_SLOTS;
+                self.refinement.grid_built(first, count, group, total);
+                if first + count >= total {
                     self.shadow_grid_dirty = false;
                 }
             }
             WorkUnit::Visibility => {
-                self.visibility_pass.encode(
-                    device,
-                    enc,
-                    &self.camera,
-                    &self.hair,
-                    &self.targets,
-                    None,
-                );
+                // A parameter change keeps the camera's visibility: only the components restart.
+                if !self.visibility_valid {
+                    self.visibility_pass.encode(
+                        device,
+                        enc,
+                        &self.camera,
+                        &self.hair,
+                        &self.targets,
+                        None,
+                    );
+                    self.visibility_valid = true;
+                }
                 ShadingPass::clear(enc, &self.targets);
                 self.encode_resolve(device, enc, 0..self.settings.height);
             }

@@ -249,9 +249,14 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             azimuthal: &azimuthal,
         };
         let shadows = ReferenceShadows::Dual(&d);
-        super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-            reference_shade(params, variant, sp, wo, &lights, &shadows)
-        })
+        super::shade::shade_pixels(
+            frame,
+            &cam,
+            &hair,
+            &pixels,
+            super::shade::DISTINCT,
+            |sp, wo| reference_shade(params, variant, sp, wo, &lights, &shadows),
+        )
     } else {
         let volume = settings.shadows.then(|| {
             FiberDensity::build(scene.hair, scene.sigma_a, settings.voxel_size(scene.hair))
@@ -259,9 +264,14 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
         let shadows = volume.as_ref().map_or(ReferenceShadows::None, |v| {
             ReferenceShadows::Volume(v, settings.shadow_skip(scene.hair))
         });
-        super::shade::shade_pixels(frame, &cam, &hair, &pixels, |sp, wo| {
-            reference_shade(params, variant, sp, wo, &lights, &shadows)
-        })
+        super::shade::shade_pixels(
+            frame,
+            &cam,
+            &hair,
+            &pixels,
+            super::shade::DISTINCT,
+            |sp, wo| reference_shade(params, variant, sp, wo, &lights, &shadows),
+        )
     };
     frame.with_components(&pixels, &radiance, settings.exposure.exp2())
 }

@@ -5,6 +5,7 @@
 
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
+use super::preview::{Preview, PreviewMode};
 use super::progressive::Refinement;
 use super::resolve::{ResolveInfo, ResolvePass};
 use super::shading::{
@@ -245,6 +246,12 @@ pub struct Renderer {
     pub(super) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
     pub(super) refinement: Refinement,
+    /// Whether and how refinement previews a change, and the preview's targets.
+    pub(super) preview_mode: PreviewMode,
+    pub(super) preview: Option<Preview>,
+    /// The frame's visibility pass has drawn the current camera and fibres (refinement reuses it
+    /// after a parameter change).
+    pub(super) visibility_valid: bool,
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -439,6 +446,9 @@ impl Renderer {
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
             refinement: Refinement::default(),
+            preview_mode: PreviewMode::Off,
+            preview: None,
+            visibility_valid: false,
             settings,
         };
         renderer.update_batches(device);
@@ -455,22 +465,23 @@ impl Renderer {
         }
         let samples = self.settings.samples;
         let height = self.settings.height;
-        let batches: Vec<ShadeBatch> =
-            ShadingPass::batches(self.light_count, self.settings.lights_per_pass)
-                .into_iter()
-                .flat_map(|(first, count)| {
-                    (0..samples).map(move |slot| ShadeBatch {
-                        first,
-                        count,
-                        flags,
-                        samples,
-                        slot,
-                        row0: 0,
-                        rows: height,
-                        _pad: 0,
-                    })
+        // Sample-major: every light batch at the first visibility sample (most of every pixel), then
+        // at the others (the pixels where fibres cross), so a refining image has all its lights early.
+        let light_batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
+        let batches: Vec<ShadeBatch> = (0..samples)
+            .flat_map(|slot| {
+                light_batches.iter().map(move |&(first, count)| ShadeBatch {
+                    first,
+                    count,
+                    flags,
+                    samples,
+                    slot,
+                    row0: 0,
+                    rows: height,
+                    _pad: 0,
                 })
-                .collect();
+            })
+            .collect();
         self.shading_pass.set_batches(device, &batches);
         self.restart_refinement();
     }
@@ -499,6 +510,7 @@ impl Renderer {
         tile: Tile,
     ) -> Result<(), RenderError> {
         self.set_size(ctx, tile.size[0], tile.size[1])?;
+        self.invalidate_visibility();
         self.camera_view = *camera;
         self.tile = Some(tile);
         let u = camera.tile_uniform(&tile, self.settings.min_width_px);
@@ -570,15 +582,23 @@ impl Renderer {
         self.tables_for = *params;
         // The forward and dual tables are read only with multiple scattering (the grid's forward
         // terms, the shading's dual terms); without it only a new azimuthal table changes the image.
-        if self.settings.multiple_scattering {
-            self.mark_shadow_grid_dirty();
-        } else if azimuthal_changed {
-            self.restart_refinement();
+        // A new azimuthal table shows a change not on screen yet (an eta or eccentricity change waits
+        // for it): a preview is owed; the others refine the change already shown.
+        let multiple = self.settings.multiple_scattering;
+        if azimuthal_changed {
+            if multiple {
+                self.mark_shadow_grid_dirty();
+            } else {
+                self.restart_refinement();
+            }
+        } else if multiple {
+            self.refining(|r| r.mark_shadow_grid_dirty());
         }
         true
     }
 
     pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) {
+        self.invalidate_visibility();
         self.camera_view = *camera;
         self.tile = None;
         let u = camera.uniform(
@@ -636,7 +656,8 @@ impl Renderer {
         if !self.volume_stale {
             return false;
         }
-        self.mark_volume_dirty();
+        // The change itself is on screen (shaded with the old volume): no new preview.
+        self.refining(|r| r.mark_volume_dirty());
         true
     }
 
@@ -675,6 +696,8 @@ impl Renderer {
                 self.skip,
                 self.settings.multiple_scattering,
             );
+            // A new buffer: no entry is part-way through a rebuild.
+            self.refinement.grid_partial.clear();
         }
         self.mark_shadow_grid_dirty();
         self.update_batches(&ctx.device);
@@ -709,6 +732,7 @@ impl Renderer {
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
         self.write_thickness(ctx, hair, thickness_scale)?;
+        self.invalidate_visibility();
         self.mark_volume_dirty();
         Ok(())
     }
@@ -725,6 +749,7 @@ impl Renderer {
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
         self.write_thickness(ctx, hair, thickness_scale)?;
+        self.invalidate_visibility();
         if self.volume_dirty {
             return Ok(());
         }
@@ -810,6 +835,8 @@ impl Renderer {
                 self.skip,
                 multiple_scattering,
             );
+            // A new buffer: no entry is part-way through a rebuild.
+            self.refinement.grid_partial.clear();
             self.shadow_grid_dirty = true;
             self.refinement.grid_done = 0;
         }
@@ -848,6 +875,17 @@ impl Renderer {
             0..self.settings.height,
             None,
         );
+        if let Some(p) = &self.preview {
+            self.resolve_pass.encode(
+                &ctx.device,
+                &mut enc,
+                &p.camera,
+                &self.resolve_info,
+                &p.targets,
+                0..p.targets.height,
+                None,
+            );
+        }
         ctx.queue.submit([enc.finish()]);
     }
 
@@ -960,6 +998,7 @@ impl Renderer {
             0..self.settings.height,
             timer.and_then(|t| t.compute_writes("resolve")),
         );
+        self.visibility_valid = true;
         self.last_ran.extend(["visibility", "shading", "resolve"]);
         if let Some(t) = timer {
             t.resolve(&mut enc);
@@ -1014,7 +1053,15 @@ impl Renderer {
 
     /// Waits for the last frame and reads every output back.
     pub fn read_frame(&self, ctx: &GpuContext) -> Result<Frame, RenderError> {
-        let t = &self.targets;
+        self.read_targets(ctx, &self.targets)
+    }
+
+    /// Reads every output of `t` (the frame's targets or the preview's) back.
+    pub(super) fn read_targets(
+        &self,
+        ctx: &GpuContext,
+        t: &FrameTargets,
+    ) -> Result<Frame, RenderError> {
         let scale = self.settings.exposure.exp2();
         let read4 = |b: &wgpu::Buffer| ctx.read_buffer::<[f32; 4]>(b).map_err(RenderError::Gpu);
         let components = t

@@ -187,6 +187,23 @@ pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
     out
 }
 
+/// The preview's one segment per pixel (twin of the WGSL's `SLOT_REPRESENTATIVE` branch): the first
+/// covered sample's segment id, standing for all the covered samples (their count).
+pub fn representative_sample(ids: &[u32]) -> Option<(u32, u32)> {
+    let first = *ids.iter().find(|&&v| v != 0)?;
+    Some((first, ids.iter().filter(|&&v| v != 0).count() as u32))
+}
+
+/// Which of a pixel's samples are shaded: each distinct segment with its count (the frame), or one
+/// representative (the preview).
+pub type SampleChoice = fn(&[u32]) -> Vec<(u32, u32)>;
+
+/// The frame's choice: every distinct segment ([`distinct_samples`]).
+pub const DISTINCT: SampleChoice = distinct_samples;
+
+/// The preview's choice: [`representative_sample`].
+pub const REPRESENTATIVE: SampleChoice = |ids| representative_sample(ids).into_iter().collect();
+
 /// The pixel loop of the CPU shading passes (rayon over the given pixels): for each pixel, `fold` is
 /// called on a fresh `init()` for every distinct segment among its visibility samples, with the pixel
 /// index, the shading point, omega_o and the segment's coverage weight (its share of the samples).
@@ -195,6 +212,19 @@ pub fn fold_visible_points<T: Send>(
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
+    init: impl Fn() -> T + Sync,
+    fold: impl Fn(&mut T, usize, &ShadingPoint, Vec3, f64) + Sync,
+) -> Vec<T> {
+    fold_chosen_points(frame, camera, hair, pixels, DISTINCT, init, fold)
+}
+
+/// [`fold_visible_points`] over the samples `choose` picks.
+pub fn fold_chosen_points<T: Send>(
+    frame: &Frame,
+    camera: &CameraUniform,
+    hair: &ShadingHair,
+    pixels: &[usize],
+    choose: SampleChoice,
     init: impl Fn() -> T + Sync,
     fold: impl Fn(&mut T, usize, &ShadingPoint, Vec3, f64) + Sync,
 ) -> Vec<T> {
@@ -209,7 +239,7 @@ pub fn fold_visible_points<T: Send>(
             );
             let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
             let mut acc = init();
-            for (id, count) in distinct_samples(ids) {
+            for (id, count) in choose(ids) {
                 let sp = hair.shading_point(id - 1, origin, dir);
                 fold(&mut acc, i, &sp, -dir, count as f64 / frame.samples as f64);
             }
@@ -219,19 +249,22 @@ pub fn fold_visible_points<T: Send>(
 }
 
 /// The pixel loop of the shading pass on the CPU: for each pixel of `pixels`, the coverage-weighted
-/// sum of `shade` over the distinct segments of its samples, the radiance per lobe (before exposure).
+/// sum of `shade` over the samples `choose` picks ([`DISTINCT`] for the frame, [`REPRESENTATIVE`] for
+/// the preview), the radiance per lobe (before exposure).
 pub fn shade_pixels(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
+    choose: SampleChoice,
     shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
 ) -> Vec<LobeRadiance> {
-    fold_visible_points(
+    fold_chosen_points(
         frame,
         camera,
         hair,
         pixels,
+        choose,
         || [[0.0; 3]; 5],
         |acc: &mut LobeRadiance, _, sp, omega_o, weight| {
             let l = shade(sp, omega_o);

@@ -11,6 +11,9 @@ use bytemuck::{Pod, Zeroable};
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
+/// [`ShadeBatch::slot`] of the preview's dispatches: each pixel shades its representative sample
+/// ([`super::shade::representative_sample`]) instead of each distinct segment at one slot.
+pub const SLOT_REPRESENTATIVE: u32 = u32::MAX;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
@@ -30,7 +33,8 @@ pub struct ShadeBatch {
     pub count: u32,
     pub flags: u32,
     pub samples: u32,
-    /// The visibility sample this dispatch shades (one dispatch per sample and batch).
+    /// The visibility sample this dispatch shades (one dispatch per sample and batch), or
+    /// [`SLOT_REPRESENTATIVE`].
     pub slot: u32,
     /// Rows [row0, row0 + rows) of the image.
     pub row0: u32,

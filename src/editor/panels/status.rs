@@ -45,8 +45,16 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
                             .desired_width(120.0)
                             .text(format!("refining {w}×{h}")),
                     );
-                    if let Some(t) = live.first_image_in {
-                        ui.weak(format!("first image {:.2} s", t.as_secs_f64()));
+                    let times: Vec<String> =
+                        [("preview", live.preview_in), ("full", live.full_image_in)]
+                            .into_iter()
+                            .filter_map(|(n, t)| t.map(|t| format!("{n} {:.2} s", t.as_secs_f64())))
+                            .collect();
+                    if !times.is_empty() {
+                        ui.weak(times.join(" · ")).on_hover_text(
+                            "Since the last change: the reduced-resolution preview, and the full \
+                             image with every light at the first sample",
+                        );
                     }
                 }
                 _ => {}

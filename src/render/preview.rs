@@ -1,0 +1,246 @@
+//! The preview that progressive refinement shows right after a change: the same view at a fraction of
+//! the resolution, every light, one shading per pixel (the first covered visibility sample's segment
+//! standing for all the covered samples: [`super::shade::representative_sample`]), shadows from the
+//! grid as it stands (a light group whose entries are part-way through a rebuild is shaded
+//! unshadowed). Its own small frame targets and camera; the frame's are untouched, so the converged
+//! image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
+//! preview takes about [`PREVIEW_TARGET`].
+
+use super::camera::CameraUniform;
+use super::frame::Frame;
+use super::renderer::{RenderError, Renderer};
+use super::shading::{
+    FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, SLOT_REPRESENTATIVE, ShadeBatch, ShadingInputs,
+    ShadingPass,
+};
+use super::targets::FrameTargets;
+use crate::gpu::GpuContext;
+use std::time::Duration;
+
+/// Whether, and at what resolution, refinement previews a change.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PreviewMode {
+    /// No preview (the CLI and `render_frame` users).
+    #[default]
+    Off,
+    /// The image's width and height divided by this (1: no preview).
+    Fixed(u32),
+    /// A divisor adapted to the measured preview time (the editor).
+    Auto,
+}
+
+/// The shading time an automatic preview aims at, in one unit (the bound for the first
+/// preview after a change is 0.25 s on lavapipe; the rest is the unit in flight when the change comes
+/// and the UI frame). On lavapipe this puts the default scene's divisor near Blender's 8-pixel start.
+pub const PREVIEW_TARGET: Duration = Duration::from_millis(150);
+/// Pixels of the first automatic preview, before its time is measured.
+pub const PREVIEW_PIXELS: u32 = 6_000;
+/// The coarsest preview (a divisor).
+pub const MAX_PREVIEW_FACTOR: u32 = 16;
+
+/// The preview's targets and camera.
+pub(super) struct Preview {
+    pub factor: u32,
+    pub targets: FrameTargets,
+    pub camera: wgpu::Buffer,
+    /// The visibility pass has drawn the current camera (a parameter change reuses it).
+    pub visible: bool,
+}
+
+impl Preview {
+    /// The preview size of a `width` x `height` image at divisor `factor`.
+    pub fn size(width: u32, height: u32, factor: u32) -> (u32, u32) {
+        let f = factor.max(1);
+        (width.div_ceil(f), height.div_ceil(f))
+    }
+}
+
+impl Renderer {
+    /// Whether changes are previewed (the editor: [`PreviewMode::Auto`]).
+    pub fn set_preview(&mut self, mode: PreviewMode) {
+        self.preview_mode = mode;
+        self.replan();
+    }
+
+    /// The preview's resolution divisor now (1: none; tiles of a still are never previewed).
+    pub fn preview_factor(&self) -> u32 {
+        if self.tile.is_some() {
+            return 1;
+        }
+        let pixels = self.settings.width as f64 * self.settings.height as f64;
+        let first = (pixels / PREVIEW_PIXELS as f64).sqrt().ceil() as u32;
+        match self.preview_mode {
+            PreviewMode::Off => 1,
+            PreviewMode::Fixed(f) => f.max(1),
+            PreviewMode::Auto if first < 2 => 1,
+            PreviewMode::Auto => self
+                .refinement
+                .preview_auto_factor
+                .unwrap_or(first)
+                .clamp(2, MAX_PREVIEW_FACTOR),
+        }
+    }
+
+    /// Makes the preview's targets for the current size and divisor; its height, or None when there
+    /// is no preview.
+    pub(super) fn prepare_preview(&mut self, device: &wgpu::Device) -> Option<u32> {
+        let factor = self.preview_factor();
+        if factor < 2 {
+            return None;
+        }
+        let (w, h) = Preview::size(self.settings.width, self.settings.height, factor);
+        let fits = self
+            .preview
+            .as_ref()
+            .is_some_and(|p| p.factor == factor && (p.targets.width, p.targets.height) == (w, h));
+        if !fits {
+            let camera = self.preview_camera(factor);
+            self.preview = Some(Preview {
+                factor,
+                targets: FrameTargets::new(device, w, h, self.settings.samples),
+                camera: crate::gpu::context::buffer_init(
+                    device,
+                    "preview camera",
+                    bytemuck::bytes_of(&camera),
+                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                ),
+                visible: false,
+            });
+            self.refinement.preview_bands_reset();
+        }
+        Some(h)
+    }
+
+    /// The preview's camera: the frame's view at the preview's size, fibres at least as wide as one
+    /// pixel of the frame (a preview pixel's 1/factor), so they keep their width in the scene.
+    fn preview_camera(&self, factor: u32) -> CameraUniform {
+        let (w, h) = Preview::size(self.settings.width, self.settings.height, factor);
+        self.camera_view
+            .uniform(w, h, self.settings.min_width_px / factor as f32)
+    }
+
+    /// Whether the preview's visibility shows the current camera.
+    pub(super) fn preview_visible(&self) -> bool {
+        self.preview.as_ref().is_some_and(|p| p.visible)
+    }
+
+    /// The camera, the image size or the fibres' width changed: both visibility passes must run again.
+    pub(super) fn invalidate_visibility(&mut self) {
+        self.visibility_valid = false;
+        if let Some(p) = &mut self.preview {
+            p.visible = false;
+        }
+    }
+
+    /// Encodes the preview's visibility pass with the current camera.
+    pub(super) fn encode_preview_visibility(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+    ) {
+        let Some(p) = &self.preview else {
+            return;
+        };
+        let camera = self.preview_camera(p.factor);
+        ctx.queue
+            .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
+        self.visibility_pass
+            .encode(&ctx.device, enc, &p.camera, &self.hair, &p.targets, None);
+        if let Some(p) = &mut self.preview {
+            p.visible = true;
+        }
+    }
+
+    /// Encodes preview rows [row0, row0 + rows) (the first unit clears the preview's components):
+    /// every light batch, then the rows' resolve.
+    pub(super) fn encode_preview(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        row0: u32,
+        rows: u32,
+    ) {
+        let Some(p) = &self.preview else {
+            return;
+        };
+        let device = &ctx.device;
+        if row0 == 0 {
+            ShadingPass::clear(enc, &p.targets);
+        }
+        let inputs = ShadingInputs {
+            camera: &p.camera,
+            ..self.shading_inputs()
+        };
+        let batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
+        for (b, (first, count)) in batches.into_iter().enumerate() {
+            let partial = self
+                .refinement
+                .grid_partial
+                .get(b)
+                .copied()
+                .unwrap_or(false);
+            let mut flags = 0;
+            if self.settings.shadows && !partial {
+                flags |= FLAG_SHADOWS;
+            }
+            if self.settings.multiple_scattering {
+                flags |= FLAG_MULTIPLE_SCATTERING;
+            }
+            let batch = ShadeBatch {
+                first,
+                count,
+                flags,
+                samples: self.settings.samples,
+                slot: SLOT_REPRESENTATIVE,
+                row0,
+                rows,
+                _pad: 0,
+            };
+            self.shading_pass
+                .encode_batch(device, enc, &inputs, &p.targets, &batch, None);
+        }
+        self.resolve_pass.encode(
+            device,
+            enc,
+            &p.camera,
+            &self.resolve_info,
+            &p.targets,
+            row0..row0 + rows,
+            None,
+        );
+    }
+
+    /// A preview of this change took `preview_time` (its units): the automatic divisor moves
+    /// towards [`PREVIEW_TARGET`] (time goes with the pixels, the square of the divisor).
+    pub(super) fn adapt_preview(&mut self, preview_time: Duration) {
+        if self.preview_mode != PreviewMode::Auto {
+            return;
+        }
+        let f = self.preview_factor();
+        if f < 2 {
+            return;
+        }
+        let ideal = f as f64 * (preview_time.as_secs_f64() / PREVIEW_TARGET.as_secs_f64()).sqrt();
+        let next = if ideal > 1.25 * f as f64 || ideal < 0.7 * f as f64 {
+            (ideal.ceil() as u32).clamp(2, MAX_PREVIEW_FACTOR)
+        } else {
+            f
+        };
+        self.refinement.preview_auto_factor = Some(next);
+    }
+
+    /// The last preview as drawn (None: no preview made yet) with its camera (tests: the CPU twin
+    /// shades its representative samples).
+    pub fn read_preview(
+        &self,
+        ctx: &GpuContext,
+    ) -> Result<Option<(Frame, CameraUniform)>, RenderError> {
+        match &self.preview {
+            None => Ok(None),
+            Some(p) => Ok(Some((
+                self.read_targets(ctx, &p.targets)?,
+                self.preview_camera(p.factor),
+            ))),
+        }
+    }
+}
