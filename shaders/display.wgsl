@@ -1,7 +1,8 @@
 // Display pass: the resolved beauty (linear, premultiplied by coverage) through the viewport's view
 // transform into an 8-bit sRGB-encoded image over a flat background (egui samples it as Rgba8Unorm).
-// A smaller image (the preview) is sampled bilinearly, premultiplied. The EXR never passes here.
-// CPU twin: render/display.rs (`source_sample`, `display_pixel`).
+// A smaller image (the preview) is sampled bilinearly, premultiplied; while the preview shows, the rows
+// of the full image its first pass has finished are drawn over it. The EXR never passes here.
+// CPU twin: render/display.rs (`displayed_pixel`: `source_sample`, `display_pixel`).
 
 struct DisplayInfo {
     width: u32,
@@ -14,16 +15,21 @@ struct DisplayInfo {
     exposure_scale: f32,
     // 2^EV of the render's exposure (the beauty has it; the components do not).
     render_scale: f32,
-    // Size of the image read (the display's, or the preview's).
+    // Size of the full image.
     source: vec2<u32>,
     // Background, display-encoded.
     background: vec3<f32>,
+    // Size of the preview, and the rows of the full image drawn over it (all of them: no preview).
+    preview_source: vec2<u32>,
+    sharp_rows: u32,
 }
 
 @group(0) @binding(0) var<uniform> info: DisplayInfo;
 @group(0) @binding(1) var<storage, read> beauty: array<vec4<f32>>;
 @group(0) @binding(2) var image: texture_storage_2d<rgba8unorm, write>;
 @group(0) @binding(3) var<storage, read> component: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> preview_beauty: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> preview_component: array<vec4<f32>>;
 
 fn aces_filmic(x: f32) -> f32 {
     let y = max(x, 0.0) * 0.6;
@@ -71,9 +77,10 @@ struct SourceTaps {
     f: vec2<f32>,
 }
 
-// The source pixels under display pixel `id` and their bilinear weights (pixel centres aligned).
-fn source_taps(id: vec2<u32>) -> SourceTaps {
-    let s = max(info.source, vec2<u32>(1u));
+// The source pixels (of a `size` image) under display pixel `id` and their bilinear weights (pixel
+// centres aligned).
+fn source_taps(id: vec2<u32>, size: vec2<u32>) -> SourceTaps {
+    let s = max(size, vec2<u32>(1u));
     let p = max((vec2<f32>(id) + 0.5) * vec2<f32>(s) / vec2<f32>(f32(info.width), f32(info.height)) - 0.5, vec2<f32>(0.0));
     let c0 = min(vec2<u32>(floor(p)), s - 1u);
     let c1 = min(c0 + 1u, s - 1u);
@@ -89,12 +96,21 @@ fn display(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= info.width || id.y >= info.height {
         return;
     }
+    // The full image's row under this display row.
+    let row = (id.y * info.source.y) / info.height;
+    if row >= info.sharp_rows {
+        let t = source_taps(id.xy, info.preview_source);
+        let b = bilinear(preview_beauty[t.i00], preview_beauty[t.i10], preview_beauty[t.i01], preview_beauty[t.i11], t.f);
+        let c = bilinear(preview_component[t.i00], preview_component[t.i10], preview_component[t.i01], preview_component[t.i11], t.f);
+        textureStore(image, vec2<i32>(id.xy), display_pixel(b, c));
+        return;
+    }
     if all(info.source == vec2<u32>(info.width, info.height)) {
         let i = id.y * info.width + id.x;
         textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i]));
         return;
     }
-    let t = source_taps(id.xy);
+    let t = source_taps(id.xy, info.source);
     let b = bilinear(beauty[t.i00], beauty[t.i10], beauty[t.i01], beauty[t.i11], t.f);
     let c = bilinear(component[t.i00], component[t.i10], component[t.i01], component[t.i11], t.f);
     textureStore(image, vec2<i32>(id.xy), display_pixel(b, c));

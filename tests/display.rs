@@ -1,11 +1,13 @@
 //! The viewport's display pass (shaders/display.wgsl) against its CPU twin (`source_sample`,
 //! `display_pixel`), on lavapipe: both view transforms, the viewport exposure, partial coverage over the
-//! background, a solo component, and a smaller image (the preview) enlarged bilinearly.
+//! background, a solo component, a smaller image enlarged bilinearly, and a preview under the full
+//! image's first rows.
 
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::display::{
-    DisplayInfo, DisplayPass, Solo, ViewTransform, display_pixel, source_sample,
+    DisplayInfo, DisplayPass, Solo, ViewTransform, displayed_pixel,
 };
+use strandlight::render::progressive::DisplayImage;
 use strandlight::render::targets::FrameTargets;
 
 #[test]
@@ -30,9 +32,31 @@ fn the_display_pass_matches_its_cpu_twin() {
         .write_buffer(&targets.beauty, 0, bytemuck::cast_slice(&beauty));
     ctx.queue
         .write_buffer(&targets.components[1], 0, bytemuck::cast_slice(&component));
+    // A preview: a third of the size, other values.
+    let (pw, ph) = (w.div_ceil(3), h.div_ceil(3));
+    let preview = FrameTargets::new(&ctx.device, pw, ph, 4);
+    let pn = (pw * ph) as usize;
+    let preview_beauty: Vec<[f32; 4]> = (0..pn)
+        .map(|i| {
+            let a = 0.25 + 0.75 * (i % 3) as f32 / 2.0;
+            [a * 0.3 * i as f32, a * 0.2, a, a]
+        })
+        .collect();
+    let preview_component: Vec<[f32; 4]> = preview_beauty
+        .iter()
+        .map(|p| [p[2], p[1], p[0], 0.0])
+        .collect();
+    ctx.queue
+        .write_buffer(&preview.beauty, 0, bytemuck::cast_slice(&preview_beauty));
+    ctx.queue.write_buffer(
+        &preview.components[1],
+        0,
+        bytemuck::cast_slice(&preview_component),
+    );
     let mut worst = 0.0f32;
-    // The display at the image's size, and larger than it (a preview: 3x wider, not a whole multiple).
-    for (dw, dh) in [(w, h), (3 * w - 2, 3 * h + 1)] {
+    // The display at the image's size, larger than it (3x wider, not a whole multiple), and the
+    // preview under the image's first 5 rows.
+    for (dw, dh, with_preview) in [(w, h, false), (3 * w - 2, 3 * h + 1, false), (w, h, true)] {
         let pass = DisplayPass::new(&ctx.device, dw, dh);
         for (transform, ev, solo) in [
             (ViewTransform::Filmic, 0.0, Solo::Beauty),
@@ -44,23 +68,32 @@ fn the_display_pass_matches_its_cpu_twin() {
                 render_scale: 2.0,
                 ..DisplayInfo::new(dw, dh, transform, ev, [0.2, 0.3, 0.4])
             };
+            let sharp_rows = 5;
+            let image = DisplayImage {
+                full: &targets,
+                preview: with_preview.then_some((&preview, sharp_rows)),
+            };
             let mut enc = ctx.device.create_command_encoder(&Default::default());
-            pass.encode(&ctx.device, &ctx.queue, &mut enc, &targets, &info, solo);
+            pass.encode(&ctx.device, &ctx.queue, &mut enc, image, &info, solo);
             let (buffer, row) = pass.copy_to_buffer(&ctx.device, &mut enc);
             ctx.queue.submit([enc.finish()]);
             let bytes: Vec<u8> = ctx.read_buffer(&buffer).expect("read back");
             let cpu_info = DisplayInfo {
                 solo: matches!(solo, Solo::Component(_)) as u32,
                 source: [w, h],
+                preview_source: if with_preview { [pw, ph] } else { [w, h] },
+                sharp_rows: if with_preview { sharp_rows } else { u32::MAX },
                 ..info
+            };
+            let full = (&beauty[..], &component[..]);
+            let small = if with_preview {
+                (&preview_beauty[..], &preview_component[..])
+            } else {
+                full
             };
             for y in 0..dh {
                 for x in 0..dw {
-                    let want = display_pixel(
-                        &cpu_info,
-                        source_sample(&cpu_info, &beauty, x, y),
-                        source_sample(&cpu_info, &component, x, y),
-                    );
+                    let want = displayed_pixel(&cpu_info, full, small, x, y);
                     for c in 0..4 {
                         let got =
                             bytes[y as usize * row as usize + 4 * x as usize + c] as f32 / 255.0;

@@ -337,15 +337,15 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     assert!(live.set_thickness_scale(&ctx, &wrong, 2.0).is_err());
 }
 
-/// Refines to convergence, returning each call's submitted unit and the image it reported ready.
-fn refine_events(
-    r: &mut Renderer,
-    ctx: &GpuContext,
-) -> Vec<(Option<WorkUnit>, Option<ImageReady>)> {
+/// One call of `refine`: the unit it submitted, the image it reported ready, the sharp rows after it.
+type Event = (Option<WorkUnit>, Option<ImageReady>, u32);
+
+/// Refines to convergence, returning every call's [`Event`].
+fn refine_events(r: &mut Renderer, ctx: &GpuContext) -> Vec<Event> {
     let mut events = Vec::new();
     loop {
         let p = r.refine(ctx).expect("refine");
-        events.push((p.submitted, p.ready));
+        events.push((p.submitted, p.ready, r.sharp_rows()));
         if p.converged {
             return events;
         }
@@ -414,6 +414,15 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
         })
         .max();
     assert_eq!(shaded_before_full, Some(light_batches - 1));
+    // Meanwhile the full image's first pass went band by band under every light: its finished rows
+    // (drawn over the preview) grew in steps.
+    let mut sharp: Vec<u32> = events[..full_at].iter().map(|e| e.2).collect();
+    sharp.dedup();
+    println!("sharp rows before the full image: {sharp:?}");
+    assert!(
+        sharp.len() >= 3 && sharp.windows(2).all(|w| w[0] < w[1]),
+        "the first pass sharpens band by band"
+    );
     let b = progressive.read_frame(&ctx).expect("read");
     assert_eq!(
         difference(&a, &b),

@@ -123,8 +123,11 @@ pub struct EditorApp {
     /// The viewport's size in physical pixels and its rectangle in points (last frame).
     pub viewport_px: [u32; 2],
     pub viewport_rect: Option<egui::Rect>,
-    /// Smoothed UI frame time.
+    /// Smoothed UI frame time: the interval between frames while the viewport refines (an idle
+    /// editor draws nothing, so the first frame after a pause is not counted).
     pub frame_ms: f32,
+    /// The last frame asked to be drawn again soon (the viewport was refining).
+    refining: bool,
     /// The frame after convergence was requested (it paints the last image).
     painted_converged: bool,
     /// Set by wgpu when the device is lost (reason and message).
@@ -213,6 +216,7 @@ impl EditorApp {
             viewport_px: [640, 400],
             viewport_rect: None,
             frame_ms: 0.0,
+            refining: false,
             painted_converged: false,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
@@ -702,9 +706,11 @@ impl EditorApp {
         let result = result
             .and_then(|_| live.sync(&self.session, &camera))
             .and_then(|_| live.step(self.view));
+        self.refining = false;
         match result {
             Ok(p) => {
                 if !p.converged || live.tables_pending() {
+                    self.refining = true;
                     // Poll for the unit in flight every 30 ms (not every vsync: on a software GPU,
                     // egui's own frames share the CPU with the refinement).
                     self.ctx.request_repaint_after(REFINE_POLL);
@@ -759,7 +765,7 @@ impl EditorApp {
 
     fn frame_timing(&mut self) {
         let now = Instant::now();
-        if let Some(last) = self.last_frame {
+        if let Some(last) = self.last_frame.filter(|_| self.refining) {
             let ms = (now - last).as_secs_f32() * 1e3;
             self.frame_ms = if self.frame_ms == 0.0 {
                 ms

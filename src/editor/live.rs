@@ -14,6 +14,7 @@ use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
+use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
@@ -120,6 +121,8 @@ pub struct LiveScene {
     mean_sigma_a: [f64; 3],
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
+    /// Tables to build (for these parameters, reusing this azimuthal table when it fits).
+    wanted_tables: Option<(HairParams, Arc<AzimuthalTable>)>,
     /// Tables built but not yet handed to the renderer (see `step`).
     held_tables: Option<Tables>,
     pub progress: Option<Progress>,
@@ -131,8 +134,10 @@ pub struct LiveScene {
     pub first_image_in: Option<Duration>,
     pub preview_in: Option<Duration>,
     pub full_image_in: Option<Duration>,
-    /// The image the display shows, and how many previews it has shown.
+    /// The image the display shows, how many previews it has shown, and the full image's sharp rows
+    /// it drew over the last.
     showing: ImageReady,
+    shown_sharp: u32,
     pub previews_shown: u64,
     /// Restarts of the refinement (a change or a refinement of it), and the one whose converged
     /// image was displayed.
@@ -200,6 +205,7 @@ impl LiveScene {
             },
             view: None,
             tables: None,
+            wanted_tables: None,
             held_tables: None,
             progress: None,
             refine_started: Instant::now(),
@@ -208,6 +214,7 @@ impl LiveScene {
             preview_in: None,
             full_image_in: None,
             showing: ImageReady::Full,
+            shown_sharp: 0,
             previews_shown: 0,
             restarts: 0,
             shown_converged: None,
@@ -265,13 +272,14 @@ impl LiveScene {
                     .map(|(_, t)| t.azimuthal.clone())
                     .filter(|t| t.fits_hair(&params))
                     .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
-                // A newer build replaces an older one; set_tables ignores stale tables anyway.
+                // A newer build replaces an older one; set_tables ignores stale tables anyway. It
+                // starts once the change's preview is on screen (`step`): on two cores the build
+                // would slow the preview, and a slider drag would start one per frame.
                 self.held_tables = None;
-                self.tables = Some(Job::spawn(
-                    "hair tables",
-                    || {},
-                    move |_| (params, build_tables(&params, Some(&azimuthal))),
-                ));
+                self.wanted_tables = Some((params, azimuthal));
+            } else {
+                // The renderer's or the held tables fit: an intermediate look's build is not wanted.
+                self.wanted_tables = None;
             }
             changed = true;
         }
@@ -405,6 +413,23 @@ impl LiveScene {
         // The image the last unit finished goes to the display before the next unit is queued.
         let ready = self.renderer.poll_refinement(&self.ctx)?;
         self.note_ready(ready);
+        // The tables' build starts once the change shows (at once without a preview, or for a new eta
+        // or eccentricity, which shows only with its azimuthal table).
+        let start = self
+            .wanted_tables
+            .as_ref()
+            .is_some_and(|(params, azimuthal)| {
+                self.first_image_in.is_some()
+                    || self.renderer.preview_factor() < 2
+                    || !azimuthal.fits_hair(params)
+            });
+        if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
+            self.tables = Some(Job::spawn(
+                "hair tables",
+                || {},
+                move |_| (params, build_tables(&params, Some(&azimuthal))),
+            ));
+        }
         let finished = self.tables.as_mut().and_then(|job| job.poll());
         match finished {
             Some(Ok(tables)) => {
@@ -436,7 +461,8 @@ impl LiveScene {
             self.refined();
         }
         // With tables on the way, the volume waits for them: they rebuild the grid too.
-        let tables_waiting = self.tables.is_some() || self.held_tables.is_some();
+        let tables_waiting =
+            self.wanted_tables.is_some() || self.tables.is_some() || self.held_tables.is_some();
         if shown && !tables_waiting && self.renderer.rebuild_stale_volume() {
             self.refined();
         }
@@ -450,7 +476,10 @@ impl LiveScene {
             self.shown_converged = Some(self.restarts);
             self.showing = ImageReady::Full;
         }
-        if ready.is_some() || converged_now || self.view != Some(view) {
+        // The first pass sharpens the preview band by band.
+        let sharper =
+            self.showing == ImageReady::Preview && self.renderer.sharp_rows() != self.shown_sharp;
+        if ready.is_some() || converged_now || sharper || self.view != Some(view) {
             self.show(view);
         }
         self.progress = Some(progress);
@@ -506,11 +535,15 @@ impl LiveScene {
         );
         self.ctx.queue.submit([enc.finish()]);
         self.view = Some(view);
+        self.shown_sharp = self.renderer.sharp_rows();
     }
 
     /// Whether tables are still being built or not yet handed to the renderer, or a deferred
     /// absorption change still waits for its volume: the image is not the session's final one yet.
     pub fn tables_pending(&self) -> bool {
-        self.tables.is_some() || self.held_tables.is_some() || self.renderer.volume_stale()
+        self.wanted_tables.is_some()
+            || self.tables.is_some()
+            || self.held_tables.is_some()
+            || self.renderer.volume_stale()
     }
 }

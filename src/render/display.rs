@@ -3,6 +3,7 @@
 //! that egui draws. Display only: stills and EXRs never pass here. [`display_pixel`] is the CPU twin.
 
 use super::frame::{aces_filmic, srgb_encode};
+use super::progressive::DisplayImage;
 use super::targets::FrameTargets;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use bytemuck::{Pod, Zeroable};
@@ -41,13 +42,17 @@ pub struct DisplayInfo {
     pub solo: u32,
     pub exposure_scale: f32,
     pub render_scale: f32,
-    /// Size of the image read: the display's, or smaller (the preview, sampled bilinearly).
+    /// Size of the full image (the display's, or another, sampled bilinearly).
     pub source: [u32; 2],
     pub background: [f32; 3],
     pub _pad2: f32,
+    /// Size of the preview, and the rows of the full image drawn over it (every row: no preview).
+    pub preview_source: [u32; 2],
+    pub sharp_rows: u32,
+    pub _pad3: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<DisplayInfo>() == 48);
+const _: () = assert!(std::mem::size_of::<DisplayInfo>() == 64);
 
 impl DisplayInfo {
     pub fn new(
@@ -67,6 +72,9 @@ impl DisplayInfo {
             source: [width, height],
             background,
             _pad2: 0.0,
+            preview_source: [width, height],
+            sharp_rows: u32::MAX,
+            _pad3: 0,
         }
     }
 }
@@ -114,21 +122,27 @@ pub fn display_pixel(info: &DisplayInfo, beauty: [f32; 4], component: [f32; 4]) 
     ]
 }
 
-/// The premultiplied value of `image` (a `info.source`-sized image) under display pixel (x, y):
-/// itself at the same size, bilinear with pixel centres aligned otherwise (twin of the WGSL
-/// `source_taps` and `bilinear`).
-pub fn source_sample(info: &DisplayInfo, image: &[[f32; 4]], x: u32, y: u32) -> [f32; 4] {
-    let [sw, sh] = info.source.map(|v| v.max(1));
-    if [sw, sh] == [info.width, info.height] {
-        return image[(y * info.width + x) as usize];
+/// The premultiplied value of `image` (a `source`-sized image) under display pixel (x, y) of a
+/// `display`-sized one: itself at the same size, bilinear with pixel centres aligned otherwise (twin of
+/// the WGSL `source_taps` and `bilinear`).
+pub fn source_sample(
+    display: [u32; 2],
+    source: [u32; 2],
+    image: &[[f32; 4]],
+    x: u32,
+    y: u32,
+) -> [f32; 4] {
+    let [sw, sh] = source.map(|v| v.max(1));
+    if [sw, sh] == display {
+        return image[(y * sw + x) as usize];
     }
     let axis = |i: u32, s: u32, d: u32| {
         let p = ((i as f32 + 0.5) * s as f32 / d as f32 - 0.5).max(0.0);
         let c0 = (p.floor() as u32).min(s - 1);
         (c0, (c0 + 1).min(s - 1), p - p.floor())
     };
-    let (x0, x1, fx) = axis(x, sw, info.width);
-    let (y0, y1, fy) = axis(y, sh, info.height);
+    let (x0, x1, fx) = axis(x, sw, display[0]);
+    let (y0, y1, fy) = axis(y, sh, display[1]);
     let at = |x: u32, y: u32| image[(y * sw + x) as usize];
     let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
     std::array::from_fn(|k| {
@@ -136,6 +150,32 @@ pub fn source_sample(info: &DisplayInfo, image: &[[f32; 4]], x: u32, y: u32) -> 
         let bottom = c[k] + (d[k] - c[k]) * fx;
         top + (bottom - top) * fy
     })
+}
+
+/// A beauty and a solo component of one image, as the display reads them.
+pub type DisplaySource<'a> = (&'a [[f32; 4]], &'a [[f32; 4]]);
+
+/// Display pixel (x, y): the full image's rows above `info.sharp_rows`, the preview's below, each
+/// sampled to the display's size, through [`display_pixel`] (twin of the WGSL `display`).
+pub fn displayed_pixel(
+    info: &DisplayInfo,
+    full: DisplaySource,
+    preview: DisplaySource,
+    x: u32,
+    y: u32,
+) -> [f32; 4] {
+    let display = [info.width, info.height];
+    let row = y * info.source[1] / info.height.max(1);
+    let (size, (beauty, component)) = if row >= info.sharp_rows {
+        (info.preview_source, preview)
+    } else {
+        (info.source, full)
+    };
+    display_pixel(
+        info,
+        source_sample(display, size, beauty, x, y),
+        source_sample(display, size, component, x, y),
+    )
 }
 
 /// The display texture for one image size and the pass that fills it.
@@ -220,26 +260,30 @@ impl DisplayPass {
         (buffer, row)
     }
 
-    /// Encodes the transform of `targets.beauty` or one component into the texture (bilinearly
-    /// enlarged when the targets are smaller: the preview).
+    /// Encodes the transform of the image's beauty or one component into the texture (bilinearly
+    /// enlarged when smaller: the preview, under the full image's sharp rows).
     pub fn encode(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        targets: &FrameTargets,
+        image: DisplayImage,
         info: &DisplayInfo,
         solo: Solo,
     ) {
-        let (flag, component) = match solo {
-            Solo::Beauty => (0, &targets.components[0]),
-            Solo::Component(k) => (1, &targets.components[k.min(targets.components.len() - 1)]),
+        let targets = image.full;
+        let component_of = |t: &'_ FrameTargets| match solo {
+            Solo::Beauty => 0,
+            Solo::Component(k) => k.min(t.components.len() - 1),
         };
+        let (preview, sharp_rows) = image.preview.unwrap_or((targets, u32::MAX));
         let info = DisplayInfo {
             width: self.width,
             height: self.height,
             source: [targets.width, targets.height],
-            solo: flag,
+            preview_source: [preview.width, preview.height],
+            sharp_rows,
+            solo: matches!(solo, Solo::Component(_)) as u32,
             ..*info
         };
         queue.write_buffer(&self.info, 0, bytemuck::bytes_of(&info));
@@ -255,7 +299,15 @@ impl DisplayPass {
                 },
                 wgpu::BindGroupEntry {
                     binding: 3,
-                    resource: component.as_entire_binding(),
+                    resource: targets.components[component_of(targets)].as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: preview.beauty.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: preview.components[component_of(preview)].as_entire_binding(),
                 },
             ],
         );

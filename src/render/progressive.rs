@@ -37,8 +37,16 @@ pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
-/// The row width of that guess.
+/// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
+const GUESS_ROW_LIGHTS: f64 = 16.0;
+/// Visibility samples with their own shading bands (at most 4 samples per pixel).
+const MAX_SLOTS: usize = 4;
+
+/// The bands of visibility sample `slot`.
+fn slot_bands(slot: u32) -> usize {
+    (slot as usize).min(MAX_SLOTS - 1)
+}
 
 /// One bounded piece of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,6 +65,14 @@ pub enum WorkUnit {
     Preview { row0: u32, rows: u32 },
 }
 
+/// The images a display pass reads: the frame's, and a preview under the frame's first `sharp_rows`
+/// rows ([`Renderer::image`]).
+#[derive(Clone, Copy)]
+pub struct DisplayImage<'a> {
+    pub full: &'a FrameTargets,
+    pub preview: Option<(&'a FrameTargets, u32)>,
+}
+
 /// Which image a finished unit left worth showing ([`Renderer::image`] gives its targets).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageReady {
@@ -69,11 +85,19 @@ pub enum ImageReady {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage {
     PreviewVisibility,
-    Preview { row: u32 },
+    Preview {
+        row: u32,
+    },
     Volume,
     ShadowGrid,
     Visibility,
-    Shade { batch: u32, row: u32 },
+    /// Frame batch `batch` from `row`; `band`: the rows of the band the first pass shades under
+    /// every light batch (0: size a new band).
+    Shade {
+        batch: u32,
+        row: u32,
+        band: u32,
+    },
     Converged,
 }
 
@@ -176,12 +200,15 @@ pub struct Refinement {
     /// preview shades those lights unshadowed).
     pub(super) grid_partial: Vec<bool>,
     /// Rows of shading batches submitted since the restart.
-    rows_done: u64,
+    /// Estimated seconds of the shading units submitted since the restart (for the progress).
+    shade_done: f64,
     budget: Duration,
     /// Seconds per shadow-grid entry (None: not measured yet).
     grid_cost: Option<f64>,
-    /// The frame's shading bands and the preview's.
-    bands: Bands,
+    /// The frame's shading bands per visibility sample (costs per light: the first sample shades
+    /// every covered pixel, the others only where a new segment appears, a few times cheaper), and
+    /// the preview's (costs per row of all lights).
+    bands: [Bands; MAX_SLOTS],
     preview_bands: Bands,
     /// Items of the last grid unit.
     grid_last: u32,
@@ -195,6 +222,8 @@ pub struct Refinement {
     pub(super) preview_owed: bool,
     /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
     pub(super) preview_auto_factor: Option<u32>,
+    /// Rows of the full image that the first pass has finished under every light since the restart.
+    sharp_rows: u32,
     /// A preview unit was submitted since the restart, and the time its shading units took.
     preview_started: bool,
     preview_shading: Duration,
@@ -206,10 +235,10 @@ impl Default for Refinement {
             stage: Stage::Visibility,
             grid_done: 0,
             grid_partial: Vec::new(),
-            rows_done: 0,
+            shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
-            bands: Bands::default(),
+            bands: Default::default(),
             preview_bands: Bands::default(),
             grid_last: 1,
             in_flight: None,
@@ -218,6 +247,7 @@ impl Default for Refinement {
             restarts: 0,
             preview_owed: false,
             preview_auto_factor: None,
+            sharp_rows: 0,
             preview_started: false,
             preview_shading: Duration::ZERO,
         }
@@ -245,6 +275,13 @@ impl Refinement {
             .min(remaining.max(1))
     }
 
+    /// Seconds per row and light of a shading batch at visibility sample `slot` (measured or guessed).
+    fn light_row_cost(&self, slot: u32) -> f64 {
+        self.bands[slot_bands(slot)]
+            .cost
+            .unwrap_or(GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS)
+    }
+
     /// The preview's targets were made anew: its rows' costs are unknown.
     pub(super) fn preview_bands_reset(&mut self) {
         self.preview_bands = Bands::default();
@@ -252,13 +289,16 @@ impl Refinement {
 
     /// The image width changed by `ratio`.
     pub(super) fn resized(&mut self, ratio: f64) {
-        self.bands.resized(ratio);
+        for b in &mut self.bands {
+            b.resized(ratio);
+        }
         self.preview_bands = Bands::default();
     }
 
     /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
-    /// measurement, so one slow unit does not halve the next ones).
-    fn measured(&mut self, unit: WorkUnit, elapsed: Duration) {
+    /// measurement, so one slow unit does not halve the next ones); `batch`: a shading unit's
+    /// visibility sample and light count.
+    fn measured(&mut self, unit: WorkUnit, elapsed: Duration, batch: Option<(u32, u32)>) {
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
             self.stats.longest_unit = Some(unit);
@@ -277,7 +317,10 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.grid_cost = Some(self.grid_cost.map_or(per, |o| 0.5 * (o + per)));
             }
-            WorkUnit::Shade { row0, rows, .. } => self.bands.measured(row0, rows, seconds),
+            WorkUnit::Shade { row0, rows, .. } => {
+                let (slot, lights) = batch.unwrap_or((0, 1));
+                self.bands[slot_bands(slot)].measured(row0, rows, seconds / lights.max(1) as f64);
+            }
             WorkUnit::Preview { row0, rows } => {
                 self.preview_shading += elapsed;
                 self.preview_bands.measured(row0, rows, seconds)
@@ -376,7 +419,8 @@ impl Renderer {
         let r = &mut self.refinement;
         r.preview_started = false;
         r.preview_shading = Duration::ZERO;
-        r.rows_done = 0;
+        r.sharp_rows = 0;
+        r.shade_done = 0.0;
         r.stats = RefineStats::default();
         r.started = Instant::now();
         r.restarts += 1;
@@ -403,7 +447,11 @@ impl Renderer {
         let (unit, elapsed, restart) =
             (f.unit, t.saturating_duration_since(f.submitted), f.restart);
         self.refinement.in_flight = None;
-        self.refinement.measured(unit, elapsed);
+        let batch = match unit {
+            WorkUnit::Shade { batch, .. } => self.batch_shape(batch),
+            _ => None,
+        };
+        self.refinement.measured(unit, elapsed, batch);
         let ready = match unit {
             WorkUnit::Preview { row0, rows } => {
                 let height = self.preview.as_ref().map_or(0, |p| p.targets.height);
@@ -411,6 +459,10 @@ impl Renderer {
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let first_pass = self.first_pass_batches();
+                if batch + 1 == first_pass && restart == self.refinement.restarts {
+                    let r = &mut self.refinement;
+                    r.sharp_rows = r.sharp_rows.max(row0 + rows);
+                }
                 let after = batch + 1 > first_pass
                     || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
                 after.then_some(ImageReady::Full)
@@ -508,12 +560,30 @@ impl Renderer {
         in_flight || (planned && r.preview_started)
     }
 
-    /// The targets holding `image` (the preview's, or the frame's).
-    pub fn image(&self, image: ImageReady) -> &FrameTargets {
-        match (image, &self.preview) {
-            (ImageReady::Preview, Some(p)) => &p.targets,
-            _ => &self.targets,
+    /// What shows `image`: the frame's targets, and for the preview its targets with the rows of the
+    /// frame that the first pass has finished since (drawn sharp over it).
+    pub fn image(&self, image: ImageReady) -> DisplayImage<'_> {
+        let preview = match (image, &self.preview) {
+            (ImageReady::Preview, Some(p)) => Some((&p.targets, self.refinement.sharp_rows)),
+            _ => None,
+        };
+        DisplayImage {
+            full: &self.targets,
+            preview,
         }
+    }
+
+    /// Rows of the full image the first pass has finished under every light since the restart.
+    pub fn sharp_rows(&self) -> u32 {
+        self.refinement.sharp_rows
+    }
+
+    /// Frame batch `batch`'s visibility sample and light count.
+    fn batch_shape(&self, batch: u32) -> Option<(u32, u32)> {
+        self.shading_pass
+            .frame_batches()
+            .nth(batch as usize)
+            .map(|b| (b.slot, b.count))
     }
 
     /// Shading batches of the first pass: every light batch at the first visibility sample.
@@ -532,7 +602,6 @@ impl Renderer {
     ) -> Progress {
         let r = &self.refinement;
         let grid_cost = r.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
-        let shade_cost = r.bands.cost.unwrap_or(GUESS_SHADE_ROW_S);
         let entries = self.shadow_grid.entry_count() as f64;
         let grid_total = if self.grid_used() {
             entries * grid_cost
@@ -544,10 +613,13 @@ impl Renderer {
         } else {
             grid_total
         };
-        let rows_total =
-            self.shading_pass.frame_batches().count() as f64 * self.settings.height as f64;
-        let shade_total = rows_total * shade_cost;
-        let shade_done = r.rows_done as f64 * shade_cost;
+        let height = self.settings.height as f64;
+        let shade_total: f64 = self
+            .shading_pass
+            .frame_batches()
+            .map(|b| height * r.light_row_cost(b.slot) * b.count as f64)
+            .sum();
+        let shade_done = r.shade_done;
         let converged = r.stage == Stage::Converged && r.in_flight.is_none();
         let fraction = if converged {
             1.0
@@ -645,33 +717,69 @@ impl Renderer {
                 self.refinement.stage = if batches == 0 {
                     Stage::Converged
                 } else {
-                    Stage::Shade { batch: 0, row: 0 }
+                    Stage::Shade {
+                        batch: 0,
+                        row: 0,
+                        band: 0,
+                    }
                 };
                 Some(WorkUnit::Visibility)
             }
-            Stage::Shade { batch, row } => {
+            Stage::Shade { batch, row, band } => {
                 if grid_needed
                     && row == 0
                     && let Some(unit) = self.grid_unit(self.grid_entries_for(batch))
                 {
                     return Some(unit);
                 }
+                let first_pass = self.first_pass_batches();
+                let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
+                let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
-                let rows = r
-                    .bands
-                    .rows(row, height, r.budget.as_secs_f64(), GUESS_SHADE_ROW_S);
-                r.rows_done += rows as u64;
-                r.bands.last = rows;
-                r.stage = if row + rows < height {
+                let budget = r.budget.as_secs_f64() / lights;
+                let rows = if band > 0 {
+                    band.min(height - row)
+                } else {
+                    let bands = &mut r.bands[slot_bands(slot)];
+                    let rows =
+                        bands.rows(row, height, budget, GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS);
+                    bands.last = rows;
+                    rows
+                };
+                r.shade_done += rows as f64 * r.light_row_cost(slot) * lights;
+                let next_band = |batch| Stage::Shade {
+                    batch,
+                    row: 0,
+                    band: 0,
+                };
+                r.stage = if batch < first_pass {
+                    // The first pass band by band, each under every light batch: the full image
+                    // sharpens from the top over the preview.
+                    if batch + 1 < first_pass {
+                        Stage::Shade {
+                            batch: batch + 1,
+                            row,
+                            band: rows,
+                        }
+                    } else if row + rows < height {
+                        Stage::Shade {
+                            batch: 0,
+                            row: row + rows,
+                            band: 0,
+                        }
+                    } else if first_pass < batches {
+                        next_band(first_pass)
+                    } else {
+                        Stage::Converged
+                    }
+                } else if row + rows < height {
                     Stage::Shade {
                         batch,
                         row: row + rows,
+                        band: 0,
                     }
                 } else if batch + 1 < batches {
-                    Stage::Shade {
-                        batch: batch + 1,
-                        row: 0,
-                    }
+                    next_band(batch + 1)
                 } else {
                     Stage::Converged
                 };
@@ -693,9 +801,10 @@ impl Renderer {
         let light_batches = self.first_pass_batches().max(1) as f64;
         let width = self.settings.width as f64 / factor;
         let r = &mut self.refinement;
-        let guess = r.bands.cost.map_or(
+        let lights = self.light_count as f64;
+        let guess = r.bands[0].cost.map_or(
             GUESS_SHADE_ROW_S * light_batches * width / GUESS_ROW_PIXELS,
-            |c| c * light_batches / factor,
+            |c| c * lights / factor,
         );
         // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
         // unit saved), even past a shorter unit budget.
