@@ -47,9 +47,10 @@ pub struct BenchArgs {
     /// Progressive refinement without its preview (the editor's reduced-resolution first image).
     #[arg(long)]
     pub no_preview: bool,
-    /// Progressive refinement's time budget per unit, milliseconds.
-    #[arg(long, default_value_t = 30.0)]
-    pub unit_budget_ms: f64,
+    /// Progressive refinement's time budget per unit, milliseconds (default: the editor's for the
+    /// adapter, 80 on a software GPU, 30 on a hardware one).
+    #[arg(long)]
+    pub unit_budget_ms: Option<f64>,
     /// Write the JSON here as well as to stdout.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -207,13 +208,19 @@ fn edit_run(
     let needs_tables = renderer.set_params_deferred(ctx, edited);
     let cpu_ms = t.elapsed().as_secs_f64() * 1e3;
     let azimuthal = renderer.azimuthal_table().clone();
-    let mut worker = needs_tables.then(|| {
+    let spawn = move || {
         std::thread::spawn(move || {
             let t = Instant::now();
             let tables = build_tables(&params, Some(&azimuthal));
             (tables, t.elapsed().as_secs_f64() * 1e3)
         })
-    });
+    };
+    // As the editor: the build starts once the preview shows (at once without one).
+    let mut spawn = needs_tables.then_some(spawn);
+    let mut worker = None;
+    if renderer.preview_factor() < 2 {
+        worker = spawn.take().map(|s| s());
+    }
     let mut tables_ms = 0.0;
     let mut hand_over = |r: &mut Renderer, worker: &mut Option<std::thread::JoinHandle<_>>| {
         if let Some(w) = worker.take()
@@ -224,11 +231,19 @@ fn edit_run(
         }
     };
     let run = refine_run(ctx, renderer, |r, run| {
+        if (run.preview_ms.is_some() || run.first_pass_ms.is_some())
+            && let Some(s) = spawn.take()
+        {
+            worker = Some(s());
+        }
         if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
             hand_over(r, &mut worker);
         }
     })?;
     let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
+    if let Some(s) = spawn.take() {
+        worker = Some(s());
+    }
     if worker.is_some() {
         // Converged before the tables came: they refine it once more.
         hand_over(renderer, &mut worker);
@@ -348,9 +363,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let progressive = if args.no_progressive {
             None
         } else {
-            renderer.set_unit_budget(std::time::Duration::from_secs_f64(
-                args.unit_budget_ms.max(0.1) * 1e-3,
-            ));
+            let budget = args.unit_budget_ms.map_or_else(
+                || strandlight::editor::live::unit_budget(&ctx),
+                |ms| std::time::Duration::from_secs_f64(ms.max(0.1) * 1e-3),
+            );
+            renderer.set_unit_budget(budget);
             renderer.set_preview(if args.no_preview {
                 PreviewMode::Off
             } else {
@@ -391,7 +408,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 edits.push(edit);
             }
             Some(ProgressiveReport {
-                unit_budget_ms: args.unit_budget_ms,
+                unit_budget_ms: budget.as_secs_f64() * 1e3,
                 preview_factor: renderer.preview_factor(),
                 units: stats.units,
                 longest_unit_ms: stats.longest.as_secs_f64() * 1e3,

@@ -121,6 +121,8 @@ pub struct LiveScene {
     mean_sigma_a: [f64; 3],
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
+    /// A camera held back while a preview is under way.
+    wanted_camera: Option<Camera>,
     /// Tables to build (for these parameters, reusing this azimuthal table when it fits).
     wanted_tables: Option<(HairParams, Arc<AzimuthalTable>)>,
     /// Tables built but not yet handed to the renderer (see `step`).
@@ -205,6 +207,7 @@ impl LiveScene {
             },
             view: None,
             tables: None,
+            wanted_camera: None,
             wanted_tables: None,
             held_tables: None,
             progress: None,
@@ -302,10 +305,13 @@ impl LiveScene {
         }
         self.applied.render = session.render;
         // During a drag the camera waits for the preview under way (a move per UI frame would restart
-        // it before it is ever shown); the latest goes over when it is complete.
-        if *camera != self.applied.camera && !self.renderer.preview_under_way() {
-            self.renderer.set_camera(&self.ctx, camera);
-            self.applied.camera = *camera;
+        // it before it is ever shown); the latest goes over as soon as it is complete (`step`).
+        if *camera == self.applied.camera {
+            self.wanted_camera = None;
+        } else if self.renderer.preview_under_way() {
+            self.wanted_camera = Some(*camera);
+        } else {
+            self.apply_camera(camera);
             changed = true;
         }
         // The fibre thickness, against what the renderer has (not the applied look: a look that failed
@@ -394,16 +400,22 @@ impl LiveScene {
         self.first_image_in = None;
         self.preview_in = None;
         self.full_image_in = None;
-        self.refined();
+        self.restarted_as_refinement();
     }
 
     /// A restart that refines the change on screen (its tables, its volume): its times still count
     /// from the change.
-    fn refined(&mut self) {
+    fn restarted_as_refinement(&mut self) {
         self.converged_in = None;
         self.restarts += 1;
         // The last refinement's progress (converged, say) says nothing about this one.
         self.progress = None;
+    }
+
+    fn apply_camera(&mut self, camera: &Camera) {
+        self.renderer.set_camera(&self.ctx, camera);
+        self.applied.camera = *camera;
+        self.wanted_camera = None;
     }
 
     /// One UI frame's work: shows the image a finished unit left, takes finished tables, submits one
@@ -413,15 +425,25 @@ impl LiveScene {
         // The image the last unit finished goes to the display before the next unit is queued.
         let ready = self.renderer.poll_refinement(&self.ctx)?;
         self.note_ready(ready);
+        // A camera held back behind a preview goes over the moment it is done, before the next unit
+        // (a full-resolution one) is queued.
+        if let Some(camera) = self.wanted_camera
+            && !self.renderer.preview_under_way()
+        {
+            self.apply_camera(&camera);
+            self.restarted();
+        }
         // The tables' build starts once the change shows (at once without a preview, or for a new eta
         // or eccentricity, which shows only with its azimuthal table).
         let start = self
             .wanted_tables
             .as_ref()
             .is_some_and(|(params, azimuthal)| {
-                self.first_image_in.is_some()
-                    || self.renderer.preview_factor() < 2
-                    || !azimuthal.fits_hair(params)
+                // One build at a time (a slider drag would pile them up on the GPU's cores).
+                self.tables.is_none()
+                    && (self.first_image_in.is_some()
+                        || self.renderer.preview_factor() < 2
+                        || !azimuthal.fits_hair(params))
             });
         if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
             self.tables = Some(Job::spawn(
@@ -458,15 +480,18 @@ impl LiveScene {
             && let Some((params, tables)) = self.held_tables.take()
             && self.renderer.set_tables(&self.ctx, &params, &tables)
         {
-            self.refined();
+            self.restarted_as_refinement();
         }
         // With tables on the way, the volume waits for them: they rebuild the grid too.
         let tables_waiting =
             self.wanted_tables.is_some() || self.tables.is_some() || self.held_tables.is_some();
         if shown && !tables_waiting && self.renderer.rebuild_stale_volume() {
-            self.refined();
+            self.restarted_as_refinement();
         }
         let progress = self.renderer.refine(&self.ctx)?;
+        // A unit that finished between the two polls.
+        self.note_ready(progress.ready);
+        let ready = ready.or(progress.ready);
         // Converged without a unit in flight (nothing changed since) shows nothing new.
         if progress.converged && self.converged_in.is_none() {
             self.converged_in = Some(self.refine_started.elapsed());
@@ -478,7 +503,7 @@ impl LiveScene {
         }
         // The first pass sharpens the preview band by band.
         let sharper =
-            self.showing == ImageReady::Preview && self.renderer.sharp_rows() != self.shown_sharp;
+            self.showing == ImageReady::Preview && self.renderer.sharp_rows() > self.shown_sharp;
         if ready.is_some() || converged_now || sharper || self.view != Some(view) {
             self.show(view);
         }

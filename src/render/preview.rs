@@ -29,10 +29,18 @@ pub enum PreviewMode {
     Auto,
 }
 
-/// The shading time an automatic preview aims at, in one unit (the bound for the first
-/// preview after a change is 0.25 s on lavapipe; the rest is the unit in flight when the change comes
-/// and the UI frame). On lavapipe this puts the default scene's divisor near Blender's 8-pixel start.
+/// The longest shading time an automatic preview aims at, in one unit (the bound for the
+/// first preview after a change is 0.25 s on lavapipe; the rest is the unit in flight when the change
+/// comes and the UI frame). On lavapipe this puts the default scene's divisor near Blender's 8-pixel
+/// start.
 pub const PREVIEW_TARGET: Duration = Duration::from_millis(150);
+
+/// The preview's time target under a unit budget: twice the budget (one unit instead of several is a
+/// UI frame sooner per unit saved), at most [`PREVIEW_TARGET`] (the editor's 80 ms units on a software
+/// GPU give 150 ms; 30 ms units on a hardware one, 60 ms).
+pub fn preview_target(budget: Duration) -> Duration {
+    (2 * budget).min(PREVIEW_TARGET).max(budget)
+}
 /// Pixels of the first automatic preview, before its time is measured.
 pub const PREVIEW_PIXELS: u32 = 6_000;
 /// The coarsest preview (a divisor).
@@ -58,8 +66,22 @@ impl Preview {
 impl Renderer {
     /// Whether changes are previewed (the editor: [`PreviewMode::Auto`]).
     pub fn set_preview(&mut self, mode: PreviewMode) {
-        self.preview_mode = mode;
-        self.replan();
+        if mode != self.preview_mode {
+            self.preview_mode = mode;
+            self.replan();
+        }
+    }
+
+    /// The image size changed: the preview's targets go (made again at the new size), and the
+    /// automatic divisor scales with the image's side so the preview keeps its cost.
+    pub(super) fn resized_preview(&mut self, width: u32, height: u32) {
+        self.preview = None;
+        let old = self.settings.width as f64 * self.settings.height as f64;
+        let new = width as f64 * height as f64;
+        if let Some(f) = &mut self.refinement.preview_auto_factor {
+            let scaled = (*f as f64 * (new / old.max(1.0)).sqrt()).round() as u32;
+            *f = scaled.clamp(2, MAX_PREVIEW_FACTOR);
+        }
     }
 
     /// The preview's resolution divisor now (1: none; tiles of a still are never previewed).
@@ -220,7 +242,8 @@ impl Renderer {
         if f < 2 {
             return;
         }
-        let ideal = f as f64 * (preview_time.as_secs_f64() / PREVIEW_TARGET.as_secs_f64()).sqrt();
+        let target = preview_target(self.refinement.budget()).as_secs_f64();
+        let ideal = f as f64 * (preview_time.as_secs_f64() / target).sqrt();
         let next = if ideal > 1.25 * f as f64 || ideal < 0.7 * f as f64 {
             (ideal.ceil() as u32).clamp(2, MAX_PREVIEW_FACTOR)
         } else {
@@ -229,8 +252,9 @@ impl Renderer {
         self.refinement.preview_auto_factor = Some(next);
     }
 
-    /// The last preview as drawn (None: no preview made yet) with its camera (tests: the CPU twin
-    /// shades its representative samples).
+    /// The last preview as drawn (None: no preview made yet) with the current camera at its size
+    /// (the one it was drawn with unless the camera moved since; tests: the CPU twin shades its
+    /// representative samples).
     pub fn read_preview(
         &self,
         ctx: &GpuContext,

@@ -19,7 +19,7 @@
 //! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
 //! the shadow grid has built.
 
-use super::preview::PREVIEW_TARGET;
+use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
 use super::shading::{ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
@@ -55,7 +55,8 @@ pub enum WorkUnit {
     Volume,
     /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
-    /// The visibility pass; the components are cleared.
+    /// The visibility pass (skipped when the camera, size and fibres are those it last drew); the
+    /// components are cleared.
     Visibility,
     /// Frame batch `batch` (its lights at its visibility sample) over rows [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
@@ -143,13 +144,19 @@ struct Bands {
 
 impl Bands {
     /// Rows of a band from `row` (of `height`): as many as `budget` holds by the rows' own measured
-    /// costs (the mean row's, or `guess`, where not measured yet, then at most twice the last band);
-    /// at least one; whole workgroups (8 rows) where the budget allows.
-    fn rows(&self, row: u32, height: u32, budget: f64, guess: f64) -> u32 {
+    /// costs (else the `prior` ones: an upper bound, the first sample's for the others; else the mean
+    /// row's, or `guess`, and then at most twice the last band); at least one; whole workgroups (8
+    /// rows) where the budget allows.
+    fn rows(&self, row: u32, height: u32, budget: f64, guess: f64, prior: &[f64]) -> u32 {
         let fallback = self.cost.unwrap_or(guess).max(1e-12);
         let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
         for r in row..height {
-            let c = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
+            let own = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
+            let c = if own > 0.0 {
+                own
+            } else {
+                prior.get(r as usize).copied().unwrap_or(0.0)
+            };
             unknown |= c <= 0.0;
             let c = if c > 0.0 { c } else { fallback };
             if n > 0 && t + c > budget {
@@ -199,7 +206,6 @@ pub struct Refinement {
     /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
     /// preview shades those lights unshadowed).
     pub(super) grid_partial: Vec<bool>,
-    /// Rows of shading batches submitted since the restart.
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
@@ -224,8 +230,10 @@ pub struct Refinement {
     pub(super) preview_auto_factor: Option<u32>,
     /// Rows of the full image that the first pass has finished under every light since the restart.
     sharp_rows: u32,
-    /// A preview unit was submitted since the restart, and the time its shading units took.
+    /// A preview unit was submitted since the restart, whether it drew a new view, and the time its
+    /// shading units took.
     preview_started: bool,
+    preview_new_view: bool,
     preview_shading: Duration,
 }
 
@@ -249,12 +257,18 @@ impl Default for Refinement {
             preview_auto_factor: None,
             sharp_rows: 0,
             preview_started: false,
+            preview_new_view: false,
             preview_shading: Duration::ZERO,
         }
     }
 }
 
 impl Refinement {
+    /// The longest time one unit should take.
+    pub(super) fn budget(&self) -> Duration {
+        self.budget
+    }
+
     /// `render_frame` did the whole frame.
     pub(super) fn complete_frame(&mut self) {
         self.stage = Stage::Converged;
@@ -280,6 +294,38 @@ impl Refinement {
         self.bands[slot_bands(slot)]
             .cost
             .unwrap_or(GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS)
+    }
+
+    /// A finished preview (at divisor `factor`, `lights` lights) gives the first-sample bands the
+    /// cost of the rows not measured yet: a preview row costs what `factor` frame rows of its width
+    /// under every light do, so a frame row costs about its preview row's cost times `factor` over
+    /// the lights (the first bands of a new view are sized from the picture, not from the mean of the
+    /// empty rows above it).
+    fn seed_from_preview(&mut self, factor: u32, lights: u32, height: u32) {
+        // A new view (the preview drew its visibility): the rows measured before show another picture.
+        let new_view = self.preview_new_view;
+        let f = factor.max(1);
+        let seeded: Vec<f64> = (0..height)
+            .map(|y| {
+                let measured = self.bands[0]
+                    .row_cost
+                    .get(y as usize)
+                    .copied()
+                    .unwrap_or(0.0);
+                let preview = self
+                    .preview_bands
+                    .row_cost
+                    .get((y / f) as usize)
+                    .copied()
+                    .unwrap_or(0.0);
+                if measured > 0.0 && !(new_view && preview > 0.0) {
+                    measured
+                } else {
+                    preview * f as f64 / lights.max(1) as f64
+                }
+            })
+            .collect();
+        self.bands[0].row_cost = seeded;
     }
 
     /// The preview's targets were made anew: its rows' costs are unknown.
@@ -329,6 +375,18 @@ impl Refinement {
         }
     }
 
+    /// A new grid buffer (zeros, not a light's values): every group counts as unbuilt until swept,
+    /// so the preview shades them unshadowed.
+    pub(super) fn grid_unbuilt(&mut self, group_entries: u32, total: u32) {
+        self.grid_partial = vec![true; total.div_ceil(group_entries.max(1)) as usize];
+    }
+
+    /// The whole grid was built in one go (`render_frame`, the benchmark's timing).
+    pub(super) fn grid_complete(&mut self, total: u32) {
+        self.grid_partial.clear();
+        self.grid_done = total;
+    }
+
     /// Records a grid unit over entries [first, first + count) of `total`, in groups of
     /// `group_entries` (the last may be shorter): a group it leaves part-way is partial, one it
     /// completes is not.
@@ -353,8 +411,8 @@ pub struct Progress {
     pub busy: bool,
     /// Every unit of the frame has finished: the image is `render_frame`'s.
     pub converged: bool,
-    /// The unit that finished since the last call left this image worth showing (the preview, or
-    /// the full image from its first pass on).
+    /// The unit whose completion this call noticed left this image worth showing (the preview, or
+    /// the full image from its first pass on); None when it noticed none.
     pub ready: Option<ImageReady>,
     /// Estimated fraction of the frame's work done (by the measured costs).
     pub fraction: f32,
@@ -392,7 +450,7 @@ impl Renderer {
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
     /// no new preview is owed for it (new tables, a deferred volume rebuild).
-    pub(super) fn refining(&mut self, change: impl FnOnce(&mut Self)) {
+    pub(super) fn restart_as_refinement(&mut self, change: impl FnOnce(&mut Self)) {
         let owed = self.refinement.preview_owed;
         change(self);
         self.refinement.preview_owed = owed;
@@ -418,6 +476,7 @@ impl Renderer {
         };
         let r = &mut self.refinement;
         r.preview_started = false;
+        r.preview_new_view = false;
         r.preview_shading = Duration::ZERO;
         r.sharp_rows = 0;
         r.shade_done = 0.0;
@@ -478,6 +537,8 @@ impl Renderer {
                 Some(ImageReady::Preview) => {
                     r.stats.preview.get_or_insert(since);
                     let shading = r.preview_shading;
+                    let factor = self.preview.as_ref().map_or(1, |p| p.factor);
+                    r.seed_from_preview(factor, self.light_count, self.settings.height);
                     self.adapt_preview(shading);
                 }
                 _ => {
@@ -516,6 +577,7 @@ impl Renderer {
         });
         self.refinement.preview_started |=
             matches!(unit, WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility);
+        self.refinement.preview_new_view |= unit == WorkUnit::PreviewVisibility;
         self.refinement.in_flight = Some(InFlight {
             unit,
             submitted: Instant::now(),
@@ -630,11 +692,7 @@ impl Renderer {
             submitted,
             busy,
             converged,
-            ready: if converged {
-                Some(ImageReady::Full)
-            } else {
-                ready
-            },
+            ready,
             fraction,
             stats: r.stats,
         }
@@ -740,10 +798,11 @@ impl Renderer {
                 let rows = if band > 0 {
                     band.min(height - row)
                 } else {
-                    let bands = &mut r.bands[slot_bands(slot)];
-                    let rows =
-                        bands.rows(row, height, budget, GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS);
-                    bands.last = rows;
+                    let k = slot_bands(slot);
+                    let prior: &[f64] = if k > 0 { &r.bands[0].row_cost } else { &[] };
+                    let guess = GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS;
+                    let rows = r.bands[k].rows(row, height, budget, guess, prior);
+                    r.bands[k].last = rows;
                     rows
                 };
                 r.shade_done += rows as f64 * r.light_row_cost(slot) * lights;
@@ -808,8 +867,8 @@ impl Renderer {
         );
         // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
         // unit saved), even past a shorter unit budget.
-        let budget = r.budget.max(PREVIEW_TARGET).as_secs_f64();
-        let rows = r.preview_bands.rows(row, height, budget, guess);
+        let budget = preview_target(r.budget).as_secs_f64();
+        let rows = r.preview_bands.rows(row, height, budget, guess, &[]);
         r.preview_bands.last = rows;
         rows
     }

@@ -452,6 +452,7 @@ impl Renderer {
             settings,
         };
         renderer.update_batches(device);
+        renderer.grid_buffer_made();
         Ok(renderer)
     }
 
@@ -592,7 +593,7 @@ impl Renderer {
                 self.restart_refinement();
             }
         } else if multiple {
-            self.refining(|r| r.mark_shadow_grid_dirty());
+            self.restart_as_refinement(|r| r.mark_shadow_grid_dirty());
         }
         true
     }
@@ -657,7 +658,7 @@ impl Renderer {
             return false;
         }
         // The change itself is on screen (shaded with the old volume): no new preview.
-        self.refining(|r| r.mark_volume_dirty());
+        self.restart_as_refinement(|r| r.mark_volume_dirty());
         true
     }
 
@@ -696,8 +697,7 @@ impl Renderer {
                 self.skip,
                 self.settings.multiple_scattering,
             );
-            // A new buffer: no entry is part-way through a rebuild.
-            self.refinement.grid_partial.clear();
+            self.grid_buffer_made();
         }
         self.mark_shadow_grid_dirty();
         self.update_batches(&ctx.device);
@@ -720,6 +720,17 @@ impl Renderer {
         ctx.queue
             .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
         Ok(())
+    }
+
+    /// A new shadow-grid buffer holds zeros, not finished entries: its groups count as unbuilt.
+    fn grid_buffer_made(&mut self) {
+        let group = self
+            .settings
+            .lights_per_pass
+            .clamp(1, super::shading::MAX_LIGHTS_PER_PASS)
+            * super::shadow_grid::SWEEP_SLOTS;
+        self.refinement
+            .grid_unbuilt(group, self.shadow_grid.entry_count());
     }
 
     /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
@@ -807,6 +818,7 @@ impl Renderer {
         }
         self.refinement
             .resized(width as f64 / self.settings.width.max(1) as f64);
+        self.resized_preview(width, height);
         self.settings.width = width;
         self.settings.height = height;
         self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
@@ -835,8 +847,7 @@ impl Renderer {
                 self.skip,
                 multiple_scattering,
             );
-            // A new buffer: no entry is part-way through a rebuild.
-            self.refinement.grid_partial.clear();
+            self.grid_buffer_made();
             self.shadow_grid_dirty = true;
             self.refinement.grid_done = 0;
         }
@@ -972,6 +983,7 @@ impl Renderer {
             );
             self.last_ran.push("shadow_grid");
             self.shadow_grid_dirty = false;
+            self.refinement.grid_complete(count);
         }
         self.visibility_pass.encode(
             device,
@@ -1034,6 +1046,8 @@ impl Renderer {
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        self.refinement
+            .grid_complete(self.shadow_grid.entry_count());
         Ok(t.elapsed().as_secs_f64())
     }
 
