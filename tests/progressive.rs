@@ -44,27 +44,10 @@ fn difference(a: &Frame, b: &Frame) -> f32 {
 
 /// Refines to convergence, returning the units submitted.
 fn refine_all(r: &mut Renderer, ctx: &GpuContext) -> Vec<WorkUnit> {
-    let mut units = Vec::new();
-    loop {
-        let p = r.refine(ctx).expect("refine");
-        if let Some(u) = p.submitted {
-            units.push(u);
-        }
-        if p.converged {
-            println!(
-                "  {} units, longest {:.1} ms ({:?})",
-                p.stats.units,
-                p.stats.longest.as_secs_f64() * 1e3,
-                p.stats.longest_unit
-            );
-            assert_eq!(p.fraction, 1.0);
-            return units;
-        }
-        assert!((0.0..1.0).contains(&p.fraction), "fraction {}", p.fraction);
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .expect("poll");
-    }
+    refine_events(r, ctx)
+        .into_iter()
+        .filter_map(|e| e.0)
+        .collect()
 }
 
 /// The project's sunny sky as 40 SRBF lights.
@@ -340,15 +323,24 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
 /// One call of `refine`: the unit it submitted, the image it reported ready, the sharp rows after it.
 type Event = (Option<WorkUnit>, Option<ImageReady>, u32);
 
-/// Refines to convergence, returning every call's [`Event`].
+/// Refines to convergence, returning every call's [`Event`]; the progress fraction stays in [0, 1)
+/// until convergence.
 fn refine_events(r: &mut Renderer, ctx: &GpuContext) -> Vec<Event> {
     let mut events = Vec::new();
     loop {
         let p = r.refine(ctx).expect("refine");
         events.push((p.submitted, p.ready, r.sharp_rows()));
         if p.converged {
+            println!(
+                "  {} units, longest {:.1} ms ({:?})",
+                p.stats.units,
+                p.stats.longest.as_secs_f64() * 1e3,
+                p.stats.longest_unit
+            );
+            assert_eq!(p.fraction, 1.0);
             return events;
         }
+        assert!((0.0..1.0).contains(&p.fraction), "fraction {}", p.fraction);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("poll");
@@ -366,7 +358,8 @@ fn radiance(f: &Frame, factor: u32) -> f64 {
 /// volume and the grid), then the full image from its first pass (every light at the first sample);
 /// the converged image is still `render_frame`'s. Its radiance is the frame's within a few percent.
 /// New tables refine the change already shown: no new preview. A restart in the middle of the grid's
-/// rebuild previews the groups part-way through unshadowed (finite values, not half-summed entries).
+/// rebuild previews the groups part-way through unshadowed (no brighter than a preview without
+/// shadows; half-summed entries would read as transmittances above 1).
 #[test]
 fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
     let ctx = context();

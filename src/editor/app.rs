@@ -5,14 +5,14 @@
 use super::autosave::Autosave;
 use super::export::ExportJob;
 use super::jobs::Job;
-use super::live::{LiveScene, Prepared, ViewSettings, prepare};
+use super::live::{LiveScene, ViewSettings, prepare};
 use super::navigation;
 use super::panels;
 use crate::gpu::GpuContext;
 use crate::render::Camera;
 use crate::render::scene::Environment;
 use crate::scattering::lut::Luts;
-use crate::session::assemble::{LoadedHairSource, load_environment_source, load_hair_source};
+use crate::session::assemble::{load_environment_source, load_hair_source};
 use crate::session::{Edit, EnvironmentSource, HairSource, History, Session, ViewCamera};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -49,11 +49,11 @@ pub struct Message {
 
 /// What a load job brings back.
 pub enum Loaded {
-    /// Hair and environment for a new scene, with the CPU work for its renderer done.
+    /// A new scene, its renderer built on the worker too (pipelines compile there: ~1.5 s on
+    /// lavapipe that the UI thread does not wait for), with the camera it was framed with.
     Scene {
-        hair: LoadedHairSource,
-        environment: Environment,
-        prepared: Box<Prepared>,
+        live: Box<LiveScene>,
+        camera: Camera,
         warnings: Vec<String>,
     },
     /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
@@ -328,6 +328,8 @@ impl EditorApp {
     pub fn load_scene(&mut self) {
         let session = self.session.clone();
         let ctx = self.ctx.clone();
+        let (gpu, luts) = (self.gpu.clone(), self.luts.clone());
+        let (w, h) = self.render_size();
         self.loading_for = Some(session.clone());
         self.loading = Some(Job::spawn(
             "loading the scene",
@@ -355,10 +357,24 @@ impl EditorApp {
                 };
                 warnings.extend(hair.warning.clone());
                 let prepared = prepare(&session, &hair.hair).map_err(|e| e.to_string())?;
-                Ok(Loaded::Scene {
+                let gpu = gpu.ok_or("no GPU adapter")?;
+                let (lo, hi) = hair.hair.bounds();
+                let camera = session.camera.resolve(lo, hi, w as f32 / h.max(1) as f32);
+                let live = LiveScene::new(
+                    gpu,
+                    &luts,
+                    &session,
                     hair,
                     environment,
-                    prepared: Box::new(prepared),
+                    prepared,
+                    &camera,
+                    w,
+                    h,
+                )
+                .map_err(|e| e.to_string())?;
+                Ok(Loaded::Scene {
+                    live: Box::new(live),
+                    camera,
                     warnings,
                 })
             },
@@ -553,15 +569,17 @@ impl EditorApp {
                 .unwrap_or_else(|| self.session.clone());
             match result.and_then(|r| r) {
                 Ok(Loaded::Scene {
-                    hair,
-                    environment,
-                    prepared,
+                    live,
+                    camera,
                     warnings,
                 }) => {
                     for w in warnings {
                         self.message(Level::Warning, w);
                     }
-                    self.install_scene(&for_session, hair, environment, *prepared);
+                    self.drop_live();
+                    self.live = Some(*live);
+                    self.camera = Some(camera);
+                    self.failed = None;
                 }
                 Ok(_) => {}
                 Err(e) => {
@@ -614,42 +632,6 @@ impl EditorApp {
             && let Some(er) = &self.egui_renderer
         {
             live.release(&mut er.write());
-        }
-    }
-
-    fn install_scene(
-        &mut self,
-        session: &Session,
-        hair: LoadedHairSource,
-        environment: Environment,
-        prepared: Prepared,
-    ) {
-        let Some(gpu) = self.gpu.clone() else {
-            return;
-        };
-        let camera = self.resolve_camera(hair.hair.bounds());
-        let (w, h) = self.render_size();
-        match LiveScene::new(
-            gpu,
-            &self.luts,
-            session,
-            hair,
-            environment,
-            prepared,
-            &camera,
-            w,
-            h,
-        ) {
-            Ok(live) => {
-                self.drop_live();
-                self.live = Some(live);
-                self.camera = Some(camera);
-                self.failed = None;
-            }
-            Err(e) => {
-                self.failed = Some(SceneKey::of(session));
-                self.message(Level::Error, e.to_string());
-            }
         }
     }
 

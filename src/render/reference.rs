@@ -231,6 +231,16 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
         .camera
         .uniform(frame.width, frame.height, settings.min_width_px);
     let pixels: Vec<usize> = frame.covered().collect();
+    let shade = |shadows: &ReferenceShadows| {
+        super::shade::shade_pixels(
+            frame,
+            &cam,
+            &hair,
+            &pixels,
+            super::shade::DISTINCT,
+            |sp, wo| reference_shade(params, variant, sp, wo, &lights, shadows),
+        )
+    };
     let radiance = if settings.multiple_scattering {
         let fibers = settings
             .shadows
@@ -248,30 +258,14 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             fast: scene.look.fast,
             azimuthal: &azimuthal,
         };
-        let shadows = ReferenceShadows::Dual(&d);
-        super::shade::shade_pixels(
-            frame,
-            &cam,
-            &hair,
-            &pixels,
-            super::shade::DISTINCT,
-            |sp, wo| reference_shade(params, variant, sp, wo, &lights, &shadows),
-        )
+        shade(&ReferenceShadows::Dual(&d))
     } else {
         let volume = settings.shadows.then(|| {
             FiberDensity::build(scene.hair, scene.sigma_a, settings.voxel_size(scene.hair))
         });
-        let shadows = volume.as_ref().map_or(ReferenceShadows::None, |v| {
+        shade(&volume.as_ref().map_or(ReferenceShadows::None, |v| {
             ReferenceShadows::Volume(v, settings.shadow_skip(scene.hair))
-        });
-        super::shade::shade_pixels(
-            frame,
-            &cam,
-            &hair,
-            &pixels,
-            super::shade::DISTINCT,
-            |sp, wo| reference_shade(params, variant, sp, wo, &lights, &shadows),
-        )
+        }))
     };
     frame.with_components(&pixels, &radiance, settings.exposure.exp2())
 }
