@@ -60,7 +60,7 @@ pub enum Loaded {
     Hair { source: HairSource },
     /// A new environment; applied as an edit when it arrives.
     Environment {
-        environment: Environment,
+        environment: Box<Environment>,
         source: EnvironmentSource,
     },
 }
@@ -405,7 +405,7 @@ impl EditorApp {
                     fitted: Some(Box::new(environment.lights.clone())),
                 };
                 Ok(Loaded::Environment {
-                    environment,
+                    environment: Box::new(environment),
                     source,
                 })
             },
@@ -605,7 +605,7 @@ impl EditorApp {
                         && self.loading.is_none()
                         && live.hair_source == self.session.hair
                     {
-                        live.set_environment(environment, source, self.session.env_yaw);
+                        live.set_environment(*environment, source, self.session.env_yaw);
                     }
                 }
                 Ok(Loaded::Scene { .. }) => {}
