@@ -83,8 +83,11 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             app.export = None;
             app.message(Level::Info, "export cancelled");
         }
-        ui.separator();
-        ui.weak(format!("UI {:.1} ms", app.frame_ms));
+        if app.frame_ms > 0.0 {
+            ui.separator();
+            ui.weak(format!("UI {:.1} ms", app.frame_ms))
+                .on_hover_text("Time between UI frames while the viewport refines");
+        }
         if let Some(m) = app.messages.last() {
             ui.separator();
             let colour = match m.level {
