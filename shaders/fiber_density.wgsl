@@ -25,6 +25,15 @@ const CHANNELS: u32 = 11u; // length, 6 tensor, 3 absorption, diameter (each x l
 @group(0) @binding(4) var<storage, read_write> sums: array<atomic<u32>>;
 // Three vec4 per voxel: (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, rho_L), (sigma_a.rgb, 0).
 @group(0) @binding(5) var<storage, read_write> volume: array<vec4<f32>>;
+// The segments a deposit dispatch adds: [first, first + count) (all of them for a whole build, a
+// range per unit of progressive refinement; fixed-point sums make the parts add up exactly).
+struct SegmentRange {
+    first: u32,
+    count: u32,
+    _p0: u32,
+    _p1: u32,
+}
+@group(0) @binding(6) var<storage, read> range: SegmentRange;
 
 fn voxel_index(p: vec3<f32>) -> i32 {
     let q = floor((p - info.origin) / info.voxel);
@@ -42,8 +51,9 @@ fn add_fixed(v: u32, c: u32, x: f32) {
 @compute @workgroup_size(64)
 fn deposit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // Flat index over a 2D dispatch (a dimension holds at most 65535 workgroups).
-    let s = id.x + id.y * groups.x * 64u;
-    if (s >= info.segment_count) {
+    let k = id.x + id.y * groups.x * 64u;
+    let s = range.first + k;
+    if (k >= range.count || s >= info.segment_count) {
         return;
     }
     let i = segments[s];

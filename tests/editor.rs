@@ -279,7 +279,7 @@ fn rebuilds_before_first_image(
         }
         if matches!(
             live.progress.and_then(|p| p.submitted),
-            Some(WorkUnit::ShadowGrid { .. } | WorkUnit::Volume)
+            Some(WorkUnit::ShadowGrid { .. } | WorkUnit::Volume { .. } | WorkUnit::VolumeResolve)
         ) {
             rebuilds += 1;
         }

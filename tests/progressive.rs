@@ -89,13 +89,18 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let b = progressive.read_frame(&ctx).expect("read");
     let count = |f: &dyn Fn(&WorkUnit) -> bool| units.iter().filter(|u| f(u)).count();
     let grid = count(&|u| matches!(u, WorkUnit::ShadowGrid { .. }));
+    let deposits = count(&|u| matches!(u, WorkUnit::Volume { .. }));
+    assert_eq!(count(&|u| *u == WorkUnit::VolumeResolve), 1);
     let shade = count(&|u| matches!(u, WorkUnit::Shade { .. }));
     let d = difference(&a, &b);
     println!(
-        "first frame: {} units ({grid} shadow-grid ranges, {shade} shading bands); difference to render_frame {d:.1e}",
+        "first frame: {} units ({deposits} volume deposits, {grid} shadow-grid ranges, {shade} shading bands); difference to render_frame {d:.1e}",
         units.len()
     );
-    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    assert!(matches!(
+        units.first(),
+        Some(WorkUnit::Volume { first: 0, .. })
+    ));
     assert!(grid >= 2 && shade > 12, "the frame was cut into pieces");
     assert_eq!(d, 0.0, "the converged image is render_frame's");
 
@@ -238,7 +243,10 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
         if multiple {
             assert!(live.rebuild_stale_volume());
             let units = refine_all(&mut live, &ctx);
-            assert_eq!(units.first(), Some(&WorkUnit::Volume));
+            assert!(matches!(
+                units.first(),
+                Some(WorkUnit::Volume { first: 0, .. })
+            ));
         }
         let got = live.read_frame(&ctx).expect("read");
         let mut fresh = new(&dyed);
@@ -270,7 +278,10 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     live.set_thickness_scale(&ctx, &scene.hair, 3.0)
         .expect("thickness");
     let units = refine_all(&mut live, &ctx);
-    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    assert!(matches!(
+        units.first(),
+        Some(WorkUnit::Volume { first: 0, .. })
+    ));
     let got = live.read_frame(&ctx).expect("read");
     let mut thick = scene.hair.clone();
     thick.transform(|p| p, 3.0);
@@ -308,7 +319,10 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     );
     assert!(live.rebuild_stale_volume());
     let units = refine_all(&mut live, &ctx);
-    assert_eq!(units.first(), Some(&WorkUnit::Volume));
+    assert!(matches!(
+        units.first(),
+        Some(WorkUnit::Volume { first: 0, .. })
+    ));
     let back = live.read_frame(&ctx).expect("read");
     assert_eq!(difference(&before, &back), 0.0);
     let wrong = strandlight::render::scene::generated_hair(
@@ -379,7 +393,9 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
     let events = refine_events(&mut progressive, &ctx);
     let units: Vec<WorkUnit> = events.iter().filter_map(|e| e.0).collect();
     let first_ready = |image| events.iter().position(|e| e.1 == Some(image));
-    let volume = units.iter().position(|u| *u == WorkUnit::Volume);
+    let volume = units
+        .iter()
+        .position(|u| matches!(u, WorkUnit::Volume { .. }));
     println!(
         "first frame: {} units, first {:?}; preview ready at call {:?}, full at {:?}, volume unit {volume:?}",
         units.len(),

@@ -152,13 +152,64 @@ impl FiberDensityPass {
         target: &GpuFiberDensity,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        encoder.clear_buffer(&target.sums, 0, None);
-        let bind = |pipeline: &wgpu::ComputePipeline, with_inputs: bool| {
+        let all = 0..hair.segment_count;
+        self.record(device, encoder, hair, target, Some(all), true, timestamps);
+    }
+
+    /// Deposits segments `segments` (clearing the sums first when the range starts at 0): a part of
+    /// a build, finished by [`FiberDensityPass::encode_resolve`].
+    pub fn encode_deposit(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        hair: &GpuHair,
+        target: &GpuFiberDensity,
+        segments: std::ops::Range<u32>,
+    ) {
+        self.record(device, encoder, hair, target, Some(segments), false, None);
+    }
+
+    /// Resolves every voxel from the deposited sums.
+    pub fn encode_resolve(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        hair: &GpuHair,
+        target: &GpuFiberDensity,
+    ) {
+        self.record(device, encoder, hair, target, None, true, None);
+    }
+
+    /// One compute pass: the deposit of `segments` (after clearing the sums when they start at 0)
+    /// and, with `resolve`, the voxels' resolve.
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        hair: &GpuHair,
+        target: &GpuFiberDensity,
+        segments: Option<std::ops::Range<u32>>,
+        resolve: bool,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        if segments.as_ref().is_some_and(|r| r.start == 0) {
+            encoder.clear_buffer(&target.sums, 0, None);
+        }
+        let range = segments.as_ref().map(|r| {
+            super::context::buffer_init(
+                device,
+                "deposit range",
+                bytemuck::cast_slice(&[r.start, r.end.saturating_sub(r.start), 0, 0]),
+                wgpu::BufferUsages::STORAGE,
+            )
+        });
+        let bind = |pipeline: &wgpu::ComputePipeline, range: Option<&wgpu::Buffer>| {
             let mut entries = vec![wgpu::BindGroupEntry {
                 binding: 0,
                 resource: target.info.as_entire_binding(),
             }];
-            if with_inputs {
+            if let Some(range) = range {
                 entries.extend([
                     wgpu::BindGroupEntry {
                         binding: 1,
@@ -171,6 +222,10 @@ impl FiberDensityPass {
                     wgpu::BindGroupEntry {
                         binding: 3,
                         resource: hair.segments.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: range.as_entire_binding(),
                     },
                 ]);
             } else {
@@ -189,19 +244,22 @@ impl FiberDensityPass {
                 entries: &entries,
             })
         };
-        let (deposit_bind, resolve_bind) = (bind(&self.deposit, true), bind(&self.resolve, false));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("fiber density"),
             timestamp_writes: timestamps,
         });
-        pass.set_pipeline(&self.deposit);
-        pass.set_bind_group(0, &deposit_bind, &[]);
-        let (x, y) = dispatch_2d(hair.segment_count);
-        pass.dispatch_workgroups(x, y, 1);
-        pass.set_pipeline(&self.resolve);
-        pass.set_bind_group(0, &resolve_bind, &[]);
-        let (x, y) = dispatch_2d(target.grid.voxel_count() as u32);
-        pass.dispatch_workgroups(x, y, 1);
+        if let (Some(r), Some(range)) = (&segments, &range) {
+            pass.set_pipeline(&self.deposit);
+            pass.set_bind_group(0, &bind(&self.deposit, Some(range)), &[]);
+            let (x, y) = dispatch_2d(r.end.saturating_sub(r.start));
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        if resolve {
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &bind(&self.resolve, None), &[]);
+            let (x, y) = dispatch_2d(target.grid.voxel_count() as u32);
+            pass.dispatch_workgroups(x, y, 1);
+        }
     }
 }
 

@@ -2,12 +2,13 @@
 //! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
 //! are sized from the measured cost of the units before them (row bands from each row's own cost in
 //! earlier batches) to a time budget, so egui, which shares the queue, does not wait behind a long
-//! submission (the volume and visibility units are whole passes, not sized; a unit of one row or one
+//! submission (the volume's resolve and the visibility units are whole passes, not sized; a unit of one row or one
 //! sweep can still pass the budget).
 //!
 //! The plan after a change: first, when the renderer has one ([`Renderer::set_preview`]), a preview of
 //! the change (reduced resolution, one shading per pixel, all lights, the shadow grid as it stands:
-//! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed), the
+//! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed: its
+//! deposit in ranges of segments, whose fixed-point sums add up exactly, then its resolve), the
 //! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
 //! lights or the forward table changed), visibility, then every shading batch (a light batch at one
 //! visibility sample, every light batch at the first sample before any at the second) in bands of
@@ -37,6 +38,8 @@ pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
+/// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
+const GUESS_SEGMENT_S: f64 = 1e-6;
 /// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
 const GUESS_ROW_LIGHTS: f64 = 16.0;
@@ -51,8 +54,10 @@ fn slot_bands(slot: u32) -> usize {
 /// One bounded piece of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WorkUnit {
-    /// Fiber density and its pyramid.
-    Volume,
+    /// The fiber-density deposit of segments [first, first + count) (the first part clears the sums).
+    Volume { first: u32, count: u32 },
+    /// The fiber density's resolve per voxel and its pyramid, after every segment was deposited.
+    VolumeResolve,
     /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
     /// The visibility pass (skipped when the camera, size and fibres are those it last drew); the
@@ -89,7 +94,10 @@ enum Stage {
     Preview {
         row: u32,
     },
-    Volume,
+    /// The deposit from segment `first` (then the resolve).
+    Volume {
+        first: u32,
+    },
     ShadowGrid,
     Visibility,
     /// Frame batch `batch` from `row`; `band`: the rows of the band the first pass shades under
@@ -209,15 +217,17 @@ pub struct Refinement {
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
-    /// Seconds per shadow-grid entry (None: not measured yet).
+    /// Seconds per shadow-grid entry and per deposited segment (None: not measured yet).
     grid_cost: Option<f64>,
+    volume_cost: Option<f64>,
     /// The frame's shading bands per visibility sample (costs per light: the first sample shades
     /// every covered pixel, the others only where a new segment appears, a few times cheaper), and
     /// the preview's (costs per row of all lights).
     bands: [Bands; MAX_SLOTS],
     preview_bands: Bands,
-    /// Items of the last grid unit.
+    /// Items of the last grid and deposit units.
     grid_last: u32,
+    volume_last: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
     /// When the plan was last restarted, and how many times (a finished unit planned before the
@@ -246,9 +256,11 @@ impl Default for Refinement {
             shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
+            volume_cost: None,
             bands: Default::default(),
             preview_bands: Bands::default(),
             grid_last: 1,
+            volume_last: 1,
             in_flight: None,
             stats: RefineStats::default(),
             started: Instant::now(),
@@ -351,7 +363,7 @@ impl Refinement {
         }
         let pass = match unit {
             WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility => 0,
-            WorkUnit::Volume => 1,
+            WorkUnit::Volume { .. } | WorkUnit::VolumeResolve => 1,
             WorkUnit::ShadowGrid { .. } => 2,
             WorkUnit::Visibility => 3,
             WorkUnit::Shade { .. } => 4,
@@ -371,7 +383,11 @@ impl Refinement {
                 self.preview_shading += elapsed;
                 self.preview_bands.measured(row0, rows, seconds)
             }
-            WorkUnit::Volume | WorkUnit::Visibility | WorkUnit::PreviewVisibility => {}
+            WorkUnit::Volume { count, .. } => {
+                let per = seconds / count.max(1) as f64;
+                self.volume_cost = Some(self.volume_cost.map_or(per, |o| 0.5 * (o + per)));
+            }
+            WorkUnit::VolumeResolve | WorkUnit::Visibility | WorkUnit::PreviewVisibility => {}
         }
     }
 
@@ -460,7 +476,7 @@ impl Renderer {
     /// The first stage of the frame's plan after the preview.
     fn main_stage(&self) -> Stage {
         if self.volume_dirty {
-            Stage::Volume
+            Stage::Volume { first: 0 }
         } else if self.grid_needed() {
             Stage::ShadowGrid
         } else {
@@ -760,9 +776,24 @@ impl Renderer {
                 };
                 Some(WorkUnit::Preview { row0: row, rows })
             }
-            Stage::Volume => {
-                self.refinement.stage = Stage::ShadowGrid;
-                Some(WorkUnit::Volume)
+            Stage::Volume { first } => {
+                let segments = self.hair.segment_count;
+                let r = &mut self.refinement;
+                if first >= segments && first > 0 {
+                    r.stage = Stage::ShadowGrid;
+                    return Some(WorkUnit::VolumeResolve);
+                }
+                let count = r.items(
+                    r.volume_cost,
+                    GUESS_SEGMENT_S,
+                    r.volume_last,
+                    segments - first,
+                );
+                r.volume_last = count;
+                r.stage = Stage::Volume {
+                    first: first + count,
+                };
+                Some(WorkUnit::Volume { first, count })
             }
             Stage::ShadowGrid => {
                 if grid_needed && let Some(unit) = self.grid_unit(self.grid_entries_for(0)) {
@@ -878,9 +909,18 @@ impl Renderer {
         match unit {
             WorkUnit::PreviewVisibility => self.encode_preview_visibility(ctx, enc),
             WorkUnit::Preview { row0, rows } => self.encode_preview(ctx, enc, row0, rows),
-            WorkUnit::Volume => {
+            WorkUnit::Volume { first, count } => {
+                self.density_pass.encode_deposit(
+                    device,
+                    enc,
+                    &self.hair,
+                    &self.volume,
+                    first..first + count,
+                );
+            }
+            WorkUnit::VolumeResolve => {
                 self.density_pass
-                    .encode(device, enc, &self.hair, &self.volume, None);
+                    .encode_resolve(device, enc, &self.hair, &self.volume);
                 self.pyramid_pass
                     .encode(device, enc, &self.volume, &self.pyramid, None);
                 self.volume_dirty = false;
