@@ -325,6 +325,34 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     ));
     let back = live.read_frame(&ctx).expect("read");
     assert_eq!(difference(&before, &back), 0.0);
+    // A deferred change in the middle of the volume's deposit (in parts: a tiny budget) starts the
+    // deposit again: no volume mixes the old diameters with the new.
+    let mut parts = new(&scene.hair);
+    parts.set_unit_budget(Duration::from_micros(100));
+    let (mut deposits, mut changed) = (0, false);
+    loop {
+        let p = parts.refine(&ctx).expect("refine");
+        if let Some(WorkUnit::Volume { first, .. }) = p.submitted {
+            deposits += 1;
+            if first > 0 && !changed {
+                parts
+                    .set_thickness_scale_deferred(&ctx, &scene.hair, 3.0)
+                    .expect("thickness");
+                changed = true;
+            }
+        }
+        if p.converged {
+            break;
+        }
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+    }
+    assert!(changed, "the deposit came in parts ({deposits} units)");
+    let mixed = parts.read_frame(&ctx).expect("read");
+    let d = difference(&want, &mixed);
+    println!("thickness x3 in the middle of the deposit ({deposits} deposit units): {d:.1e}");
+    assert_eq!(d, 0.0);
     let wrong = strandlight::render::scene::generated_hair(
         strandlight::hair::procedural::Style::Bob,
         10,

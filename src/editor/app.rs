@@ -50,10 +50,9 @@ pub struct Message {
 /// What a load job brings back.
 pub enum Loaded {
     /// A new scene, its renderer built on the worker too (pipelines compile there: ~1.5 s on
-    /// lavapipe that the UI thread does not wait for), with the camera it was framed with.
+    /// lavapipe that the UI thread does not wait for).
     Scene {
         live: Box<LiveScene>,
-        camera: Camera,
         warnings: Vec<String>,
     },
     /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
@@ -326,6 +325,10 @@ impl EditorApp {
     /// Loads the session's hair and environment and prepares the renderer's CPU work off the UI
     /// thread; the live scene is rebuilt when they arrive.
     pub fn load_scene(&mut self) {
+        // A load this one supersedes stops before it builds a renderer.
+        if let Some(old) = self.loading.take() {
+            old.cancel();
+        }
         let session = self.session.clone();
         let ctx = self.ctx.clone();
         let (gpu, luts) = (self.gpu.clone(), self.luts.clone());
@@ -334,7 +337,7 @@ impl EditorApp {
         self.loading = Some(Job::spawn(
             "loading the scene",
             move || ctx.request_repaint(),
-            move |_| {
+            move |cancelled| {
                 // A missing or broken source is reported and the rest of the session opens (the
                 // session keeps pointing at the file).
                 let mut warnings = Vec::new();
@@ -357,6 +360,9 @@ impl EditorApp {
                 };
                 warnings.extend(hair.warning.clone());
                 let prepared = prepare(&session, &hair.hair).map_err(|e| e.to_string())?;
+                if cancelled.load(std::sync::atomic::Ordering::Relaxed) {
+                    return Err("superseded".into());
+                }
                 let gpu = gpu.ok_or("no GPU adapter")?;
                 let (lo, hi) = hair.hair.bounds();
                 let camera = session.camera.resolve(lo, hi, w as f32 / h.max(1) as f32);
@@ -374,7 +380,6 @@ impl EditorApp {
                 .map_err(|e| e.to_string())?;
                 Ok(Loaded::Scene {
                     live: Box::new(live),
-                    camera,
                     warnings,
                 })
             },
@@ -556,7 +561,7 @@ impl EditorApp {
 
     /// Polls the background jobs.
     fn poll_jobs(&mut self) {
-        // Scenes are installed once the viewport has been laid out (its size sizes the render).
+        // Scenes are installed once the viewport has been laid out (the renderer follows its size).
         let scene = match (&mut self.loading, self.viewport_rect) {
             (Some(job), Some(_)) => job.poll(),
             _ => None,
@@ -568,17 +573,17 @@ impl EditorApp {
                 .take()
                 .unwrap_or_else(|| self.session.clone());
             match result.and_then(|r| r) {
-                Ok(Loaded::Scene {
-                    live,
-                    camera,
-                    warnings,
-                }) => {
+                // A scene built for a device lost since is not installed.
+                Ok(Loaded::Scene { .. }) if self.gpu.is_none() => {}
+                Ok(Loaded::Scene { live, warnings }) => {
                     for w in warnings {
                         self.message(Level::Warning, w);
                     }
+                    // The camera as it is now (the user may have navigated during the load); the
+                    // renderer takes it in its next sync.
+                    self.camera = Some(self.resolve_camera(live.bounds));
                     self.drop_live();
                     self.live = Some(*live);
-                    self.camera = Some(camera);
                     self.failed = None;
                 }
                 Ok(_) => {}

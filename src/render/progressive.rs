@@ -225,9 +225,8 @@ pub struct Refinement {
     /// the preview's (costs per row of all lights).
     bands: [Bands; MAX_SLOTS],
     preview_bands: Bands,
-    /// Items of the last grid and deposit units.
+    /// Items of the last grid unit.
     grid_last: u32,
-    volume_last: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
     /// When the plan was last restarted, and how many times (a finished unit planned before the
@@ -260,7 +259,6 @@ impl Default for Refinement {
             bands: Default::default(),
             preview_bands: Bands::default(),
             grid_last: 1,
-            volume_last: 1,
             in_flight: None,
             stats: RefineStats::default(),
             started: Instant::now(),
@@ -783,13 +781,14 @@ impl Renderer {
                     r.stage = Stage::ShadowGrid;
                     return Some(WorkUnit::VolumeResolve);
                 }
+                // Segments cost about the same each: sized by the budget alone (no doubling from
+                // a small first unit).
                 let count = r.items(
                     r.volume_cost,
                     GUESS_SEGMENT_S,
-                    r.volume_last,
+                    u32::MAX / 2,
                     segments - first,
                 );
-                r.volume_last = count;
                 r.stage = Stage::Volume {
                     first: first + count,
                 };

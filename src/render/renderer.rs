@@ -635,6 +635,8 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         self.upload_absorption(ctx, sigma_a)?;
         if self.volume_dirty {
+            // A deposit under way holds points or absorption of before: it starts again.
+            self.restart_refinement();
             return Ok(());
         }
         // Only the grid's forward terms read the volume's absorption.
@@ -762,6 +764,8 @@ impl Renderer {
         self.write_thickness(ctx, hair, thickness_scale)?;
         self.invalidate_visibility();
         if self.volume_dirty {
+            // A deposit under way holds points or absorption of before: it starts again.
+            self.restart_refinement();
             return Ok(());
         }
         if self.settings.shadows && self.light_count > 0 {
