@@ -50,6 +50,13 @@ fn refine_all(r: &mut Renderer, ctx: &GpuContext) -> Vec<WorkUnit> {
         .collect()
 }
 
+/// A 300-strand blond bob at 48x36 with a coarse shadow grid (it keeps the unit count small).
+fn small_bob(multiple: bool) -> common::BobScene {
+    let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), multiple);
+    scene.settings.shadow_grid_resolution = 12;
+    scene
+}
+
 /// The project's sunny sky as 40 SRBF lights.
 fn sunny_lights() -> Vec<strandlight::envmap::SrbfLight> {
     SrbfSet::read(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"))
@@ -62,9 +69,7 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let ctx = context();
     let luts = Luts::default_tables();
     let lights = sunny_lights();
-    let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
-    // A coarse grid keeps the unit count of the test small.
-    scene.settings.shadow_grid_resolution = 12;
+    let scene = small_bob(true);
     let new = || {
         Renderer::new(
             &ctx,
@@ -212,8 +217,7 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
     let luts = Luts::default_tables();
     let lights = sunny_lights();
     for multiple in [false, true] {
-        let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), multiple);
-        scene.settings.shadow_grid_resolution = 12;
+        let scene = small_bob(multiple);
         let new =
             |sigma_a: &[[f32; 3]]| bob_renderer(&ctx, &luts, &scene, &scene.hair, sigma_a, &lights);
         let mut live = new(&scene.sigma_a);
@@ -267,8 +271,7 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     let ctx = context();
     let luts = Luts::default_tables();
     let lights = sunny_lights();
-    let mut scene = common::bob_scene(300, 48, 36, Preset::Blond.params(), true);
-    scene.settings.shadow_grid_resolution = 12;
+    let scene = small_bob(true);
     let new = |hair: &strandlight::hair::Hair| {
         bob_renderer(&ctx, &luts, &scene, hair, &scene.sigma_a, &lights)
     };

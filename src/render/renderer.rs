@@ -707,7 +707,7 @@ impl Renderer {
 
     /// Rewrites the points buffer with `hair`'s diameters times `thickness_scale`.
     fn write_thickness(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         hair: &Hair,
         thickness_scale: f32,
@@ -721,6 +721,8 @@ impl Renderer {
         let points = GpuHair::point_data(hair, thickness_scale);
         ctx.queue
             .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        // The ribbons' width changed: the visibility passes draw them again.
+        self.invalidate_visibility();
         Ok(())
     }
 
@@ -745,7 +747,6 @@ impl Renderer {
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
         self.write_thickness(ctx, hair, thickness_scale)?;
-        self.invalidate_visibility();
         self.mark_volume_dirty();
         Ok(())
     }
@@ -762,7 +763,6 @@ impl Renderer {
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
         self.write_thickness(ctx, hair, thickness_scale)?;
-        self.invalidate_visibility();
         if self.volume_dirty {
             // A deposit under way holds points or absorption of before: it starts again.
             self.restart_refinement();
