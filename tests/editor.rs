@@ -268,7 +268,7 @@ fn rebuilds_before_first_image(
         if live.refine_started > before
             && let Some(full) = live.full_image_in
         {
-            let first = live.first_image_in.unwrap_or(full);
+            let first = live.first_image_in().unwrap_or(full);
             println!(
                 "{what}: first image (preview) after {:.2} s, full image after {:.2} s",
                 first.as_secs_f64(),

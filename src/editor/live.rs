@@ -131,9 +131,7 @@ pub struct LiveScene {
     /// When the current refinement started, and how long it took to converge.
     pub refine_started: Instant,
     pub converged_in: Option<Duration>,
-    /// When the first image of the last change was shown (its preview, or the full image's first
-    /// pass), and when the full image's first pass was.
-    pub first_image_in: Option<Duration>,
+    /// When the preview of the last change was shown, and the full image's first pass.
     pub preview_in: Option<Duration>,
     pub full_image_in: Option<Duration>,
     /// The image the display shows, how many previews it has shown, and the full image's sharp rows
@@ -213,7 +211,6 @@ impl LiveScene {
             progress: None,
             refine_started: Instant::now(),
             converged_in: None,
-            first_image_in: None,
             preview_in: None,
             full_image_in: None,
             showing: ImageReady::Full,
@@ -397,7 +394,6 @@ impl LiveScene {
     /// A change the image does not show yet: times are measured from here.
     fn restarted(&mut self) {
         self.refine_started = Instant::now();
-        self.first_image_in = None;
         self.preview_in = None;
         self.full_image_in = None;
         self.restarted_as_refinement();
@@ -441,7 +437,7 @@ impl LiveScene {
             .is_some_and(|(params, azimuthal)| {
                 // One build at a time (a slider drag would pile them up on the GPU's cores).
                 self.tables.is_none()
-                    && (self.first_image_in.is_some()
+                    && (self.first_image_in().is_some()
                         || self.renderer.preview_factor() < 2
                         || !azimuthal.fits_hair(params))
             });
@@ -527,9 +523,12 @@ impl LiveScene {
         if stats.first_pass.is_some() {
             self.full_image_in.get_or_insert(since);
         }
-        if stats.preview.is_some() || stats.first_pass.is_some() {
-            self.first_image_in.get_or_insert(since);
-        }
+    }
+
+    /// When the first image of the last change was shown: its preview, or the full image's first
+    /// pass.
+    pub fn first_image_in(&self) -> Option<Duration> {
+        self.preview_in.or(self.full_image_in)
     }
 
     /// The display pass of the image shown, through the view transform.
