@@ -63,6 +63,8 @@ fn harness_as(
                     offer_recovery: recovery,
                     state_dir: Some(state_dir),
                     instance,
+                    recover: None,
+                    relaunch_on_device_loss: false,
                 },
             )
         });
@@ -736,4 +738,36 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
         text.contains("0.6") && text.contains("1.2"),
         "auburn's melanin"
     );
+    // A new editor takes the session over on a new device (`edit --recover FILE`).
+    let args = h.state().relaunch.clone().expect("a restart");
+    assert_eq!(args[0], "edit");
+    assert_eq!(args[1], "--recover");
+    let file = std::path::PathBuf::from(&args[2]);
+    assert_eq!(file, h.state().autosave.path);
+    let session = h.state().session.clone();
+    drop(h);
+    let mut again = Harness::builder()
+        .with_size(egui::vec2(1100.0, 640.0))
+        .wgpu_setup(strandlight::editor::wgpu_setup())
+        .build_eframe({
+            let (dir, file) = (dir.clone(), file.clone());
+            move |cc| {
+                EditorApp::new(
+                    cc,
+                    EditorOptions {
+                        recover: Some(file),
+                        state_dir: Some(dir),
+                        instance: Some(4_000_000_002),
+                        ..Default::default()
+                    },
+                )
+            }
+        });
+    again.state_mut().view.scale = 0.25;
+    assert!(again.state().session == session, "the recovered session");
+    assert!(again.state().modified(), "recovered work is unsaved work");
+    assert!(!file.exists(), "the old recovery file was taken over");
+    assert!(again.state().autosave.path.exists(), "kept in its own");
+    converge(&mut again);
+    assert!(mean_luminance(&image(&again)) > 0.0, "it renders");
 }

@@ -19,6 +19,11 @@ pub struct EditArgs {
     /// SRBF lights fitted to an .hdr / .exr environment.
     #[arg(long, default_value_t = 40)]
     pub lights: usize,
+    /// Reopen the work kept in a recovery file (`recovery-*.slsession` in the state folder): its
+    /// session, and the session file it belongs to. The editor restarts itself this way after a
+    /// lost GPU device.
+    #[arg(long, conflicts_with_all = ["session", "hair", "env"])]
+    pub recover: Option<PathBuf>,
 }
 
 pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
@@ -38,8 +43,10 @@ pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
     run(EditorOptions {
         session_path: args.session,
         session: Some(session),
-        offer_recovery: true,
+        offer_recovery: args.recover.is_none(),
         state_dir: None,
         instance: None,
+        recover: args.recover,
+        relaunch_on_device_loss: true,
     })
 }

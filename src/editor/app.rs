@@ -31,7 +31,15 @@ pub struct EditorOptions {
     pub state_dir: Option<PathBuf>,
     /// Names this editor's recovery file (default: the process id; tests play several editors).
     pub instance: Option<u32>,
+    /// A recovery file to open at once (`edit --recover`: the restart after a lost GPU device).
+    pub recover: Option<PathBuf>,
+    /// After a lost GPU device, start a new editor on the recovery file and close this one (off in
+    /// tests, which read [`EditorApp::relaunch`] instead).
+    pub relaunch_on_device_loss: bool,
 }
+
+/// A device lost this soon after a start that recovered from one is not restarted again (no loop).
+const RELAUNCH_GUARD: Duration = Duration::from_secs(60);
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Level {
@@ -60,6 +68,7 @@ pub enum Loaded {
     /// A new environment; applied as an edit when it arrives.
     Environment {
         environment: Box<Environment>,
+        pictures: Box<super::env_preview::EnvPictures>,
         source: EnvironmentSource,
     },
 }
@@ -137,6 +146,12 @@ pub struct EditorApp {
     /// A GPU error was shown (one message, not one per frame).
     gpu_error_shown: bool,
     last_frame: Option<Instant>,
+    /// After a lost device: the arguments of the editor that takes over (`edit --recover FILE`).
+    pub relaunch: Option<Vec<std::ffi::OsString>>,
+    /// This editor is closing for its replacement: the recovery file stays as it is.
+    relaunching: bool,
+    options: EditorOptions,
+    started: Instant,
     ctx: egui::Context,
 }
 
@@ -221,8 +236,24 @@ impl EditorApp {
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
             gpu_error_shown: false,
             last_frame: None,
+            relaunch: None,
+            relaunching: false,
+            options: options.clone(),
+            started: Instant::now(),
             ctx: cc.egui_ctx.clone(),
         };
+        if let Some(file) = &options.recover {
+            match super::autosave::read_recovery(file) {
+                Ok((path, session)) => {
+                    app.adopt_recovery(file, path, session);
+                    app.message(
+                        Level::Info,
+                        format!("reopened the session from {}", file.display()),
+                    );
+                }
+                Err(e) => app.message(Level::Error, e),
+            }
+        }
         if let Some(g) = &app.gpu {
             let (flag, wake) = (app.device_lost.clone(), app.ctx.clone());
             g.device.set_device_lost_callback(move |reason, message| {
@@ -265,12 +296,77 @@ impl EditorApp {
         self.gpu = None;
         let kept = match self.autosave.on_exit(&self.session.clone(), true) {
             Ok(()) => format!("the session is kept in {}", self.autosave.path.display()),
-            Err(e) => e,
+            Err(e) => {
+                self.message(
+                    Level::Error,
+                    format!(
+                        "the GPU device was lost ({why}) and the session could not be kept: {e}"
+                    ),
+                );
+                return;
+            }
         };
+        // eframe owns the device and cannot replace it (egui draws with it too): a new editor on a
+        // new device takes the session over, unless this one is itself such a restart that lost
+        // its device at once.
+        let args: Vec<std::ffi::OsString> = vec![
+            "edit".into(),
+            "--recover".into(),
+            self.autosave.path.clone().into(),
+        ];
+        let looping = self.options.recover.is_some() && self.started.elapsed() < RELAUNCH_GUARD;
+        self.relaunch = Some(args.clone());
+        if self.options.relaunch_on_device_loss && !looping {
+            let spawned = std::env::current_exe()
+                .and_then(|exe| std::process::Command::new(exe).args(&args).spawn());
+            match spawned {
+                Ok(_) => {
+                    self.relaunching = true;
+                    self.message(
+                        Level::Info,
+                        format!(
+                            "the GPU device was lost ({why}); {kept} and a new editor opens it"
+                        ),
+                    );
+                    self.ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                    return;
+                }
+                Err(e) => self.message(
+                    Level::Error,
+                    format!("the GPU device was lost ({why}); {kept}; restarting failed: {e}"),
+                ),
+            }
+            return;
+        }
         self.message(
             Level::Error,
             format!("the GPU device was lost ({why}); the viewport stopped, {kept}: save it and restart strandlight"),
         );
+    }
+
+    /// Takes over a recovery file's session (the prompt's Recover, or `edit --recover`): the
+    /// session file it belongs to becomes this editor's, and the work is kept in this editor's own
+    /// recovery file before the old one is removed.
+    pub fn adopt_recovery(&mut self, file: &Path, path: PathBuf, session: Session) {
+        self.session_path = (!path.as_os_str().is_empty()).then_some(path);
+        // Unmodified means equal to the file it belongs to, as it is on disk now.
+        self.saved = self
+            .session_path
+            .as_deref()
+            .and_then(|p| Session::read(p).ok())
+            .unwrap_or_default();
+        self.session = session;
+        self.autosave.set_session_path(self.session_path.as_deref());
+        self.history.clear();
+        self.camera = None;
+        self.drop_live();
+        self.failed = None;
+        self.autosave.changed();
+        if let Err(e) = self.autosave.on_exit(&self.session.clone(), true) {
+            self.message(Level::Warning, e);
+        } else if file != self.autosave.path {
+            let _ = std::fs::remove_file(file);
+        }
     }
 
     pub fn luts(&self) -> &Luts {
@@ -359,7 +455,12 @@ impl EditorApp {
                     }
                 };
                 warnings.extend(hair.warning.clone());
-                let prepared = prepare(&session, &hair.hair).map_err(|e| e.to_string())?;
+                // A failure later still reports what was replaced on the way.
+                let failed = |e: String| match warnings.is_empty() {
+                    true => e,
+                    false => format!("{e} (also: {})", warnings.join("; ")),
+                };
+                let prepared = prepare(&session, &hair.hair).map_err(|e| failed(e.to_string()))?;
                 if cancelled.load(std::sync::atomic::Ordering::Relaxed) {
                     return Err("superseded".into());
                 }
@@ -377,7 +478,7 @@ impl EditorApp {
                     w,
                     h,
                 )
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| failed(e.to_string()))?;
                 Ok(Loaded::Scene {
                     live: Box::new(live),
                     warnings,
@@ -410,6 +511,7 @@ impl EditorApp {
                     fitted: Some(Box::new(environment.lights.clone())),
                 };
                 Ok(Loaded::Environment {
+                    pictures: Box::new(super::env_preview::pictures(&environment)),
                     environment: Box::new(environment),
                     source,
                 })
@@ -603,6 +705,7 @@ impl EditorApp {
                 }
                 Ok(Loaded::Environment {
                     environment,
+                    pictures,
                     source,
                 }) => {
                     self.perform(Edit::Environment(Box::new(source.clone())), false);
@@ -610,7 +713,7 @@ impl EditorApp {
                         && self.loading.is_none()
                         && live.hair_source == self.session.hair
                     {
-                        live.set_environment(*environment, source, self.session.env_yaw);
+                        live.set_environment(*environment, *pictures, source, self.session.env_yaw);
                     }
                 }
                 Ok(Loaded::Scene { .. }) => {}
@@ -800,7 +903,7 @@ impl EditorApp {
     /// When the app closes: the recovery file is written if there are unsaved changes.
     pub fn closing(&mut self) {
         // A recovery still on offer belongs to an earlier run: leave it for the next start.
-        if self.recovery_offer.is_some() {
+        if self.recovery_offer.is_some() || self.relaunching {
             return;
         }
         if let Err(e) = self.autosave.on_exit(&self.session, self.modified()) {

@@ -150,11 +150,20 @@ impl Autosave {
             .collect();
         found.sort();
         let (_, file) = found.pop()?;
-        let text = std::fs::read_to_string(&file).ok()?;
-        let r: Recovery = serde_json::from_str(&text).ok()?;
-        let session = Session::from_json(&serde_json::to_string(&r.session).ok()?, &file).ok()?;
-        Some((file, r.session_path.unwrap_or_default(), session))
+        let (path, session) = read_recovery(&file).ok()?;
+        Some((file, path, session))
     }
+}
+
+/// A recovery file's session and the session file it belongs to (empty: an unsaved session).
+pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session), String> {
+    let text = std::fs::read_to_string(file)
+        .map_err(|e| format!("{}: cannot read the recovery file: {e}", file.display()))?;
+    let r: Recovery = serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not a recovery file: {e}", file.display()))?;
+    let json = serde_json::to_string(&r.session).map_err(|e| e.to_string())?;
+    let session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
+    Ok((r.session_path.unwrap_or_default(), session))
 }
 
 /// Whether a process with this id runs (Linux: /proc; elsewhere assumed gone).

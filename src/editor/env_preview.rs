@@ -61,8 +61,17 @@ fn to_image(pixels: &[[f32; 3]], scale: f32) -> egui::ColorImage {
     egui::ColorImage::from_rgba_unmultiplied([PREVIEW_WIDTH, PREVIEW_HEIGHT], &bytes)
 }
 
+/// The two pictures of an environment as CPU images, made off the UI thread (with the scene or the
+/// environment they show: resampling a large map takes tens of milliseconds).
+pub struct EnvPictures {
+    pub key: (String, usize),
+    pub image: Option<egui::ColorImage>,
+    pub fit: egui::ColorImage,
+    pub relative_l2: Option<f64>,
+}
+
 /// The two pictures of `env`, exposed so that the image's median luminance sits at 0.18.
-pub fn build(ctx: &egui::Context, env: &Environment) -> EnvPreview {
+pub fn pictures(env: &Environment) -> EnvPictures {
     let (w, h) = (PREVIEW_WIDTH, PREVIEW_HEIGHT);
     let fit = env.lights.render(w, h);
     let image = env.image.as_ref().map(|i| resample(i, w, h));
@@ -71,21 +80,31 @@ pub fn build(ctx: &egui::Context, env: &Environment) -> EnvPreview {
     lum.sort_by(f32::total_cmp);
     let median = lum.get(lum.len() / 2).copied().unwrap_or(1.0).max(1e-6);
     let scale = 0.18 / median;
-    let name = &env.name;
+    EnvPictures {
+        key: (env.name.clone(), env.lights.lights.len()),
+        image: image.map(|p| to_image(&p, scale)),
+        fit: to_image(&fit.pixels, scale),
+        relative_l2: env.lights.fit.as_ref().map(|f| f.relative_l2),
+    }
+}
+
+/// The pictures as egui textures (the UI thread's part: an upload).
+pub fn upload(ctx: &egui::Context, p: &EnvPictures) -> EnvPreview {
+    let name = &p.key.0;
     EnvPreview {
-        key: (name.clone(), env.lights.lights.len()),
-        image: image.map(|p| {
+        key: p.key.clone(),
+        image: p.image.as_ref().map(|i| {
             ctx.load_texture(
                 format!("env image {name}"),
-                to_image(&p, scale),
+                i.clone(),
                 egui::TextureOptions::LINEAR,
             )
         }),
         fit: ctx.load_texture(
             format!("env fit {name}"),
-            to_image(&fit.pixels, scale),
+            p.fit.clone(),
             egui::TextureOptions::LINEAR,
         ),
-        relative_l2: env.lights.fit.as_ref().map(|f| f.relative_l2),
+        relative_l2: p.relative_l2,
     }
 }

@@ -9,6 +9,7 @@ use super::live::LiveScene;
 use crate::render::Renderer;
 use crate::render::camera::Tile;
 use crate::render::frame::Frame;
+use crate::render::renderer::FrameReadBack;
 use crate::render::tiled::{DEFAULT_TILE, empty_frame, paste};
 use crate::session::Session;
 use crate::session::assemble::{LoadedHairSource, Scene, StillHeader, still_attributes};
@@ -25,6 +26,8 @@ pub struct ExportJob {
     /// The tile being refined, and the full frame the finished ones are pasted into.
     current: usize,
     frame: Option<Frame>,
+    /// The converged tile on its way back from the GPU (polled, never waited for).
+    reading: Option<FrameReadBack>,
     writing: Option<Job<Result<String, String>>>,
     pub started: Instant,
     pub fraction: f32,
@@ -106,6 +109,7 @@ impl ExportJob {
             tiles,
             current: 0,
             frame: None,
+            reading: None,
             writing: None,
             started: Instant::now(),
             fraction: 0.0,
@@ -125,20 +129,24 @@ impl ExportJob {
             return Some((Level::Error, "export: the scene went away".into()));
         };
         let ctx = &live.ctx;
-        let progress = match self.renderer.refine(ctx) {
-            Ok(p) => p,
-            Err(e) => return Some((Level::Error, format!("export: {e}"))),
-        };
         let n = self.tiles.len();
-        self.fraction = (self.current as f32 + progress.fraction) / n as f32;
-        if !progress.converged {
+        let part = if let Some(r) = &self.reading {
+            match r.poll(ctx)? {
+                Ok(f) => f,
+                Err(e) => return Some((Level::Error, format!("export: {e}"))),
+            }
+        } else {
+            let progress = match self.renderer.refine(ctx) {
+                Ok(p) => p,
+                Err(e) => return Some((Level::Error, format!("export: {e}"))),
+            };
+            self.fraction = (self.current as f32 + progress.fraction) / n as f32;
+            if progress.converged {
+                self.reading = Some(self.renderer.start_read_frame(ctx));
+            }
             return None;
-        }
-        // Converged: the GPU is idle for this renderer, the read-back is short.
-        let part = match self.renderer.read_frame(ctx) {
-            Ok(f) => f,
-            Err(e) => return Some((Level::Error, format!("export: {e}"))),
         };
+        self.reading = None;
         let s = &self.scene.settings;
         let full = self.frame.get_or_insert_with(|| {
             empty_frame(s.width, s.height, part.samples, part.components.len())

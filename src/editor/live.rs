@@ -3,6 +3,7 @@
 //! told. [`LiveScene::sync`] tells the renderer only what changed (it is never rebuilt for a
 //! parameter); [`LiveScene::step`] submits one bounded unit of refinement per UI frame.
 
+use super::env_preview::{self, EnvPictures};
 use super::jobs::Job;
 use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
@@ -109,6 +110,8 @@ pub struct LiveScene {
     pub hair_source: HairSource,
     /// The environment with its lights unturned.
     pub environment: Environment,
+    /// The environment panel's pictures of it (made where the environment was loaded).
+    pub environment_pictures: Arc<EnvPictures>,
     pub environment_source: EnvironmentSource,
     pub renderer: Renderer,
     pub display: DisplayPass,
@@ -189,6 +192,7 @@ impl LiveScene {
             hair: Arc::new(hair.hair),
             hair_name: hair.name,
             hair_source: session.hair.clone(),
+            environment_pictures: Arc::new(env_preview::pictures(&environment)),
             environment,
             environment_source: session.environment.clone(),
             renderer,
@@ -333,16 +337,18 @@ impl LiveScene {
         Ok(())
     }
 
-    /// A new environment (already loaded), turned by the session's yaw.
+    /// A new environment (already loaded, with its pictures), turned by the session's yaw.
     pub fn set_environment(
         &mut self,
         environment: Environment,
+        pictures: EnvPictures,
         source: EnvironmentSource,
         env_yaw: f64,
     ) {
         let lights: SrbfSet = turned_lights(&environment.lights, env_yaw);
         self.renderer.set_lights(&self.ctx, &lights.lights);
         self.environment = environment;
+        self.environment_pictures = Arc::new(pictures);
         self.environment_source = source;
         self.applied.env_yaw = env_yaw;
         self.restarted();

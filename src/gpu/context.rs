@@ -1,6 +1,7 @@
 //! Headless wgpu device creation.
 
 use serde::Serialize;
+use std::sync::Arc;
 
 /// How to pick an adapter.
 #[derive(Clone, Debug, Default)]
@@ -151,7 +152,81 @@ impl GpuContext {
     }
 }
 
+/// Buffers being copied back without waiting (the editor's export): [`GpuContext::start_read`], then
+/// [`PendingRead::poll`] once a frame until the copies are mapped.
+pub struct PendingRead {
+    buffers: Vec<wgpu::Buffer>,
+    mapped: Arc<std::sync::atomic::AtomicUsize>,
+    failed: Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl PendingRead {
+    /// The contents of every buffer (bytes, in the order given) once all are mapped; None while
+    /// the GPU is still at them (this polls the device without blocking).
+    pub fn poll(&self, device: &wgpu::Device) -> Option<Result<Vec<Vec<u8>>, String>> {
+        use std::sync::atomic::Ordering;
+        if let Err(e) = device.poll(wgpu::PollType::Poll) {
+            return Some(Err(format!("waiting for the GPU: {e}")));
+        }
+        if self.failed.load(Ordering::Acquire) {
+            return Some(Err("a read-back buffer could not be mapped".into()));
+        }
+        if self.mapped.load(Ordering::Acquire) < self.buffers.len() {
+            return None;
+        }
+        let out = self
+            .buffers
+            .iter()
+            .map(|b| {
+                b.slice(..)
+                    .get_mapped_range()
+                    .map(|d| d.to_vec())
+                    .map_err(|e| format!("reading a buffer back: {e}"))
+            })
+            .collect();
+        Some(out)
+    }
+}
+
 impl GpuContext {
+    /// Copies each of `buffers` (COPY_SRC) into a mappable buffer after the work already
+    /// submitted and asks for them mapped, without waiting (see [`PendingRead`]).
+    pub fn start_read(&self, buffers: &[&wgpu::Buffer]) -> PendingRead {
+        use std::sync::atomic::Ordering;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        let copies: Vec<wgpu::Buffer> = buffers
+            .iter()
+            .map(|b| {
+                let c = self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("readback"),
+                    size: b.size(),
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                enc.copy_buffer_to_buffer(b, 0, &c, 0, b.size());
+                c
+            })
+            .collect();
+        self.queue.submit([enc.finish()]);
+        let mapped = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let failed = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        for c in &copies {
+            let (mapped, failed) = (mapped.clone(), failed.clone());
+            c.slice(..)
+                .map_async(wgpu::MapMode::Read, move |r| match r {
+                    Ok(()) => {
+                        mapped.fetch_add(1, Ordering::AcqRel);
+                    }
+                    Err(_) => failed.store(true, Ordering::Release),
+                });
+        }
+        PendingRead {
+            buffers: copies,
+            mapped,
+            failed,
+        }
+    }
+
     /// Runs a batch kernel: `inputs` bound at bindings 0.. of group 0, then the `queries` (a storage
     /// buffer), then a results buffer of `per_query` values of R for each query; one invocation per
     /// query in workgroups of 64; returns the results read back.

@@ -1074,34 +1074,32 @@ impl Renderer {
         self.read_targets(ctx, &self.targets)
     }
 
-    /// Reads every output of `t` (the frame's targets or the preview's) back.
+    /// Reads every output of `t` (the frame's targets or the preview's) back, waiting for the GPU.
     pub(super) fn read_targets(
         &self,
         ctx: &GpuContext,
         t: &FrameTargets,
     ) -> Result<Frame, RenderError> {
-        let scale = self.settings.exposure.exp2();
-        let read4 = |b: &wgpu::Buffer| ctx.read_buffer::<[f32; 4]>(b).map_err(RenderError::Gpu);
-        let components = t
-            .components
+        let bytes = frame_buffers(t)
             .iter()
-            .map(|b| {
-                read4(b).map(|v| {
-                    v.into_iter()
-                        .map(|p| [p[0] * scale, p[1] * scale, p[2] * scale])
-                        .collect()
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(Frame {
-            width: t.width,
-            height: t.height,
-            samples: t.samples,
-            beauty: read4(&t.beauty)?,
-            depth: ctx.read_buffer(&t.view_depth).map_err(RenderError::Gpu)?,
-            sample_ids: ctx.read_buffer(&t.sample_ids).map_err(RenderError::Gpu)?,
-            components,
-        })
+            .map(|b| ctx.read_buffer::<u8>(b))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(RenderError::Gpu)?;
+        Ok(frame_from_bytes(
+            (t.width, t.height, t.samples),
+            self.settings.exposure,
+            &bytes,
+        ))
+    }
+
+    /// Starts reading the frame back without waiting: poll the result once a UI frame.
+    pub fn start_read_frame(&self, ctx: &GpuContext) -> FrameReadBack {
+        let t = &self.targets;
+        FrameReadBack {
+            pending: ctx.start_read(&frame_buffers(t)),
+            shape: (t.width, t.height, t.samples),
+            exposure: self.settings.exposure,
+        }
     }
 
     /// The shadow grid as built (light-major, logarithms of the transmittances, as
@@ -1121,5 +1119,55 @@ impl Renderer {
                 depth_behind: e[7],
             })
             .collect())
+    }
+}
+
+/// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them.
+fn frame_buffers(t: &FrameTargets) -> Vec<&wgpu::Buffer> {
+    let mut v = vec![&t.beauty, &t.view_depth, &t.sample_ids];
+    v.extend(t.components.iter());
+    v
+}
+
+/// A frame (width, height, samples) from its buffers' bytes; the components take the exposure the
+/// beauty has.
+fn frame_from_bytes(
+    (width, height, samples): (u32, u32, u32),
+    exposure: f32,
+    bytes: &[Vec<u8>],
+) -> Frame {
+    let scale = exposure.exp2();
+    let rgb = |b: &Vec<u8>| -> Vec<[f32; 3]> {
+        bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b)
+            .into_iter()
+            .map(|p| [p[0] * scale, p[1] * scale, p[2] * scale])
+            .collect()
+    };
+    Frame {
+        width,
+        height,
+        samples,
+        beauty: bytemuck::pod_collect_to_vec(&bytes[0]),
+        depth: bytemuck::pod_collect_to_vec(&bytes[1]),
+        sample_ids: bytemuck::pod_collect_to_vec(&bytes[2]),
+        components: bytes[3..].iter().map(rgb).collect(),
+    }
+}
+
+/// A frame on its way back from the GPU ([`Renderer::start_read_frame`]).
+pub struct FrameReadBack {
+    pending: crate::gpu::context::PendingRead,
+    shape: (u32, u32, u32),
+    exposure: f32,
+}
+
+impl FrameReadBack {
+    /// The frame once the copies landed (None before; never blocks).
+    pub fn poll(&self, ctx: &GpuContext) -> Option<Result<Frame, RenderError>> {
+        let bytes = match self.pending.poll(&ctx.device)? {
+            Ok(b) => b,
+            Err(e) => return Some(Err(RenderError::Gpu(e))),
+        };
+        Some(Ok(frame_from_bytes(self.shape, self.exposure, &bytes)))
     }
 }

@@ -71,21 +71,12 @@ fn recovery_prompt(app: &mut EditorApp, ctx: &egui::Context) {
         return;
     };
     if recover {
-        app.session = session;
-        app.session_path = (!path.as_os_str().is_empty()).then_some(path);
-        app.autosave.set_session_path(app.session_path.as_deref());
-        app.history.clear();
-        app.camera = None;
-        app.drop_live();
-        // Written again as this editor's own recovery file before the old one goes.
-        app.autosave.changed();
-        if let Err(e) = app.autosave.on_exit(&app.session.clone(), true) {
-            app.message(Level::Warning, e);
-        }
+        app.adopt_recovery(&file, path, session);
         app.load_scene();
         app.message(Level::Info, "recovered the unsaved session");
+    } else {
+        let _ = std::fs::remove_file(file);
     }
-    let _ = std::fs::remove_file(file);
 }
 
 /// Errors stay on screen until dismissed.

@@ -147,9 +147,9 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
     }
     if let Some(live) = &app.live {
         let env = &live.environment;
-        let key = (env.name.clone(), env.lights.lights.len());
-        if app.env_preview.as_ref().map(|p| &p.key) != Some(&key) {
-            app.env_preview = Some(crate::editor::env_preview::build(ui.ctx(), env));
+        let pictures = &live.environment_pictures;
+        if app.env_preview.as_ref().map(|p| &p.key) != Some(&pictures.key) {
+            app.env_preview = Some(crate::editor::env_preview::upload(ui.ctx(), pictures));
         }
         ui.weak(format!(
             "{} SRBF lights · {}",
