@@ -25,12 +25,7 @@ fn tmp(name: &str) -> PathBuf {
 /// A bob of 400 strands with a coarse volume and shadow grid.
 fn small_session() -> Session {
     let mut s = Session {
-        hair: HairSource::Generated {
-            style: Style::Bob,
-            strands: 400,
-            points: 8,
-            seed: 3,
-        },
+        hair: HairSource::generated(Style::Bob, 400, 8, 3),
         ..Default::default()
     };
     s.render.volume_resolution = 48;

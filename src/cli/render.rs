@@ -212,12 +212,12 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
                 path: path.clone(),
                 blake3: None,
             },
-            None => HairSource::Generated {
-                style: args.style.unwrap_or(Style::Wavy),
-                strands: args.strands,
-                points: args.points,
-                seed: 1,
-            },
+            None => HairSource::generated(
+                args.style.unwrap_or(Style::Wavy),
+                args.strands,
+                args.points,
+                1,
+            ),
         },
         environment: match &args.env {
             Some(path) => EnvironmentSource::File {

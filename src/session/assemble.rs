@@ -6,8 +6,9 @@ use super::model::{EnvironmentSource, HairSource, Look, Session};
 use crate::envmap::{SrbfSet, load_env};
 use crate::hair::Hair;
 use crate::hair::load::{LoadOptions, load_hair};
+use crate::hair::procedural::generate;
 use crate::paint::{AbsorptionSpec, PaintLayer};
-use crate::render::scene::{Environment, default_environment, generated_hair, load_environment};
+use crate::render::scene::{Environment, default_environment, load_environment};
 use crate::render::{Camera, HairLook, RenderSettings};
 use std::path::Path;
 
@@ -23,6 +24,8 @@ pub enum AssembleError {
     NoStrands(String),
     #[error("invalid look: {0}")]
     Look(String),
+    #[error("{0}: {1}")]
+    Generator(String, String),
 }
 
 /// A loaded hair, its name for logs and EXR headers, and a warning when the file changed since the
@@ -56,12 +59,18 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
             style,
             strands,
             points,
-            seed,
-        } => LoadedHairSource {
-            hair: generated_hair(*style, *strands, *points, *seed),
-            name: format!("generated {style:?} {strands}x{points}"),
-            warning: None,
-        },
+            ..
+        } => {
+            let name = format!("generated {style:?} {strands}x{points}");
+            let params = source
+                .style_params()
+                .ok_or_else(|| AssembleError::Generator(name.clone(), "no settings".into()))?;
+            LoadedHairSource {
+                hair: generate(&params).map_err(|e| AssembleError::Generator(name.clone(), e))?,
+                name,
+                warning: None,
+            }
+        }
         HairSource::File { path, blake3 } => {
             let loaded = load_hair(path, &LoadOptions::default())?;
             LoadedHairSource {

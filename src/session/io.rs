@@ -162,6 +162,9 @@ impl Session {
                 "generated hair of {strands} strands x {points} points is out of range"
             ));
         }
+        if let Some(p) = self.hair.style_params() {
+            p.validate().map_err(|e| format!("generated hair: {e}"))?;
+        }
         Ok(())
     }
 }
@@ -209,6 +212,57 @@ mod tests {
         let e = Session::from_json(&bad, &path).unwrap_err().to_string();
         assert!(e.contains("d_f"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_generators_shape_is_optional_checked_and_reaches_the_hair() {
+        use crate::hair::procedural::Style;
+        use crate::session::HairSource;
+        // Files without the shape read as the generator's defaults.
+        let old = Session::default().to_json();
+        assert!(!old.contains("clumping"));
+        let s = Session::from_json(&old, Path::new("x")).unwrap();
+        assert_eq!(s, Session::default());
+        let shaped = Session {
+            hair: HairSource::Generated {
+                style: Style::Bob,
+                strands: 50,
+                points: 8,
+                seed: 2,
+                length: Some([10.0, 12.0]),
+                clumping: Some(0.9),
+                frizz: Some(0.0),
+            },
+            ..Default::default()
+        };
+        let back = Session::from_json(&shaped.to_json(), Path::new("x")).unwrap();
+        assert_eq!(back, shaped);
+        let p = back.hair.style_params().unwrap();
+        assert_eq!((p.length, p.clumping, p.frizz), ((10.0, 12.0), 0.9, 0.0));
+        let bad = shaped.to_json().replace("0.9", "1.5");
+        let e = Session::from_json(&bad, Path::new("x"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("clumping"), "{e}");
+        // The shape changes the hair: longer strands reach further down.
+        let lowest = |source: &HairSource| {
+            crate::session::assemble::load_hair_source(source)
+                .unwrap()
+                .hair
+                .bounds()
+                .0
+                .y
+        };
+        let long = HairSource::Generated {
+            style: Style::Bob,
+            strands: 50,
+            points: 8,
+            seed: 2,
+            length: Some([20.0, 24.0]),
+            clumping: Some(0.9),
+            frizz: Some(0.0),
+        };
+        assert!(lowest(&long) < lowest(&shaped.hair) - 3.0);
     }
 
     #[test]

@@ -24,6 +24,15 @@ pub enum HairSource {
         strands: usize,
         points: usize,
         seed: u64,
+        /// Strand length range (min, max), cm (absent: the style's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        length: Option<[f32; 2]>,
+        /// 0 (none) to 1 (tips meet their clump's guide) (absent: the generator's 0.4).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        clumping: Option<f32>,
+        /// 0 (none) to 1 (strong random tilts towards the tip) (absent: the generator's 0.1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        frizz: Option<f32>,
     },
     /// A hair file (.hair, .tfx, .gltf, .glb); the BLAKE3 of its bytes when it was chosen tells a
     /// changed file on reopening.
@@ -32,6 +41,44 @@ pub enum HairSource {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         blake3: Option<String>,
     },
+}
+
+impl HairSource {
+    /// The generator's settings with its defaults for the shape (length, clumping, frizz).
+    pub fn generated(style: Style, strands: usize, points: usize, seed: u64) -> Self {
+        HairSource::Generated {
+            style,
+            strands,
+            points,
+            seed,
+            length: None,
+            clumping: None,
+            frizz: None,
+        }
+    }
+
+    /// The generator's parameters (None for a file).
+    pub fn style_params(&self) -> Option<crate::hair::procedural::StyleParams> {
+        let HairSource::Generated {
+            style,
+            strands,
+            points,
+            seed,
+            length,
+            clumping,
+            frizz,
+        } = *self
+        else {
+            return None;
+        };
+        let mut p = crate::hair::procedural::StyleParams::new(style, strands, points, seed);
+        if let Some([a, b]) = length {
+            p.length = (a, b);
+        }
+        p.clumping = clumping.unwrap_or(p.clumping);
+        p.frizz = frizz.unwrap_or(p.frizz);
+        Some(p)
+    }
 }
 
 /// Where the lights come from.
@@ -307,12 +354,7 @@ impl Default for Session {
     fn default() -> Self {
         Self {
             version: SESSION_VERSION,
-            hair: HairSource::Generated {
-                style: Style::Wavy,
-                strands: 3000,
-                points: 16,
-                seed: 1,
-            },
+            hair: HairSource::generated(Style::Wavy, 3000, 16, 1),
             environment: EnvironmentSource::Builtin,
             env_yaw: 0.0,
             look: Look::default(),

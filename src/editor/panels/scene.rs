@@ -4,7 +4,7 @@
 use super::widgets::{Changed, slider, slider32};
 use crate::editor::app::EditorApp;
 use crate::editor::panels::menu;
-use crate::hair::procedural::Style;
+use crate::hair::procedural::{Style, StyleParams};
 use crate::render::display::{Solo, ViewTransform};
 use crate::render::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
@@ -43,57 +43,7 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
     if ui.button("Open hair file…").clicked() {
         menu::hair_dialog(app);
     }
-    let id = ui.scope_id().with("generator");
-    let mut gen_state = ui.data_mut(|d| {
-        d.get_temp::<(usize, usize, usize, u64)>(id)
-            .unwrap_or(match app.session.hair {
-                HairSource::Generated {
-                    style,
-                    strands,
-                    points,
-                    seed,
-                } => (
-                    STYLES.iter().position(|s| s.0 == style).unwrap_or(1),
-                    strands,
-                    points,
-                    seed,
-                ),
-                _ => (1, 3000, 16, 1),
-            })
-    });
-    egui::CollapsingHeader::new("Generator")
-        .default_open(false)
-        .show(ui, |ui| {
-            let (style, strands, points, seed) = &mut gen_state;
-            egui::ComboBox::from_label("style")
-                .selected_text(STYLES[*style].1)
-                .show_ui(ui, |ui| {
-                    for (i, (_, name)) in STYLES.iter().enumerate() {
-                        ui.selectable_value(style, i, *name);
-                    }
-                });
-            ui.add(
-                egui::DragValue::new(strands)
-                    .range(1..=200_000)
-                    .prefix("strands "),
-            )
-            .on_hover_text("Number of strands");
-            ui.add(egui::DragValue::new(points).range(2..=64).prefix("points "))
-                .on_hover_text("Points per strand");
-            ui.add(egui::DragValue::new(seed).prefix("seed "));
-            if ui.button("Generate").clicked() {
-                app.perform(
-                    Edit::Hair(HairSource::Generated {
-                        style: STYLES[*style].0,
-                        strands: *strands,
-                        points: *points,
-                        seed: *seed,
-                    }),
-                    false,
-                );
-            }
-        });
-    ui.data_mut(|d| d.insert_temp(id, gen_state));
+    generator(app, ui);
     if let Some(live) = &app.live {
         let (lo, hi) = live.hair.bounds();
         let size = hi - lo;
@@ -106,6 +56,123 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
             size.z
         ));
     }
+}
+
+/// The generator's settings being edited (applied by Generate, one undo step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Generator {
+    style: usize,
+    strands: usize,
+    points: usize,
+    seed: u64,
+    length: [f32; 2],
+    clumping: f32,
+    frizz: f32,
+}
+
+impl Generator {
+    fn of(source: &HairSource) -> Self {
+        let p = source
+            .style_params()
+            .unwrap_or_else(|| StyleParams::new(Style::Wavy, 3000, 16, 1));
+        Self {
+            style: STYLES.iter().position(|s| s.0 == p.style).unwrap_or(1),
+            strands: p.strands,
+            points: p.points,
+            seed: p.seed,
+            length: [p.length.0, p.length.1],
+            clumping: p.clumping,
+            frizz: p.frizz,
+        }
+    }
+
+    /// The session's hair source; the shape is left at the generator's defaults where it equals them.
+    fn source(&self) -> HairSource {
+        let style = STYLES[self.style].0;
+        let d = StyleParams::new(style, self.strands, self.points, self.seed);
+        let [a, b] = self.length;
+        HairSource::Generated {
+            style,
+            strands: self.strands,
+            points: self.points,
+            seed: self.seed,
+            length: ((a, b) != d.length).then_some([a.min(b), a.max(b)]),
+            clumping: (self.clumping != d.clumping).then_some(self.clumping),
+            frizz: (self.frizz != d.frizz).then_some(self.frizz),
+        }
+    }
+}
+
+/// The procedural generator (style, counts, seed, length, clumping, frizz): Generate makes the
+/// settings the session's hair.
+fn generator(app: &mut EditorApp, ui: &mut egui::Ui) {
+    let id = ui.scope_id().with("generator");
+    let mut g = ui
+        .data_mut(|d| d.get_temp::<Generator>(id))
+        .unwrap_or_else(|| Generator::of(&app.session.hair));
+    egui::CollapsingHeader::new("Generator")
+        .default_open(false)
+        .show(ui, |ui| {
+            let before = g.style;
+            egui::ComboBox::from_label("style")
+                .selected_text(STYLES[g.style].1)
+                .show_ui(ui, |ui| {
+                    for (i, (_, name)) in STYLES.iter().enumerate() {
+                        ui.selectable_value(&mut g.style, i, *name);
+                    }
+                });
+            if g.style != before {
+                let (a, b) = STYLES[g.style].0.default_length();
+                g.length = [a, b];
+            }
+            ui.add(
+                egui::DragValue::new(&mut g.strands)
+                    .range(1..=200_000)
+                    .prefix("strands "),
+            )
+            .on_hover_text("Number of strands");
+            ui.add(egui::DragValue::new(&mut g.points).range(2..=64).prefix("points "))
+                .on_hover_text("Points per strand");
+            ui.add(egui::DragValue::new(&mut g.seed).prefix("seed "))
+                .on_hover_text("Random seed: the same settings and seed give the same hair");
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::DragValue::new(&mut g.length[0])
+                        .range(1.0..=200.0)
+                        .speed(0.2)
+                        .prefix("length ")
+                        .suffix(" cm"),
+                )
+                .on_hover_text("Shortest strand, cm (strand lengths are uniform in the range)");
+                ui.add(
+                    egui::DragValue::new(&mut g.length[1])
+                        .range(1.0..=200.0)
+                        .speed(0.2)
+                        .prefix("to ")
+                        .suffix(" cm"),
+                )
+                .on_hover_text("Longest strand, cm");
+            });
+            ui.add(egui::Slider::new(&mut g.clumping, 0.0..=1.0).text("clumping"))
+                .on_hover_text("How far strands are pulled towards their clump's guide: 0 none, 1 the tips meet it");
+            ui.add(egui::Slider::new(&mut g.frizz, 0.0..=1.0).text("frizz"))
+                .on_hover_text("Random tilts of the strands growing towards the tips: 0 none, 1 strong");
+            ui.horizontal(|ui| {
+                let source = g.source();
+                if ui
+                    .add_enabled(source != app.session.hair, egui::Button::new("Generate"))
+                    .clicked()
+                {
+                    app.perform(Edit::Hair(source), false);
+                }
+                if ui.button("Defaults").on_hover_text("The style's default shape").clicked() {
+                    let style = STYLES[g.style].0;
+                    let d = Generator::of(&HairSource::generated(style, g.strands, g.points, g.seed));
+                    g = Generator { style: g.style, ..d };
+                }
+            });
+        });
+    ui.data_mut(|d| d.insert_temp(id, g));
 }
 
 fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
