@@ -258,6 +258,7 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
             shadow_grid_resolution: args.shadow_grid,
         },
         paint: args.paint.clone(),
+        paint_layer: None,
     })
 }
 

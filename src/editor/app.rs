@@ -128,6 +128,13 @@ pub struct EditorApp {
     pub recent: Vec<PathBuf>,
     state_dir: PathBuf,
     pub export: Option<ExportJob>,
+    /// The active tool, the brush's settings, the stroke under way and what the brush measured.
+    pub tool: super::brush_tool::Tool,
+    pub brush: crate::paint::Brush,
+    pub(super) stroke: Option<super::brush_tool::StrokeState>,
+    pub brush_stats: super::brush_tool::BrushStats,
+    /// F / Shift+F held: the pointer's distance sets the radius or the strength.
+    pub radius_drag: Option<super::brush_tool::RadiusDrag>,
     /// The viewport's size in physical pixels and its rectangle in points (last frame).
     pub viewport_px: [u32; 2],
     pub viewport_rect: Option<egui::Rect>,
@@ -227,6 +234,11 @@ impl EditorApp {
             state_dir,
             env_preview: None,
             export: None,
+            tool: Default::default(),
+            brush: Default::default(),
+            stroke: None,
+            brush_stats: Default::default(),
+            radius_drag: None,
             viewport_px: [640, 400],
             viewport_rect: None,
             frame_ms: 0.0,
@@ -407,13 +419,17 @@ impl EditorApp {
     }
 
     pub fn undo(&mut self) {
-        if self.history.undo(&mut self.session).is_some() {
+        self.end_stroke();
+        if let Some(e) = self.history.undo(&mut self.session) {
+            self.applied_paint(&e);
             self.autosave.changed();
         }
     }
 
     pub fn redo(&mut self) {
-        if self.history.redo(&mut self.session).is_some() {
+        self.end_stroke();
+        if let Some(e) = self.history.redo(&mut self.session) {
+            self.applied_paint(&e);
             self.autosave.changed();
         }
     }
@@ -796,6 +812,10 @@ impl EditorApp {
         let result = result
             .and_then(|_| live.sync(&self.session, &camera))
             .and_then(|_| live.step(self.view));
+        if self.tool == super::brush_tool::Tool::Brush {
+            live.update_picking();
+        }
+        let paint_warning = live.paint_warning.take();
         self.refining = false;
         match result {
             Ok(p) => {
@@ -815,6 +835,9 @@ impl EditorApp {
                 let text = e.to_string();
                 self.message(Level::Error, text);
             }
+        }
+        if let Some(w) = paint_warning {
+            self.message(Level::Warning, w);
         }
     }
 
@@ -955,7 +978,7 @@ impl eframe::App for EditorApp {
         self.dropped_files(ctx);
         self.shortcuts(ctx);
         if !ctx.input(|i| i.pointer.any_down()) {
-            self.history.end_gesture();
+            self.history.end_gesture(&self.session);
         }
     }
 

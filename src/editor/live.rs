@@ -17,7 +17,11 @@ use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
-use crate::session::assemble::{LoadedHairSource, absorption, renderer_look, turned_lights};
+use crate::paint::SharedLayer;
+use crate::paint::brush::effective;
+use crate::session::assemble::{
+    LoadedHairSource, base_absorption, mean_absorption, renderer_look, turned_lights,
+};
 use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -63,8 +67,12 @@ type Tables = (HairParams, ParamTables);
 /// loading worker).
 pub struct Prepared {
     pub sigma_a: Vec<[f32; 3]>,
+    /// The look's absorption before the paint (the brush mixes toward and away from it).
+    pub base_sigma_a: Vec<[f32; 3]>,
     pub look: HairLook,
     pub tables: ParamTables,
+    /// The session's paint could not be shown (a layer made for another hair, an unreadable file).
+    pub warning: Option<String>,
 }
 
 /// The refinement unit budget for this adapter: on a software GPU egui's own frames run on the same
@@ -82,20 +90,70 @@ pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_
 
 /// Computes [`Prepared`] (off the UI thread).
 pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
-    let (sigma_a, look) = absorption(&session.look, hair, session.paint.as_deref())?;
+    let base_sigma_a = base_absorption(&session.look, hair)?;
+    let (layer, warning) = paint_for(session, hair);
+    let sigma_a = painted(&base_sigma_a, layer.as_ref());
+    let look = renderer_look(&session.look, mean_absorption(&sigma_a));
     let tables = build_tables(&look.params, None);
     Ok(Prepared {
         sigma_a,
+        base_sigma_a,
         look,
         tables,
+        warning,
     })
+}
+
+/// The session's paint for this hair: the layer in memory, else its file. A layer made for another
+/// hair is left out with a warning (the session keeps it: undoing the hair change brings it back).
+pub fn paint_for(session: &Session, hair: &Hair) -> (Option<SharedLayer>, Option<String>) {
+    let (points, strands) = (hair.point_count(), hair.strand_count());
+    let layer = match (&session.paint_layer, &session.paint) {
+        (Some(l), _) => l.clone(),
+        (None, Some(path)) => match crate::paint::PaintLayer::read(path) {
+            Ok(l) => SharedLayer::new(l),
+            Err(e) => return (None, Some(format!("{e}; the hair is shown unpainted"))),
+        },
+        (None, None) => return (None, None),
+    };
+    if layer.get().fits(points, strands) {
+        (Some(layer), None)
+    } else {
+        let l = layer.get();
+        let text = format!(
+            "the paint layer was painted on {} points in {} strands, this hair has {points} points in {strands} strands: it is not shown",
+            l.points.len(),
+            l.strand_count
+        );
+        (None, Some(text))
+    }
+}
+
+/// Each point's absorption: the base with the layer over it.
+pub fn painted(base: &[[f32; 3]], layer: Option<&SharedLayer>) -> Vec<[f32; 3]> {
+    match layer {
+        Some(l) => base
+            .iter()
+            .zip(&l.get().points)
+            .map(|(b, v)| effective(*b, *v))
+            .collect(),
+        None => base.to_vec(),
+    }
+}
+
+/// What identifies the session's paint: its file and the revision of the layer in memory.
+fn paint_key(session: &Session) -> (Option<std::path::PathBuf>, Option<u64>) {
+    (
+        session.paint.clone(),
+        session.paint_layer.as_ref().map(SharedLayer::revision),
+    )
 }
 
 /// What the renderer was last told.
 #[derive(Clone, Debug, PartialEq)]
 struct Applied {
     look: Look,
-    paint: Option<std::path::PathBuf>,
+    paint: (Option<std::path::PathBuf>, Option<u64>),
     env_yaw: f64,
     render: RenderOptions,
     camera: Camera,
@@ -121,7 +179,17 @@ pub struct LiveScene {
     thickness_scale: f32,
     /// The mean absorption of the points (the dual tables' sigma_a), kept while only the look's other
     /// parameters change.
-    mean_sigma_a: [f64; 3],
+    pub(super) mean_sigma_a: [f64; 3],
+    /// Each point's absorption without paint, and with it (what the renderer has).
+    pub base_sigma_a: Vec<[f32; 3]>,
+    pub(super) sigma_a: Vec<[f32; 3]>,
+    /// The session's paint could not be shown (reported once by the app).
+    pub paint_warning: Option<String>,
+    /// The brush's view of the hair (view depth read back, points projected).
+    pub picking: super::picking::Picking,
+    /// A dab changed the absorption while a preview was under way: the refinement restarts when
+    /// it is done (a restart per dab would never let a preview finish).
+    pub(super) paint_restart: bool,
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
     /// A camera held back while a preview is under way.
@@ -167,8 +235,10 @@ impl LiveScene {
         let settings = session.render.settings(width, height);
         let Prepared {
             sigma_a,
+            base_sigma_a,
             look,
             tables,
+            warning,
         } = prepared;
         let mut renderer = Renderer::with_tables(
             &ctx,
@@ -199,10 +269,15 @@ impl LiveScene {
             display,
             texture: None,
             mean_sigma_a: look.params.sigma_a,
+            base_sigma_a,
+            sigma_a,
+            paint_warning: warning,
+            picking: Default::default(),
+            paint_restart: false,
             thickness_scale: session.look.thickness_scale,
             applied: Applied {
                 look: session.look,
-                paint: session.paint.clone(),
+                paint: paint_key(session),
                 env_yaw: session.env_yaw,
                 render: session.render,
                 camera: *camera,
@@ -241,50 +316,35 @@ impl LiveScene {
     /// [`LiveScene::needs_rebuild`]).
     pub fn sync(&mut self, session: &Session, camera: &Camera) -> Result<(), LiveError> {
         let mut changed = false;
-        if session.look != self.applied.look || session.paint != self.applied.paint {
+        let paint = paint_key(session);
+        if session.look != self.applied.look || paint != self.applied.paint {
             let (old, new) = (&self.applied.look, &session.look);
-            let absorption_changed = new.root != old.root
+            let base_changed = new.root != old.root
                 || new.tip != old.tip
                 || new.strand_variation != old.strand_variation
-                || new.variation_seed != old.variation_seed
-                || session.paint != self.applied.paint;
+                || new.variation_seed != old.variation_seed;
+            let absorption_changed = base_changed || paint != self.applied.paint;
             // Applied before anything can fail, so a failure is reported once, not every frame.
             self.applied.look = session.look;
-            self.applied.paint = session.paint.clone();
+            self.applied.paint = paint;
             let look = if absorption_changed {
-                let (sigma_a, look) =
-                    absorption(&session.look, &self.hair, session.paint.as_deref())?;
+                if base_changed {
+                    self.base_sigma_a = base_absorption(&session.look, &self.hair)?;
+                }
+                let (layer, warning) = paint_for(session, &self.hair);
+                self.paint_warning = warning;
+                self.sigma_a = painted(&self.base_sigma_a, layer.as_ref());
                 // Shown at once; the volume and grid follow the first image (`step`).
-                self.renderer.set_absorption_deferred(&self.ctx, &sigma_a)?;
-                self.mean_sigma_a = look.params.sigma_a;
-                look
+                self.renderer
+                    .set_absorption_deferred(&self.ctx, &self.sigma_a)?;
+                self.mean_sigma_a = mean_absorption(&self.sigma_a);
+                session.look.validate().map_err(AssembleError::Look)?;
+                renderer_look(&session.look, self.mean_sigma_a)
             } else {
                 session.look.validate().map_err(AssembleError::Look)?;
                 renderer_look(&session.look, self.mean_sigma_a)
             };
-            let held_fits = self
-                .held_tables
-                .as_ref()
-                .is_some_and(|(p, _)| *p == look.params);
-            if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
-                let params = look.params;
-                // The azimuthal table of the held tables when it fits (an eta change in the works),
-                // else the renderer's: rebuilt only for a new eta or eccentricity.
-                let azimuthal = self
-                    .held_tables
-                    .as_ref()
-                    .map(|(_, t)| t.azimuthal.clone())
-                    .filter(|t| t.fits_hair(&params))
-                    .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
-                // A newer build replaces an older one; set_tables ignores stale tables anyway. It
-                // starts once the change's preview is on screen (`step`): on two cores the build
-                // would slow the preview, and a slider drag would start one per frame.
-                self.held_tables = None;
-                self.wanted_tables = Some((params, azimuthal));
-            } else {
-                // The renderer's or the held tables fit: an intermediate look's build is not wanted.
-                self.wanted_tables = None;
-            }
+            self.set_look_deferred(look);
             changed = true;
         }
         if session.env_yaw != self.applied.env_yaw {
@@ -335,6 +395,34 @@ impl LiveScene {
             self.restarted();
         }
         Ok(())
+    }
+
+    /// The look in the renderer's form goes to the renderer now (single scattering shows it at
+    /// once); its tables are built off the UI thread when the parameters they depend on changed.
+    pub(super) fn set_look_deferred(&mut self, look: HairLook) {
+        let held_fits = self
+            .held_tables
+            .as_ref()
+            .is_some_and(|(p, _)| *p == look.params);
+        if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
+            let params = look.params;
+            // The azimuthal table of the held tables when it fits (an eta change in the works),
+            // else the renderer's: rebuilt only for a new eta or eccentricity.
+            let azimuthal = self
+                .held_tables
+                .as_ref()
+                .map(|(_, t)| t.azimuthal.clone())
+                .filter(|t| t.fits_hair(&params))
+                .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
+            // A newer build replaces an older one; set_tables ignores stale tables anyway. It
+            // starts once the change's preview is on screen (`step`): on two cores the build
+            // would slow the preview, and a slider drag would start one per frame.
+            self.held_tables = None;
+            self.wanted_tables = Some((params, azimuthal));
+        } else {
+            // The renderer's or the held tables fit: an intermediate look's build is not wanted.
+            self.wanted_tables = None;
+        }
     }
 
     /// A new environment (already loaded, with its pictures), turned by the session's yaw.
@@ -397,8 +485,13 @@ impl LiveScene {
         }
     }
 
+    /// The session's paint as the renderer has it now (a dab wrote its points).
+    pub(super) fn note_paint(&mut self, session: &Session) {
+        self.applied.paint = paint_key(session);
+    }
+
     /// A change the image does not show yet: times are measured from here.
-    fn restarted(&mut self) {
+    pub(super) fn restarted(&mut self) {
         self.refine_started = Instant::now();
         self.preview_in = None;
         self.full_image_in = None;
@@ -433,6 +526,12 @@ impl LiveScene {
             && !self.renderer.preview_under_way()
         {
             self.apply_camera(&camera);
+            self.restarted();
+        }
+        // Likewise the dabs painted while a preview was under way.
+        if self.paint_restart && !self.renderer.preview_under_way() {
+            self.paint_restart = false;
+            self.renderer.restart();
             self.restarted();
         }
         // The tables' build starts once the change shows (at once without a preview, or for a new eta

@@ -5,10 +5,12 @@
 
 pub mod app;
 pub mod autosave;
+pub mod brush_tool;
 pub mod env_preview;
 pub mod export;
 pub mod jobs;
 pub mod live;
+pub mod picking;
 pub mod navigation;
 pub mod panels;
 

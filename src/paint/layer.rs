@@ -13,6 +13,8 @@
 //! A point's absorption is mix(base, painted, weight): weight 0 keeps the base (unpainted).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 pub const MAGIC: &[u8; 8] = b"SLPAINT1";
 pub const VERSION: u32 = 1;
@@ -115,11 +117,25 @@ impl PaintLayer {
         out
     }
 
+    /// Writes the layer atomically (temporary file, fsync, rename).
     pub fn write(&self, path: &Path) -> Result<(), PaintLayerError> {
-        std::fs::write(path, self.encode()).map_err(|source| PaintLayerError::Io {
+        crate::session::write_atomic(path, &self.encode()).map_err(|source| PaintLayerError::Io {
             path: path.into(),
             source,
         })
+    }
+
+    /// An unpainted layer for a hair.
+    pub fn empty(points: usize, strands: usize) -> Self {
+        Self {
+            strand_count: strands as u64,
+            points: vec![[0.0; 4]; points],
+        }
+    }
+
+    /// Whether the layer was painted on a hair of this many points and strands.
+    pub fn fits(&self, points: usize, strands: usize) -> bool {
+        self.points.len() == points && self.strand_count == strands as u64
     }
 
     /// Applies the layer over `base` (one absorption per point of a hair of `strands` strands).
@@ -146,5 +162,50 @@ impl PaintLayer {
             }
         }
         Ok(())
+    }
+}
+
+/// Revisions of shared layers: every change takes a new number, so equal numbers mean equal values.
+static REVISION: AtomicU64 = AtomicU64::new(1);
+
+/// A paint layer shared by the session, its saved copy, the undo history's view of it and the scene
+/// loader: cloned without copying, changed copy-on-write, equal when their values are (compared by
+/// revision first, so the editor's per-frame "modified?" check costs nothing while nothing changed).
+#[derive(Clone, Debug)]
+pub struct SharedLayer {
+    layer: Arc<PaintLayer>,
+    revision: u64,
+}
+
+impl SharedLayer {
+    pub fn new(layer: PaintLayer) -> Self {
+        Self {
+            layer: Arc::new(layer),
+            revision: REVISION.fetch_add(1, Ordering::Relaxed),
+        }
+    }
+
+    pub fn get(&self) -> &PaintLayer {
+        &self.layer
+    }
+
+    /// The layer to change (copied first when shared); takes a new revision.
+    pub fn make_mut(&mut self) -> &mut PaintLayer {
+        self.revision = REVISION.fetch_add(1, Ordering::Relaxed);
+        Arc::make_mut(&mut self.layer)
+    }
+
+    /// Changes with every [`SharedLayer::make_mut`].
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+}
+
+impl PartialEq for SharedLayer {
+    fn eq(&self, other: &Self) -> bool {
+        self.revision == other.revision
+            || (self.layer.strand_count == other.layer.strand_count
+                && bytemuck::cast_slice::<[f32; 4], u8>(&self.layer.points)
+                    == bytemuck::cast_slice::<[f32; 4], u8>(&other.layer.points))
     }
 }

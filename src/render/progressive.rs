@@ -622,6 +622,41 @@ impl Renderer {
         self.refinement.stats
     }
 
+    /// Whether the frame's view depth holds the current camera's visibility: the visibility pass and
+    /// the resolve after it ran and finished (the brush picks hair from it).
+    pub fn view_depth_ready(&self) -> bool {
+        self.visibility_valid
+            && !self
+                .refinement
+                .in_flight
+                .as_ref()
+                .is_some_and(|f| f.unit == WorkUnit::Visibility)
+    }
+
+    /// Starts reading the frame's view depth back (see [`Renderer::view_depth_ready`]) with the
+    /// camera it was drawn with.
+    pub fn start_read_view_depth(
+        &self,
+        ctx: &GpuContext,
+    ) -> (crate::gpu::context::PendingRead, super::camera::CameraUniform) {
+        (ctx.start_read(&[&self.targets.view_depth]), self.view_camera())
+    }
+
+    /// The camera uniform of the whole image as the frame is drawn now.
+    pub fn view_camera(&self) -> super::camera::CameraUniform {
+        self.camera_view.uniform(
+            self.settings.width,
+            self.settings.height,
+            self.settings.min_width_px,
+        )
+    }
+
+    /// Restarts the refinement with a preview: a change made through a deferred setter that did not
+    /// restart (a brush dab: [`Renderer::set_absorption_points_deferred`]) shows.
+    pub fn restart(&mut self) {
+        self.restart_refinement();
+    }
+
     /// Whether a preview is part-way (its first unit submitted, its last not finished).
     pub fn preview_under_way(&self) -> bool {
         let r = &self.refinement;

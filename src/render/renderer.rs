@@ -634,10 +634,56 @@ impl Renderer {
         sigma_a: &[[f32; 3]],
     ) -> Result<(), RenderError> {
         self.upload_absorption(ctx, sigma_a)?;
+        self.absorption_deferred();
+        Ok(())
+    }
+
+    /// [`Renderer::set_absorption_deferred`] for a few points (a brush dab): `sigma_a` holds every
+    /// point's absorption, and only the points `changed` (sorted) are written, in runs (gaps of a few
+    /// unchanged points are written along rather than split).
+    pub fn set_absorption_points_deferred(
+        &mut self,
+        ctx: &GpuContext,
+        sigma_a: &[[f32; 3]],
+        changed: &[u32],
+    ) -> Result<(), RenderError> {
+        if sigma_a.len() != self.point_count {
+            return Err(RenderError::AbsorptionCount {
+                points: self.point_count,
+                absorption: sigma_a.len(),
+            });
+        }
+        const GAP: u32 = 16;
+        let mut k = 0;
+        while k < changed.len() {
+            let start = changed[k];
+            let mut end = start + 1;
+            k += 1;
+            while k < changed.len() && changed[k] < end + GAP {
+                end = changed[k] + 1;
+                k += 1;
+            }
+            let end = (end as usize).min(sigma_a.len());
+            let v: Vec<[f32; 4]> = sigma_a[start as usize..end]
+                .iter()
+                .map(|s| [s[0], s[1], s[2], 0.0])
+                .collect();
+            ctx.queue.write_buffer(
+                &self.hair.absorption,
+                16 * start as u64,
+                bytemuck::cast_slice(&v),
+            );
+        }
+        self.absorption_deferred();
+        Ok(())
+    }
+
+    /// The absorption changed (shown at once): the volume and grid that carry it follow later.
+    fn absorption_deferred(&mut self) {
         if self.volume_dirty {
             // A deposit under way holds points or absorption of before: it starts again.
             self.restart_refinement();
-            return Ok(());
+            return;
         }
         // Only the grid's forward terms read the volume's absorption.
         if self.settings.shadows && self.settings.multiple_scattering && self.light_count > 0 {
@@ -645,7 +691,6 @@ impl Renderer {
         } else {
             self.volume_absorption_old = true;
         }
-        Ok(())
     }
 
     /// Whether a deferred absorption change still waits for its volume and grid.

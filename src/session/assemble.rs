@@ -137,6 +137,12 @@ pub fn absorption(
     hair: &Hair,
     paint: Option<&Path>,
 ) -> Result<(Vec<[f32; 3]>, HairLook), AssembleError> {
+    let layer = paint.map(PaintLayer::read).transpose()?;
+    painted_absorption(look, hair, layer.as_ref().zip(paint))
+}
+
+/// The look's absorption per point, before any paint (the brush mixes toward and away from it).
+pub fn base_absorption(look: &Look, hair: &Hair) -> Result<Vec<[f32; 3]>, AssembleError> {
     look.validate().map_err(AssembleError::Look)?;
     let root = look.root.sigma_a().map(|x| x as f32);
     let tip = look.tip.map_or(root, |t| t.sigma_a().map(|x| x as f32));
@@ -146,14 +152,43 @@ pub fn absorption(
         variation: look.strand_variation.max(0.0),
         seed: look.variation_seed,
     };
-    let mut sigma_a = spec.per_point(hair);
-    if let Some(path) = paint {
-        PaintLayer::read(path)?.apply(&mut sigma_a, hair.strand_count(), path)?;
+    Ok(spec.per_point(hair))
+}
+
+/// [`absorption`] with a layer already read (`name`: the file or source it came from, for errors).
+pub fn painted_absorption(
+    look: &Look,
+    hair: &Hair,
+    layer: Option<(&PaintLayer, &Path)>,
+) -> Result<(Vec<[f32; 3]>, HairLook), AssembleError> {
+    let mut sigma_a = base_absorption(look, hair)?;
+    if let Some((layer, name)) = layer {
+        layer.apply(&mut sigma_a, hair.strand_count(), name)?;
     }
-    let n = sigma_a.len().max(1) as f64;
-    let mean: [f64; 3] =
-        std::array::from_fn(|c| sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n);
+    let mean = mean_absorption(&sigma_a);
     Ok((sigma_a, renderer_look(look, mean)))
+}
+
+/// The points' mean absorption (what the dual-scattering tables are built for).
+pub fn mean_absorption(sigma_a: &[[f32; 3]]) -> [f64; 3] {
+    let n = sigma_a.len().max(1) as f64;
+    std::array::from_fn(|c| sigma_a.iter().map(|s| s[c] as f64).sum::<f64>() / n)
+}
+
+/// The session's absorption: its paint layer in memory (the editor's) when it has one, else its
+/// paint file.
+pub fn session_absorption(
+    session: &Session,
+    hair: &Hair,
+) -> Result<(Vec<[f32; 3]>, HairLook), AssembleError> {
+    match &session.paint_layer {
+        Some(layer) => painted_absorption(
+            &session.look,
+            hair,
+            Some((layer.get(), Path::new("the session's paint layer"))),
+        ),
+        None => absorption(&session.look, hair, session.paint.as_deref()),
+    }
 }
 
 /// The look in the renderer's form with `mean_sigma_a` (the points' mean absorption, what the
@@ -197,7 +232,7 @@ impl Scene {
         mut environment: Environment,
         env_warning: Option<String>,
     ) -> Result<Self, AssembleError> {
-        let (sigma_a, look) = absorption(&session.look, &hair.hair, session.paint.as_deref())?;
+        let (sigma_a, look) = session_absorption(session, &hair.hair)?;
         // The look's thickness scale (after absorption, which validated the look).
         hair.hair.transform(|p| p, session.look.thickness_scale);
         environment.lights = turned_lights(&environment.lights, session.env_yaw);

@@ -3,6 +3,7 @@
 //! Camera moves are not edits (they are saved with the session but not undone).
 
 use super::model::{EnvironmentSource, HairSource, Look, RenderOptions, Session};
+use crate::paint::PaintDelta;
 use serde::{Deserialize, Serialize};
 
 /// One change of the session. Each carries the new value of what it changes.
@@ -16,6 +17,9 @@ pub enum Edit {
     Render(RenderOptions),
     Hair(HairSource),
     Environment(Box<EnvironmentSource>),
+    /// A paint stroke's points and the layer values they take (applying swaps them with the
+    /// layer's: the inverse holds the values they had).
+    Paint(Box<PaintDelta>),
 }
 
 /// What an edit touches: consecutive edits of the same kind during one gesture (a slider drag) merge
@@ -27,6 +31,7 @@ pub enum EditKind {
     Render,
     Hair,
     Environment,
+    Paint,
 }
 
 impl Edit {
@@ -37,6 +42,7 @@ impl Edit {
             Edit::Render(_) => EditKind::Render,
             Edit::Hair(_) => EditKind::Hair,
             Edit::Environment(_) => EditKind::Environment,
+            Edit::Paint(_) => EditKind::Paint,
         }
     }
 
@@ -48,7 +54,24 @@ impl Edit {
             Edit::Render(_) => "render settings",
             Edit::Hair(_) => "hair",
             Edit::Environment(_) => "environment",
+            Edit::Paint(_) => "paint stroke",
         }
+    }
+
+    /// Memory the edit holds, bytes (the undo history's budget).
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Edit>()
+            + match self {
+                Edit::Paint(d) => d.bytes(),
+                Edit::Look(_) => std::mem::size_of::<Look>(),
+                Edit::Environment(e) => match e.as_ref() {
+                    EnvironmentSource::File {
+                        fitted: Some(f), ..
+                    } => std::mem::size_of_val(f.lights.as_slice()) + 256,
+                    _ => 256,
+                },
+                _ => 0,
+            }
     }
 }
 
@@ -61,6 +84,14 @@ pub fn apply(session: &mut Session, edit: Edit) -> Edit {
         Edit::Hair(h) => Edit::Hair(std::mem::replace(&mut session.hair, h)),
         Edit::Environment(e) => {
             Edit::Environment(Box::new(std::mem::replace(&mut session.environment, *e)))
+        }
+        Edit::Paint(mut d) => {
+            if let Some(layer) = &mut session.paint_layer
+                && d.indices.iter().all(|&i| (i as usize) < layer.get().points.len())
+            {
+                d.swap(&mut layer.make_mut().points);
+            }
+            Edit::Paint(d)
         }
     }
 }

@@ -1,29 +1,27 @@
-//! Undo and redo of [`Edit`]s: each step keeps the edit that undoes it. A gesture (a slider drag, a
-//! colour-picker drag) is one step: while it is open, edits of the same kind replace the step's redo
-//! value and keep its undo value (rerun adds undo points only when no drag is in progress). The history
-//! is bounded by a step count.
+//! Undo and redo of [`Edit`]s. Each step holds one edit: on the undo stack the edit that undoes it,
+//! on the redo stack the edit that redoes it (applying an edit returns its inverse, so undo and redo
+//! swap them; a paint stroke's sparse delta is stored once). A gesture (a slider drag, a colour-picker
+//! drag) is one step: while it is open, edits of the same kind keep the step's undo edit. The history
+//! is bounded by a step count and a memory budget: the oldest steps are dropped first.
 
 use super::edit::{Edit, EditKind, apply};
 use super::model::Session;
 
 /// The default number of undo steps kept.
 pub const DEFAULT_UNDO_STEPS: usize = 512;
-
-#[derive(Clone, Debug)]
-struct Step {
-    /// Applying this undoes the step.
-    undo: Edit,
-    /// Applying this redoes it.
-    redo: Edit,
-}
+/// The default memory budget of the steps (paint strokes hold their points' values).
+pub const DEFAULT_UNDO_BYTES: usize = 256 << 20;
 
 #[derive(Clone, Debug)]
 pub struct History {
-    undo: Vec<Step>,
-    redo: Vec<Step>,
+    /// Applying the last undoes the last step.
+    undo: Vec<Edit>,
+    /// Applying the last redoes the last undone step.
+    redo: Vec<Edit>,
     /// The kind of the step a gesture is still extending.
     open: Option<EditKind>,
     limit: usize,
+    budget: usize,
 }
 
 impl Default for History {
@@ -34,11 +32,17 @@ impl Default for History {
 
 impl History {
     pub fn new(limit: usize) -> Self {
+        Self::with_budget(limit, DEFAULT_UNDO_BYTES)
+    }
+
+    /// At most `limit` steps holding at most `budget` bytes (the newest step is always kept).
+    pub fn with_budget(limit: usize, budget: usize) -> Self {
         Self {
             undo: Vec::new(),
             redo: Vec::new(),
             open: None,
             limit: limit.max(1),
+            budget,
         }
     }
 
@@ -52,51 +56,62 @@ impl History {
             return false;
         }
         self.redo.clear();
-        match self.undo.last_mut() {
-            Some(step) if self.open == Some(kind) => step.redo = edit,
-            _ => {
-                self.undo.push(Step {
-                    undo: inverse,
-                    redo: edit,
-                });
-                if self.undo.len() > self.limit {
-                    self.undo.remove(0);
-                }
-            }
+        if self.open != Some(kind) || self.undo.is_empty() {
+            self.push(inverse);
         }
         self.open = gesture.then_some(kind);
         true
     }
 
+    /// Records a change already made to the session (a paint stroke, applied dab by dab) as one step:
+    /// `undo` restores the state before it.
+    pub fn record(&mut self, undo: Edit) {
+        self.redo.clear();
+        self.open = None;
+        self.push(undo);
+    }
+
+    fn push(&mut self, undo: Edit) {
+        self.undo.push(undo);
+        let mut held: usize = self.undo.iter().map(Edit::bytes).sum();
+        while self.undo.len() > 1 && (self.undo.len() > self.limit || held > self.budget) {
+            held -= self.undo[0].bytes();
+            self.undo.remove(0);
+        }
+    }
+
+    /// Memory the steps hold, bytes.
+    pub fn bytes(&self) -> usize {
+        self.undo.iter().chain(&self.redo).map(Edit::bytes).sum()
+    }
+
     /// Closes the open gesture (the pointer was released): the next edit starts a new step. A drag
     /// that came back to where it started leaves no step.
-    pub fn end_gesture(&mut self) {
+    pub fn end_gesture(&mut self, session: &Session) {
         if self.open.take().is_some()
-            && let Some(step) = self.undo.last()
-            && step.undo == step.redo
+            && let Some(undo) = self.undo.last()
         {
-            self.undo.pop();
+            let mut s = session.clone();
+            if apply(&mut s, undo.clone()) == *undo {
+                self.undo.pop();
+            }
         }
     }
 
     /// Undoes the last step; returns the edit applied (None: nothing to undo).
     pub fn undo(&mut self, session: &mut Session) -> Option<Edit> {
         self.open = None;
-        let step = self.undo.pop()?;
-        apply(session, step.undo.clone());
-        let applied = step.undo.clone();
-        self.redo.push(step);
-        Some(applied)
+        let edit = self.undo.pop()?;
+        self.redo.push(apply(session, edit.clone()));
+        Some(edit)
     }
 
     /// Redoes the last undone step; returns the edit applied.
     pub fn redo(&mut self, session: &mut Session) -> Option<Edit> {
         self.open = None;
-        let step = self.redo.pop()?;
-        apply(session, step.redo.clone());
-        let applied = step.redo.clone();
-        self.undo.push(step);
-        Some(applied)
+        let edit = self.redo.pop()?;
+        self.undo.push(apply(session, edit.clone()));
+        Some(edit)
     }
 
     pub fn can_undo(&self) -> bool {
@@ -109,7 +124,7 @@ impl History {
 
     /// Label of the step Ctrl+Z would undo.
     pub fn undo_label(&self) -> Option<&'static str> {
-        self.undo.last().map(|s| s.redo.label())
+        self.undo.last().map(Edit::label)
     }
 
     pub fn clear(&mut self) {
@@ -134,7 +149,7 @@ mod tests {
         for y in [10.0, 20.0, 30.0] {
             assert!(h.perform(&mut s, Edit::EnvYaw(y), true));
         }
-        h.end_gesture();
+        h.end_gesture(&s);
         assert!(h.perform(&mut s, Edit::EnvYaw(45.0), false));
         assert_eq!(yaw(&s), 45.0);
         h.undo(&mut s);
@@ -168,7 +183,7 @@ mod tests {
         let mut h = History::default();
         h.perform(&mut s, Edit::EnvYaw(10.0), true);
         h.perform(&mut s, Edit::EnvYaw(0.0), true);
-        h.end_gesture();
+        h.end_gesture(&s);
         assert!(!h.can_undo());
         assert_eq!(yaw(&s), 0.0);
     }
@@ -186,5 +201,41 @@ mod tests {
         }
         assert_eq!(undone, 3);
         assert_eq!(yaw(&s), 2.0);
+    }
+
+    #[test]
+    fn a_paint_stroke_is_one_step_of_20_bytes_a_point_within_the_budget() {
+        use crate::paint::{PaintDelta, PaintLayer, SharedLayer};
+        let mut s = Session {
+            paint_layer: Some(SharedLayer::new(PaintLayer::empty(1000, 10))),
+            ..Default::default()
+        };
+        let before = s.clone();
+        // Three strokes of 100 points each; the budget holds two.
+        let mut h = History::with_budget(100, 2 * 100 * 20 + 100);
+        for k in 0..3u32 {
+            let indices: Vec<u32> = (100 * k..100 * k + 100).collect();
+            let layer = s.paint_layer.as_mut().unwrap().make_mut();
+            let mut undo = PaintDelta {
+                values: indices.iter().map(|&i| layer.points[i as usize]).collect(),
+                indices: indices.clone(),
+            };
+            for &i in &indices {
+                layer.points[i as usize] = [1.0, 2.0, 3.0, 0.5 + 0.1 * k as f32];
+            }
+            assert_eq!(undo.bytes(), 100 * 20);
+            h.record(Edit::Paint(Box::new(undo)));
+        }
+        assert!(h.bytes() <= 2 * 100 * 20 + 100, "{}", h.bytes());
+        let painted = s.clone();
+        assert!(h.undo(&mut s).is_some() && h.undo(&mut s).is_some());
+        assert!(h.undo(&mut s).is_none(), "the oldest stroke was dropped");
+        let first = &s.paint_layer.as_ref().unwrap().get().points;
+        assert_eq!(first[0], [1.0, 2.0, 3.0, 0.5], "the first stroke stays");
+        assert_eq!(first[150], [0.0; 4], "the second is undone");
+        h.redo(&mut s);
+        h.redo(&mut s);
+        assert!(s == painted, "redo restores the strokes bit for bit");
+        assert!(s != before);
     }
 }

@@ -343,9 +343,14 @@ pub struct Session {
     pub camera: ViewCamera,
     #[serde(default)]
     pub render: RenderOptions,
-    /// A paint layer (SLPAINT1) applied over the look's absorption.
+    /// A paint layer (SLPAINT1) applied over the look's absorption: the file the editor saves its
+    /// layer to beside the session, and `render --paint` reads.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub paint: Option<PathBuf>,
+    /// The paint layer in memory (the editor's brush; read from `paint` when the session is
+    /// opened). When present it is the session's paint, whatever the file holds.
+    #[serde(skip)]
+    pub paint_layer: Option<crate::paint::SharedLayer>,
 }
 
 impl Default for Session {
@@ -361,6 +366,7 @@ impl Default for Session {
             camera: ViewCamera::default(),
             render: RenderOptions::default(),
             paint: None,
+            paint_layer: None,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The editor's panels, one module each. Panels read the app and return edits; the app applies them
 //! ([`super::app::EditorApp::perform`]).
 
+pub mod brush;
 pub mod look;
 pub mod menu;
 pub mod scene;
@@ -20,6 +21,8 @@ pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
         .resizable(true)
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
+                brush::tools(app, ui);
+                ui.separator();
                 if let Some((look, gesture)) = look::panel(ui, &app.session.look) {
                     app.perform(Edit::Look(Box::new(look)), gesture);
                 }

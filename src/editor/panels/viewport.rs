@@ -2,6 +2,7 @@
 //! Shift+middle pan, wheel and Ctrl+middle zoom, Alt+left orbit, Home frames, 1/3/7 views).
 
 use crate::editor::app::EditorApp;
+use crate::editor::brush_tool::{self, Tool};
 use crate::editor::navigation;
 
 pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
@@ -40,6 +41,92 @@ pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
         }
     }
     navigate(app, ui, &response, rect);
+    brush(app, ui, &response, rect);
+}
+
+/// The brush tool: left-drag paints (Alt+left still orbits), the cursor ring shows the radius, F and
+/// Shift+F set the radius and strength by the pointer's distance.
+fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: egui::Rect) {
+    let pointer = response.hover_pos();
+    if (response.hovered() || response.has_focus()) && !ui.ctx().egui_wants_keyboard_input() {
+        brush_tool::tool_keys(app, ui.ctx(), pointer);
+    }
+    if app.tool != Tool::Brush {
+        app.radius_drag = None;
+        return;
+    }
+    let painter = ui.painter_at(rect);
+    let ring = egui::Stroke::new(1.5, egui::Color32::from_white_alpha(200));
+    let shadow = egui::Stroke::new(3.0, egui::Color32::from_black_alpha(120));
+    if let Some(drag) = app.radius_drag {
+        // Adjusting: the ring follows the pointer's distance; a click or Enter confirms.
+        if let Some(p) = ui.input(|i| i.pointer.hover_pos()) {
+            let d = (p - drag.centre).length();
+            if drag.strength {
+                app.brush.strength = (d / 200.0).clamp(0.0, 1.0);
+            } else {
+                app.brush.radius_px = d.clamp(2.0, 500.0);
+            }
+        }
+        painter.circle_stroke(drag.centre, app.brush.radius_px, shadow);
+        painter.circle_stroke(drag.centre, app.brush.radius_px, ring);
+        let text = if drag.strength {
+            format!("strength {:.2}", app.brush.strength)
+        } else {
+            format!("radius {:.0} px", app.brush.radius_px)
+        };
+        painter.text(
+            drag.centre,
+            egui::Align2::CENTER_CENTER,
+            text,
+            egui::FontId::proportional(14.0),
+            egui::Color32::WHITE,
+        );
+        if ui.input(|i| i.pointer.any_pressed() || i.key_pressed(egui::Key::Enter)) {
+            app.radius_drag = None;
+        }
+        return;
+    }
+    if let Some(p) = pointer {
+        painter.circle_stroke(p, app.brush.radius_px, shadow);
+        painter.circle_stroke(p, app.brush.radius_px, ring);
+        painter.circle_stroke(
+            p,
+            app.brush.radius_px * app.brush.strength.clamp(0.05, 1.0),
+            egui::Stroke::new(1.0, egui::Color32::from_white_alpha(90)),
+        );
+        ui.ctx().set_cursor_icon(egui::CursorIcon::Crosshair);
+    }
+    let alt = ui.input(|i| i.modifiers.alt);
+    let primary = egui::PointerButton::Primary;
+    let pressed = response.drag_started_by(primary) && !alt;
+    let dragging = response.dragged_by(primary) && !alt;
+    let released = response.drag_stopped_by(primary)
+        || (app.stroke_active() && !ui.input(|i| i.pointer.primary_down()));
+    // A click without a drag is one dab.
+    let clicked = response.clicked_by(primary) && !alt;
+    let pos = ui.input(|i| i.pointer.interact_pos()).filter(|_| dragging || pressed || clicked);
+    let to = pos.map(|p| {
+        let (w, h) = app.render_size();
+        [
+            (p.x - rect.min.x) / rect.width().max(1.0) * w as f32,
+            (p.y - rect.min.y) / rect.height().max(1.0) * h as f32,
+        ]
+    });
+    let pressure = ui.input(|i| {
+        i.events.iter().rev().find_map(|e| match e {
+            egui::Event::Touch {
+                force: Some(f), ..
+            } => Some(*f),
+            _ => None,
+        })
+    });
+    let pressure = pressure.unwrap_or(1.0);
+    if clicked && !app.stroke_active() {
+        app.brush_input(to, true, true, pressure);
+    } else if pressed || dragging || released {
+        app.brush_input(to, pressed && !app.stroke_active(), released, pressure);
+    }
 }
 
 fn navigate(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: egui::Rect) {
