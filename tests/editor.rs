@@ -766,3 +766,289 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
     converge(&mut again);
     assert!(mean_luminance(&image(&again)) > 0.0, "it renders");
 }
+
+/// A left-drag with the brush from `from` to `to` (points) in `steps` moves.
+fn brush_stroke(h: &mut Harness<'static, EditorApp>, from: egui::Pos2, to: egui::Pos2, steps: u32) {
+    let m = egui::Modifiers::NONE;
+    h.hover_at(from);
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: m,
+    });
+    h.step();
+    for k in 1..=steps {
+        h.event(egui::Event::PointerMoved(
+            from + (to - from) * (k as f32 / steps as f32),
+        ));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: m,
+    });
+    h.step();
+    h.step();
+}
+
+/// Mean of the beauty (un-premultiplied) over the pixels `which`, RGB.
+fn mean_colour(f: &Frame, which: &[usize]) -> [f64; 3] {
+    let a: f64 = which.iter().map(|&i| f.beauty[i][3] as f64).sum();
+    std::array::from_fn(|c| {
+        which.iter().map(|&i| f.beauty[i][c] as f64).sum::<f64>() / a.max(1e-12)
+    })
+}
+
+#[test]
+fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
+    use strandlight::paint::brush::{Falloff, effective};
+    use strandlight::paint::pick::{dabs_along, project};
+    let dir = tmp("brush");
+    let mut session = small_session();
+    session.render.multiple_scattering = false;
+    let mut h = harness(session, &dir, false);
+    converge(&mut h);
+    let before = image(&h);
+    let sigma_before = h.state().live.as_ref().unwrap().sigma_a.clone();
+    // B over the viewport takes the brush; the picker follows the view's depth.
+    let rect = h.state().viewport_rect.expect("a viewport");
+    h.hover_at(rect.center());
+    h.step();
+    h.key_press(egui::Key::B);
+    h.step();
+    assert_eq!(h.state().tool, strandlight::editor::brush_tool::Tool::Brush);
+    let t = Instant::now();
+    while h.state().live.as_ref().unwrap().picker().is_none() {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+        assert!(t.elapsed() < Duration::from_secs(30), "no picker");
+    }
+    // A blue dye at full strength, constant falloff, across the hair's middle.
+    let dye = strandlight::paint::sigma_a_from_colour([0.05, 0.25, 0.8], 0.3).map(|x| x as f32);
+    h.state_mut().brush = strandlight::paint::Brush {
+        radius_px: 40.0,
+        strength: 1.0,
+        falloff: Falloff::Constant,
+        dye,
+        ..Default::default()
+    };
+    let (w, hh) = (before.width as f32, before.height as f32);
+    let covered: Vec<usize> = (0..before.beauty.len())
+        .filter(|&i| before.beauty[i][3] > 0.0)
+        .collect();
+    let cx = covered
+        .iter()
+        .map(|&i| (i % before.width as usize) as f32 + 0.5)
+        .sum::<f32>()
+        / covered.len() as f32;
+    let cy = covered
+        .iter()
+        .map(|&i| (i / before.width as usize) as f32 + 0.5)
+        .sum::<f32>()
+        / covered.len() as f32;
+    let to_screen =
+        |x: f32, y: f32| rect.min + egui::vec2(x / w * rect.width(), y / hh * rect.height());
+    let (a, b) = (to_screen(cx - 10.0, cy), to_screen(cx + 10.0, cy));
+    brush_stroke(&mut h, a, b, 8);
+    let app = h.state();
+    let layer = app.session.paint_layer.clone().expect("a paint layer");
+    let painted: Vec<u32> = (0..layer.get().points.len() as u32)
+        .filter(|&i| layer.get().points[i as usize][3] > 0.0)
+        .collect();
+    println!(
+        "stroke: {} dabs, {} points painted",
+        app.brush_stats.dabs,
+        painted.len()
+    );
+    assert!(painted.len() > 10, "the stroke painted the hair");
+    // The points painted are the picker's selection for the dabs along the path, at full strength.
+    let live = app.live.as_ref().unwrap();
+    let picker = live.picker().expect("picker");
+    let radius = app.brush_radius_render_px();
+    let to_render = |p: egui::Pos2| {
+        [
+            (p.x - rect.min.x) / rect.width() * w,
+            (p.y - rect.min.y) / rect.height() * hh,
+        ]
+    };
+    let (ra, rb) = (to_render(a), to_render(b));
+    let (mut centres, _) = dabs_along(ra, rb, radius * app.brush.spacing, 0.0);
+    centres.insert(0, ra);
+    let mut want: Vec<u32> = centres
+        .iter()
+        .flat_map(|c| picker.dab(&app.brush, *c, radius, 1.0))
+        .map(|t| t.0)
+        .collect();
+    want.sort_unstable();
+    want.dedup();
+    let extra: Vec<_> = painted
+        .iter()
+        .filter(|i| want.binary_search(i).is_err())
+        .collect();
+    let missing: Vec<_> = want
+        .iter()
+        .filter(|i| painted.binary_search(i).is_err())
+        .collect();
+    println!(
+        "{} wanted; painted but not wanted {extra:?}, wanted but not painted {missing:?}",
+        want.len()
+    );
+    assert_eq!(painted, want, "the points of the dabs along the path");
+    for &i in &painted {
+        let v = layer.get().points[i as usize];
+        assert_eq!(v[3], 1.0);
+        assert!((0..3).all(|c| (v[c] - dye[c]).abs() < 1e-6));
+        let q = project(
+            &picker.view.camera,
+            app.live.as_ref().unwrap().hair.positions[i as usize],
+        )
+        .unwrap();
+        let (dx, dy) = (rb[0] - ra[0], rb[1] - ra[1]);
+        let s = (((q.x - ra[0]) * dx + (q.y - ra[1]) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+        let d = ((q.x - ra[0] - s * dx).powi(2) + (q.y - ra[1] - s * dy).powi(2)).sqrt();
+        assert!(
+            d <= radius + 1e-3,
+            "a painted point {d} px from the path (radius {radius})"
+        );
+    }
+    // The renderer has the new absorption at the painted points only.
+    let sigma = &live.sigma_a;
+    for (i, (s0, s1)) in sigma_before.iter().zip(sigma).enumerate() {
+        let p = painted.binary_search(&(i as u32)).is_ok();
+        let want = if p {
+            effective(live.base_sigma_a[i], layer.get().points[i])
+        } else {
+            *s0
+        };
+        assert_eq!(*s1, want, "point {i}");
+    }
+    let session_after = h.state().session.clone();
+    converge(&mut h);
+    let after = image(&h);
+    // Pixels showing a painted segment move toward the dye (bluer); the others do not change
+    // (single scattering: the shadows' transmittance does not read absorption).
+    let live = h.state().live.as_ref().unwrap();
+    let hair = &live.hair;
+    let painted_point = |p: u32| layer.get().points[p as usize][3] > 0.0;
+    let segment_start: Vec<u32> = (0..hair.strand_count())
+        .flat_map(|s| {
+            let r = hair.strand_range(s);
+            (r.start as u32..r.end as u32 - 1).collect::<Vec<_>>()
+        })
+        .collect();
+    let (mut hit, mut miss) = (Vec::new(), Vec::new());
+    for i in 0..after.beauty.len() {
+        if after.beauty[i][3] == 0.0 {
+            continue;
+        }
+        let touches = after.sample_ids[i].iter().any(|&id| {
+            id > 0 && {
+                let p = segment_start[id as usize - 1];
+                painted_point(p) || painted_point(p + 1)
+            }
+        });
+        if touches { hit.push(i) } else { miss.push(i) }
+    }
+    let (c0, c1) = (mean_colour(&before, &hit), mean_colour(&after, &hit));
+    println!("painted pixels {}: rgb {c0:.4?} -> {c1:.4?}", hit.len());
+    assert!(
+        c1[2] / c1[0] > 1.5 * c0[2] / c0[0],
+        "the painted hair turns blue"
+    );
+    let (b0, b1) = (&before.beauty, &after.beauty);
+    let worst = miss
+        .iter()
+        .flat_map(|&i| (0..4).map(move |c| (b0[i][c] - b1[i][c]).abs()))
+        .fold(0.0f32, f32::max);
+    let peak = before
+        .beauty
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(1e-6f32, f32::max);
+    println!(
+        "unpainted pixels {}: largest change {:.2e} of the peak",
+        miss.len(),
+        worst / peak
+    );
+    assert!(
+        worst / peak < 1e-5,
+        "unpainted hair unchanged under single scattering"
+    );
+    // Undo restores the absorption bit for bit and the image; redo reapplies the stroke.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    let live = h.state().live.as_ref().unwrap();
+    assert!(
+        live.sigma_a == sigma_before,
+        "undo restores the absorption bit for bit"
+    );
+    assert!(
+        h.state()
+            .session
+            .paint_layer
+            .as_ref()
+            .unwrap()
+            .get()
+            .points
+            .iter()
+            .all(|v| *v == [0.0; 4])
+    );
+    converge(&mut h);
+    assert!(
+        max_relative_difference(&image(&h), &before) < 1e-6,
+        "undo restores the image"
+    );
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    h.step();
+    assert!(
+        h.state().session == session_after,
+        "redo reapplies the stroke"
+    );
+    converge(&mut h);
+    assert!(
+        max_relative_difference(&image(&h), &after) < 1e-6,
+        "redo restores the image"
+    );
+    // With multiple scattering, the unpainted hair changes only through the light the dyed hair
+    // passes on: far less than the dyed hair itself.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    let mut render = h.state().session.render;
+    render.multiple_scattering = true;
+    h.state_mut()
+        .perform(strandlight::session::Edit::Render(render), false);
+    converge(&mut h);
+    let plain_ms = image(&h);
+    // The same stroke again, as an edit (replayed data, as autosave and tests replay them).
+    let stroke = strandlight::paint::PaintDelta {
+        values: painted
+            .iter()
+            .map(|&i| layer.get().points[i as usize])
+            .collect(),
+        indices: painted.clone(),
+    };
+    h.state_mut()
+        .perform(strandlight::session::Edit::Paint(Box::new(stroke)), false);
+    converge(&mut h);
+    let painted_ms = image(&h);
+    let change = |which: &[usize]| {
+        let (a, b) = (
+            mean_colour(&plain_ms, which),
+            mean_colour(&painted_ms, which),
+        );
+        (0..3).map(|c| (a[c] - b[c]).abs()).sum::<f64>() / (0..3).map(|c| a[c]).sum::<f64>()
+    };
+    let (near, far) = (change(&hit), change(&miss));
+    println!("multiple scattering: dyed pixels change {near:.4}, the others {far:.5} (relative)");
+    assert!(
+        far > 0.0 && far < 0.1 * near,
+        "the unpainted hair changes a little, through the dyed hair's light"
+    );
+}

@@ -5,6 +5,7 @@ pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;
 pub mod edit;
+pub mod export_hair;
 pub mod fit_env;
 pub mod gpu_info;
 pub mod info;
@@ -51,6 +52,8 @@ pub enum Command {
     Render(Box<render::RenderArgs>),
     /// Benchmark the renderer on the standard scenes S0-S3: GPU time per pass (JSON).
     Bench(bench::BenchArgs),
+    /// Export a session's hair with its look and paint for other tools (.usda USD curves, .hair).
+    ExportHair(export_hair::ExportHairArgs),
     /// Print the GPU adapter strandlight would render with (JSON).
     GpuInfo {
         /// Ask for a software adapter (lavapipe) even if a GPU exists.
@@ -73,6 +76,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::BenchFast(args)) => bench_fast::run(args),
         Some(Command::Render(args)) => render::run(*args),
         Some(Command::Bench(args)) => bench::run(args),
+        Some(Command::ExportHair(args)) => export_hair::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
         None => edit::run_editor(edit::EditArgs {
             lights: 40,

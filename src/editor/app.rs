@@ -135,6 +135,8 @@ pub struct EditorApp {
     pub brush_stats: super::brush_tool::BrushStats,
     /// F / Shift+F held: the pointer's distance sets the radius or the strength.
     pub radius_drag: Option<super::brush_tool::RadiusDrag>,
+    /// A hair export being written (its message when done).
+    pub hair_export: Option<Job<Result<String, String>>>,
     /// The viewport's size in physical pixels and its rectangle in points (last frame).
     pub viewport_px: [u32; 2],
     pub viewport_rect: Option<egui::Rect>,
@@ -179,7 +181,14 @@ impl EditorApp {
         let mut session = options.session.clone().unwrap_or_default();
         if let Some(path) = &options.session_path {
             match Session::read(path) {
-                Ok(s) => {
+                Ok(mut s) => {
+                    if let Err(e) = s.load_paint() {
+                        messages.push(Message {
+                            level: Level::Warning,
+                            text: format!("{e}; the hair is shown unpainted"),
+                            at: Instant::now(),
+                        });
+                    }
                     session = s;
                     session_path = Some(path.clone());
                 }
@@ -239,6 +248,7 @@ impl EditorApp {
             stroke: None,
             brush_stats: Default::default(),
             radius_drag: None,
+            hair_export: None,
             viewport_px: [640, 400],
             viewport_rect: None,
             frame_ms: 0.0,
@@ -366,6 +376,10 @@ impl EditorApp {
             .session_path
             .as_deref()
             .and_then(|p| Session::read(p).ok())
+            .map(|mut s| {
+                let _ = s.load_paint();
+                s
+            })
             .unwrap_or_default();
         self.session = session;
         self.autosave.set_session_path(self.session_path.as_deref());
@@ -377,7 +391,7 @@ impl EditorApp {
         if let Err(e) = self.autosave.on_exit(&self.session.clone(), true) {
             self.message(Level::Warning, e);
         } else if file != self.autosave.path {
-            let _ = std::fs::remove_file(file);
+            super::autosave::remove_recovery(file);
         }
     }
 
@@ -586,7 +600,11 @@ impl EditorApp {
     /// Opens a session file; on error the current session stays.
     pub fn open_session(&mut self, path: &Path) {
         match Session::read(path) {
-            Ok(s) => {
+            Ok(mut s) => {
+                if let Err(e) = s.load_paint() {
+                    self.message(Level::Warning, format!("{e}; the hair is shown unpainted"));
+                }
+                self.end_stroke();
                 if self.modified() {
                     // The unsaved work stays in its recovery file (offered at the next start).
                     if let Err(e) = self.autosave.on_exit(&self.session, true) {
@@ -632,7 +650,8 @@ impl EditorApp {
 
     /// Saves to `path` (atomically); the session is then unmodified.
     pub fn save_session(&mut self, path: &Path) {
-        match self.session.write(path) {
+        self.end_stroke();
+        match self.session.save(path) {
             Ok(()) => {
                 self.saved = self.session.clone();
                 self.session_path = Some(path.to_path_buf());
@@ -743,6 +762,13 @@ impl EditorApp {
                 let (level, text) = msg;
                 self.message(level, text);
                 self.export = None;
+            }
+        }
+        if let Some(r) = self.hair_export.as_mut().and_then(|j| j.poll()) {
+            self.hair_export = None;
+            match r.and_then(|r| r) {
+                Ok(m) => self.message(Level::Info, m),
+                Err(e) => self.message(Level::Error, e),
             }
         }
         if let Some(err) = self.autosave.tick(&self.session, &self.ctx) {

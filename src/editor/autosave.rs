@@ -20,6 +20,15 @@ const SUFFIX: &str = ".slsession";
 struct Recovery {
     session_path: Option<PathBuf>,
     session: serde_json::Value,
+    /// The paint layer in memory, written beside the recovery file (SLPAINT1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    paint_layer: Option<PathBuf>,
+}
+
+/// What a recovery write puts on disk: the JSON, and the paint layer's bytes and file.
+struct Contents {
+    json: Vec<u8>,
+    layer: Option<(PathBuf, Vec<u8>)>,
 }
 
 pub struct Autosave {
@@ -62,12 +71,26 @@ impl Autosave {
         self.dirty_since.get_or_insert_with(Instant::now);
     }
 
-    fn contents(&self, session: &Session) -> Vec<u8> {
+    fn contents(&self, session: &Session) -> Contents {
+        let layer_file = self.path.with_extension("slpaint");
+        let layer = session
+            .paint_layer
+            .as_ref()
+            .map(|l| (layer_file.clone(), l.get().encode()));
         let r = Recovery {
             session_path: self.session_path.clone(),
             session: serde_json::to_value(session).unwrap_or_default(),
+            paint_layer: layer.as_ref().map(|_| layer_file),
         };
-        serde_json::to_vec_pretty(&r).unwrap_or_default()
+        Contents {
+            json: serde_json::to_vec_pretty(&r).unwrap_or_default(),
+            layer,
+        }
+    }
+
+    /// Removes the recovery file and its paint layer.
+    fn remove(&self) {
+        remove_recovery(&self.path);
     }
 
     /// Once a frame: starts the write when due; returns an error message when a write failed (it is
@@ -77,7 +100,7 @@ impl Autosave {
             let result = job.poll()?;
             self.writing = None;
             if std::mem::take(&mut self.delete_when_written) {
-                let _ = std::fs::remove_file(&self.path);
+                self.remove();
             }
             match result.and_then(|r| r) {
                 Ok(()) => self.writes += 1,
@@ -94,13 +117,13 @@ impl Autosave {
             return None;
         }
         self.dirty_since = None;
-        let bytes = self.contents(session);
+        let contents = self.contents(session);
         let path = self.path.clone();
         let wake = ctx.clone();
         self.writing = Some(Job::spawn(
             "autosave",
             move || wake.request_repaint(),
-            move |_| write_recovery(&path, &bytes),
+            move |_| write_recovery(&path, &contents),
         ));
         None
     }
@@ -110,7 +133,7 @@ impl Autosave {
         self.session_path = session_path.map(Path::to_path_buf);
         self.dirty_since = None;
         self.delete_when_written = self.writing.is_some();
-        let _ = std::fs::remove_file(&self.path);
+        self.remove();
     }
 
     /// On quit (or before another session replaces an unsaved one): keep unsaved work in the
@@ -127,7 +150,7 @@ impl Autosave {
         if modified {
             write_recovery(&self.path, &self.contents(session))
         } else {
-            let _ = std::fs::remove_file(&self.path);
+            self.remove();
             Ok(())
         }
     }
@@ -162,7 +185,14 @@ pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session), String> {
     let r: Recovery = serde_json::from_str(&text)
         .map_err(|e| format!("{}: not a recovery file: {e}", file.display()))?;
     let json = serde_json::to_string(&r.session).map_err(|e| e.to_string())?;
-    let session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
+    let mut session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
+    if let Some(layer) = &r.paint_layer {
+        let layer = crate::paint::PaintLayer::read(layer).map_err(|e| e.to_string())?;
+        session.paint_layer = Some(crate::paint::SharedLayer::new(layer));
+    } else {
+        // The work had no layer in memory: the paint is the session's file, as saved.
+        let _ = session.load_paint();
+    }
     Ok((r.session_path.unwrap_or_default(), session))
 }
 
@@ -171,10 +201,25 @@ fn process_alive(pid: u32) -> bool {
     Path::new("/proc").join(pid.to_string()).exists()
 }
 
-fn write_recovery(path: &Path, bytes: &[u8]) -> Result<(), String> {
+fn write_recovery(path: &Path, contents: &Contents) -> Result<(), String> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("autosave: cannot create {}: {e}", dir.display()))?;
     }
-    write_atomic(path, bytes).map_err(|e| format!("autosave to {}: {e}", path.display()))
+    // The layer first: a recovery file never names a layer that is not there.
+    match &contents.layer {
+        Some((file, bytes)) => {
+            write_atomic(file, bytes).map_err(|e| format!("autosave to {}: {e}", file.display()))?
+        }
+        None => {
+            let _ = std::fs::remove_file(path.with_extension("slpaint"));
+        }
+    }
+    write_atomic(path, &contents.json).map_err(|e| format!("autosave to {}: {e}", path.display()))
+}
+
+/// Removes a recovery file and the paint layer beside it.
+pub fn remove_recovery(file: &Path) {
+    let _ = std::fs::remove_file(file);
+    let _ = std::fs::remove_file(file.with_extension("slpaint"));
 }

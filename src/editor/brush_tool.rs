@@ -48,7 +48,13 @@ pub struct RadiusDrag {
 impl EditorApp {
     /// A press, a drag to `to` or a release of the primary button over the viewport with the brush
     /// active; `to` in render pixels, `pressure` in [0, 1] (1 without a tablet).
-    pub fn brush_input(&mut self, to: Option<[f32; 2]>, pressed: bool, released: bool, pressure: f32) {
+    pub fn brush_input(
+        &mut self,
+        to: Option<[f32; 2]>,
+        pressed: bool,
+        released: bool,
+        pressure: f32,
+    ) {
         if pressed && let Some(p) = to {
             self.stroke = Some(StrokeState {
                 stroke: Stroke::new(),
@@ -171,6 +177,27 @@ impl EditorApp {
         {
             self.message(Level::Error, e.to_string());
         }
+    }
+
+    /// Writes the hair with its look and paint to `out` (.usda or .hair) on a worker.
+    pub fn export_hair(&mut self, out: std::path::PathBuf) {
+        let Some(live) = &self.live else {
+            self.message(Level::Error, "export: the scene is still loading");
+            return;
+        };
+        let (hair, sigma_a) = (live.hair.clone(), live.sigma_a.clone());
+        let scale = self.session.look.thickness_scale;
+        let wake = self.egui_ctx();
+        self.hair_export = Some(super::jobs::Job::spawn(
+            "exporting the hair",
+            move || wake.request_repaint(),
+            move |_| {
+                let mut h = (*hair).clone();
+                h.transform(|p| p, scale);
+                crate::session::export_hair::write_painted_hair(&h, &sigma_a, &out)
+                    .map(|_| format!("exported {}", out.display()))
+            },
+        ));
     }
 
     /// Undo or redo applied `edit`: a paint delta's points go to the renderer alone.

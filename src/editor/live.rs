@@ -8,6 +8,8 @@ use super::jobs::Job;
 use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
 use crate::hair::Hair;
+use crate::paint::SharedLayer;
+use crate::paint::brush::effective;
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
@@ -17,8 +19,6 @@ use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
-use crate::paint::SharedLayer;
-use crate::paint::brush::effective;
 use crate::session::assemble::{
     LoadedHairSource, base_absorption, mean_absorption, renderer_look, turned_lights,
 };
@@ -143,10 +143,11 @@ pub fn painted(base: &[[f32; 3]], layer: Option<&SharedLayer>) -> Vec<[f32; 3]> 
 
 /// What identifies the session's paint: its file and the revision of the layer in memory.
 fn paint_key(session: &Session) -> (Option<std::path::PathBuf>, Option<u64>) {
-    (
-        session.paint.clone(),
-        session.paint_layer.as_ref().map(SharedLayer::revision),
-    )
+    match &session.paint_layer {
+        // The layer in memory is the paint, whatever file it was saved to.
+        Some(l) => (None, Some(l.revision())),
+        None => (session.paint.clone(), None),
+    }
 }
 
 /// What the renderer was last told.
@@ -182,7 +183,7 @@ pub struct LiveScene {
     pub(super) mean_sigma_a: [f64; 3],
     /// Each point's absorption without paint, and with it (what the renderer has).
     pub base_sigma_a: Vec<[f32; 3]>,
-    pub(super) sigma_a: Vec<[f32; 3]>,
+    pub sigma_a: Vec<[f32; 3]>,
     /// The session's paint could not be shown (reported once by the app).
     pub paint_warning: Option<String>,
     /// The brush's view of the hair (view depth read back, points projected).

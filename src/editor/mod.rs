@@ -10,9 +10,9 @@ pub mod env_preview;
 pub mod export;
 pub mod jobs;
 pub mod live;
-pub mod picking;
 pub mod navigation;
 pub mod panels;
+pub mod picking;
 
 pub use app::{EditorApp, EditorOptions};
 

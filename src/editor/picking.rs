@@ -51,9 +51,11 @@ impl LiveScene {
                 let hair = self.hair.clone();
                 let (lo, hi) = self.bounds;
                 let mirror_x = 0.5 * (lo.x + hi.x);
-                p.building = Some(Job::spawn("brush picking", || {}, move |_| {
-                    Picker::new(&hair, view, mirror_x)
-                }));
+                p.building = Some(Job::spawn(
+                    "brush picking",
+                    || {},
+                    move |_| Picker::new(&hair, view, mirror_x),
+                ));
             }
         }
         let have = p.picker.as_ref().is_some_and(|k| current(&k.view.camera));

@@ -11,6 +11,7 @@ pub mod model;
 pub mod normalize;
 pub mod procedural;
 pub mod tressfx;
+pub mod usd;
 
 pub use error::HairError;
 pub use load::{LoadOptions, LoadedHair, load_hair, load_mesh};

@@ -156,8 +156,16 @@ impl Brush {
         let f = feather.max(1e-4);
         let ramp = |x: f32| x.clamp(0.0, 1.0);
         let (t0, t1) = (t0.min(t1), t0.max(t1));
-        let rise = if t0 <= 0.0 { 1.0 } else { ramp((t - t0) / f + 1.0) };
-        let fall = if t1 >= 1.0 { 1.0 } else { ramp((t1 - t) / f + 1.0) };
+        let rise = if t0 <= 0.0 {
+            1.0
+        } else {
+            ramp((t - t0) / f + 1.0)
+        };
+        let fall = if t1 >= 1.0 {
+            1.0
+        } else {
+            ramp((t1 - t) / f + 1.0)
+        };
         rise * fall
     }
 }
@@ -333,7 +341,12 @@ impl PaintDelta {
 mod tests {
     use super::*;
 
-    fn run(brush: &Brush, dabs: &[&[Touch]], layer: &mut [LayerValue], base: &[[f32; 3]]) -> Stroke {
+    fn run(
+        brush: &Brush,
+        dabs: &[&[Touch]],
+        layer: &mut [LayerValue],
+        base: &[[f32; 3]],
+    ) -> Stroke {
         let mut s = Stroke::new();
         let n = layer.len() as u32;
         for d in dabs {
@@ -345,7 +358,11 @@ mod tests {
     #[test]
     fn mixing_in_weight_form_equals_mixing_the_absorption() {
         let base = [0.3, 0.5, 1.1];
-        for before in [[0.0, 0.0, 0.0, 0.0], [2.0, 1.0, 0.2, 0.4], [0.1, 0.2, 0.3, 1.0]] {
+        for before in [
+            [0.0, 0.0, 0.0, 0.0],
+            [2.0, 1.0, 0.2, 0.4],
+            [0.1, 0.2, 0.3, 1.0],
+        ] {
             for a in [0.0, 0.25, 1.0] {
                 let target = [1.5, 0.05, 0.7];
                 let got = effective(base, mix_toward(before, target, a));
@@ -409,7 +426,12 @@ mod tests {
         let mut layer = vec![[0.0; 4]; 3];
         run(&full(PaintMode::Dye), &[&[(1, 1.0)]], &mut layer, &base);
         let dyed = effective(base[1], layer[1]);
-        run(&full(PaintMode::Blur), &[&[(0, 1.0), (1, 1.0), (2, 1.0)]], &mut layer, &base);
+        run(
+            &full(PaintMode::Blur),
+            &[&[(0, 1.0), (1, 1.0), (2, 1.0)]],
+            &mut layer,
+            &base,
+        );
         let blurred = effective(base[1], layer[1]);
         assert!((blurred[0] - base[1][0]).abs() < (dyed[0] - base[1][0]).abs());
     }

@@ -102,3 +102,29 @@ pub fn parse_colour(s: &str) -> Result<[f64; 3], String> {
     }
     Ok(c)
 }
+
+/// The colour a sigma_a gives (the inverse of [`sigma_a_from_colour`]: the multiple-scattering
+/// albedo c = exp(-sqrt(sigma_a) d(beta_N)), per channel), linear RGB; the painted hair's colour as
+/// other tools see it (USD displayColor, cyHair colours).
+pub fn colour_from_sigma_a(sigma_a: [f64; 3], beta_n: f64) -> [f64; 3] {
+    let b = beta_n;
+    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3)
+        + 5.574 * b.powi(4)
+        + 0.245 * b.powi(5);
+    sigma_a.map(|s| (-s.max(0.0).sqrt() * d).exp())
+}
+
+#[cfg(test)]
+mod colour_tests {
+    use super::*;
+
+    #[test]
+    fn colour_and_absorption_invert_each_other() {
+        for c in [[0.5, 0.03, 0.04], [0.9, 0.8, 0.6], [0.01, 0.02, 0.2]] {
+            let back = colour_from_sigma_a(sigma_a_from_colour(c, DEFAULT_BETA_N), DEFAULT_BETA_N);
+            for k in 0..3 {
+                assert!((back[k] - c[k]).abs() < 1e-9, "{back:?} {c:?}");
+            }
+        }
+    }
+}

@@ -638,8 +638,14 @@ impl Renderer {
     pub fn start_read_view_depth(
         &self,
         ctx: &GpuContext,
-    ) -> (crate::gpu::context::PendingRead, super::camera::CameraUniform) {
-        (ctx.start_read(&[&self.targets.view_depth]), self.view_camera())
+    ) -> (
+        crate::gpu::context::PendingRead,
+        super::camera::CameraUniform,
+    ) {
+        (
+            ctx.start_read(&[&self.targets.view_depth]),
+            self.view_camera(),
+        )
     }
 
     /// The camera uniform of the whole image as the frame is drawn now.

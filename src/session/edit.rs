@@ -87,7 +87,9 @@ pub fn apply(session: &mut Session, edit: Edit) -> Edit {
         }
         Edit::Paint(mut d) => {
             if let Some(layer) = &mut session.paint_layer
-                && d.indices.iter().all(|&i| (i as usize) < layer.get().points.len())
+                && d.indices
+                    .iter()
+                    .all(|&i| (i as usize) < layer.get().points.len())
             {
                 d.swap(&mut layer.make_mut().points);
             }

@@ -110,6 +110,33 @@ impl Session {
         })
     }
 
+    /// Saves the session to `path` with its paint layer in memory beside it (`path` with the
+    /// extension `.slpaint`, which `paint` then names; both written atomically, the layer first).
+    pub fn save(&mut self, path: &Path) -> Result<(), SessionError> {
+        if let Some(layer) = &self.paint_layer {
+            let file = path.with_extension("slpaint");
+            layer.get().write(&file).map_err(|e| SessionError::Io {
+                path: file.clone(),
+                message: format!("cannot write the paint layer: {e}"),
+            })?;
+            self.paint = Some(std::path::absolute(&file).unwrap_or(file));
+        }
+        self.write(path)
+    }
+
+    /// Reads the paint file the session names into memory (the editor paints on it); the session is
+    /// unchanged when the file cannot be read.
+    pub fn load_paint(&mut self) -> Result<(), crate::paint::PaintLayerError> {
+        if self.paint_layer.is_none()
+            && let Some(path) = &self.paint
+        {
+            self.paint_layer = Some(crate::paint::SharedLayer::new(
+                crate::paint::PaintLayer::read(path)?,
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks the values a file could get wrong.
     pub fn validate(&self) -> Result<(), String> {
         self.look.validate()?;

@@ -3,6 +3,7 @@
 
 pub mod assemble;
 pub mod edit;
+pub mod export_hair;
 pub mod history;
 pub mod io;
 pub mod model;

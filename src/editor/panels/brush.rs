@@ -5,7 +5,7 @@ use super::widgets::{linear_to_srgb8, srgb8_to_linear};
 use crate::editor::app::EditorApp;
 use crate::editor::brush_tool::Tool;
 use crate::paint::brush::{FRONT_DEPTH, Falloff, PaintMode};
-use crate::paint::dye::DEFAULT_BETA_N;
+use crate::paint::dye::{DEFAULT_BETA_N, colour_from_sigma_a};
 use crate::paint::sigma_a_from_colour;
 use crate::scattering::params::sigma_a_from_melanin;
 
@@ -42,16 +42,11 @@ impl DyeSpec {
     }
 }
 
-/// The colour a sigma_a looks (the inversion's forward direction, per channel: albedo
-/// exp(-sqrt(sigma_a) d), Chiang 2016 Eq. 9 solved for c), for swatches.
+/// The colour a sigma_a looks (the inversion run forward), for swatches.
 fn swatch(sigma_a: [f32; 3]) -> egui::Color32 {
-    let b = DEFAULT_BETA_N;
-    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3)
-        + 5.574 * b.powi(4)
-        + 0.245 * b.powi(5);
-    let c = sigma_a.map(|s| (-(s.max(0.0) as f64).sqrt() * d).exp());
-    let [r, g, bl] = c.map(linear_to_srgb8);
-    egui::Color32::from_rgb(r, g, bl)
+    let c = colour_from_sigma_a(sigma_a.map(f64::from), DEFAULT_BETA_N);
+    let [r, g, b] = c.map(linear_to_srgb8);
+    egui::Color32::from_rgb(r, g, b)
 }
 
 pub fn tools(app: &mut EditorApp, ui: &mut egui::Ui) {
@@ -74,13 +69,20 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
     let b = &mut app.brush;
     ui.horizontal_wrapped(|ui| {
         for m in PaintMode::ALL {
-            ui.selectable_value(&mut b.mode, m, m.name()).on_hover_text(match m {
-                PaintMode::Dye => "Mix toward the dye's absorption",
-                PaintMode::Darken => "Add eumelanin (one unit of concentration at full strength)",
-                PaintMode::Lighten => "Remove melanin (bleach: 60 % less absorption at full strength)",
-                PaintMode::Blur => "Average with the neighbours along the strand and under the brush",
-                PaintMode::Erase => "Back to the look's absorption",
-            });
+            ui.selectable_value(&mut b.mode, m, m.name())
+                .on_hover_text(match m {
+                    PaintMode::Dye => "Mix toward the dye's absorption",
+                    PaintMode::Darken => {
+                        "Add eumelanin (one unit of concentration at full strength)"
+                    }
+                    PaintMode::Lighten => {
+                        "Remove melanin (bleach: 60 % less absorption at full strength)"
+                    }
+                    PaintMode::Blur => {
+                        "Average with the neighbours along the strand and under the brush"
+                    }
+                    PaintMode::Erase => "Back to the look's absorption",
+                });
         }
     });
     if b.mode == PaintMode::Dye {
@@ -94,8 +96,8 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
             );
             if r.changed() {
                 srgb[..3].copy_from_slice(&rgb);
-                b.dye = sigma_a_from_colour(rgb.map(srgb8_to_linear), DEFAULT_BETA_N)
-                    .map(|x| x as f32);
+                b.dye =
+                    sigma_a_from_colour(rgb.map(srgb8_to_linear), DEFAULT_BETA_N).map(|x| x as f32);
             }
             ui.weak(format!(
                 "σ_a = ({:.2}, {:.2}, {:.2})",
@@ -106,10 +108,8 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
             for (name, spec) in &PALETTE {
                 let s = spec.sigma_a();
-                let swatch_button = egui::Button::new(
-                    egui::RichText::new("■").color(swatch(s)).size(18.0),
-                )
-                .small();
+                let swatch_button =
+                    egui::Button::new(egui::RichText::new("■").color(swatch(s)).size(18.0)).small();
                 if ui
                     .add(swatch_button)
                     .on_hover_text(format!(
@@ -123,10 +123,16 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
             }
         });
     }
-    ui.add(egui::Slider::new(&mut b.radius_px, 2.0..=300.0).text("radius").suffix(" px"))
-        .on_hover_text("Brush radius in screen pixels ([ and ], or F then move)");
+    ui.add(
+        egui::Slider::new(&mut b.radius_px, 2.0..=300.0)
+            .text("radius")
+            .suffix(" px"),
+    )
+    .on_hover_text("Brush radius in screen pixels ([ and ], or F then move)");
     ui.add(egui::Slider::new(&mut b.strength, 0.0..=1.0).text("strength"))
-        .on_hover_text("What a stroke reaches at the brush centre: 1 paints the dye fully (Shift+F)");
+        .on_hover_text(
+            "What a stroke reaches at the brush centre: 1 paints the dye fully (Shift+F)",
+        );
     egui::ComboBox::from_label("falloff")
         .selected_text(b.falloff.name())
         .show_ui(ui, |ui| {

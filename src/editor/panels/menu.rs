@@ -39,6 +39,13 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             if ui.button("Export still…  (Ctrl+E)").clicked() {
                 export_dialog(app);
             }
+            if ui
+                .button("Export painted hair…")
+                .on_hover_text("The hair with its dye as USD curves (.usda, displayColor) or cyHair colours (.hair)")
+                .clicked()
+            {
+                hair_export_dialog(app);
+            }
         });
         ui.menu_button("Edit", |ui| {
             let undo = app
@@ -127,6 +134,20 @@ pub fn environment_dialog(app: &mut EditorApp) {
         .pick_file()
     {
         app.load_environment(p, 40);
+    }
+}
+
+pub fn hair_export_dialog(app: &mut EditorApp) {
+    if let Some(mut p) = rfd::FileDialog::new()
+        .add_filter("USD curves", &["usda"])
+        .add_filter("cyHair", &["hair"])
+        .set_file_name("hair.usda")
+        .save_file()
+    {
+        if p.extension().is_none() {
+            p.set_extension("usda");
+        }
+        app.export_hair(p);
     }
 }
 

@@ -105,7 +105,13 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
         || (app.stroke_active() && !ui.input(|i| i.pointer.primary_down()));
     // A click without a drag is one dab.
     let clicked = response.clicked_by(primary) && !alt;
-    let pos = ui.input(|i| i.pointer.interact_pos()).filter(|_| dragging || pressed || clicked);
+    // A drag starts where the button went down (egui reports it once the pointer has moved a little).
+    let pos = ui
+        .input(|i| match pressed && !app.stroke_active() {
+            true => i.pointer.press_origin(),
+            false => i.pointer.interact_pos(),
+        })
+        .filter(|_| dragging || pressed || clicked);
     let to = pos.map(|p| {
         let (w, h) = app.render_size();
         [
@@ -115,9 +121,7 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
     });
     let pressure = ui.input(|i| {
         i.events.iter().rev().find_map(|e| match e {
-            egui::Event::Touch {
-                force: Some(f), ..
-            } => Some(*f),
+            egui::Event::Touch { force: Some(f), .. } => Some(*f),
             _ => None,
         })
     });
@@ -125,7 +129,17 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
     if clicked && !app.stroke_active() {
         app.brush_input(to, true, true, pressure);
     } else if pressed || dragging || released {
-        app.brush_input(to, pressed && !app.stroke_active(), released, pressure);
+        let start = pressed && !app.stroke_active();
+        app.brush_input(to, start, released, pressure);
+        // The move that started the drag paints from the press to here.
+        if start && let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
+            let (w, h) = app.render_size();
+            let here = [
+                (p.x - rect.min.x) / rect.width().max(1.0) * w as f32,
+                (p.y - rect.min.y) / rect.height().max(1.0) * h as f32,
+            ];
+            app.brush_input(Some(here), false, false, pressure);
+        }
     }
 }
 
