@@ -74,7 +74,8 @@ pub struct RenderArgs {
     /// Seed of the per-strand variation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Paint layer (.slpaint, as the editor saves it) applied over the absorption.
+    /// Paint layer (.slpaint, as the editor saves it) applied over the absorption (with --session:
+    /// instead of the session's).
     #[arg(long)]
     pub paint: Option<PathBuf>,
     /// Camera preset: front, three-quarter, side, back, back-three-quarter, top.
@@ -273,7 +274,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .map(PathBuf::as_path),
     )?;
     let session = match &args.session {
-        Some(path) => Session::read(path)?,
+        Some(path) => {
+            let mut s = Session::read(path)?;
+            // A paint layer named on the command line replaces the session's.
+            if let Some(p) = &args.paint {
+                s.paint = Some(p.clone());
+            }
+            s
+        }
         None => session_from_args(&args)?,
     };
     let scene = Scene::assemble(&session)?;

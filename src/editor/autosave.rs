@@ -223,3 +223,34 @@ pub fn remove_recovery(file: &Path) {
     let _ = std::fs::remove_file(file);
     let _ = std::fs::remove_file(file.with_extension("slpaint"));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::paint::{PaintLayer, SharedLayer};
+
+    #[test]
+    fn a_recovery_file_carries_the_paint_layer_and_goes_with_it() {
+        let dir = std::env::temp_dir().join(format!("sl-autosave-{}", std::process::id()));
+        let mut a = Autosave::new(dir.clone(), Some(Path::new("/x/look.slsession")), 77);
+        let mut layer = PaintLayer::empty(6, 2);
+        layer.points[3] = [0.1, 0.2, 0.3, 0.5];
+        let session = Session {
+            paint_layer: Some(SharedLayer::new(layer)),
+            ..Default::default()
+        };
+        a.on_exit(&session, true).unwrap();
+        let layer_file = a.path.with_extension("slpaint");
+        assert!(a.path.is_file() && layer_file.is_file());
+        let (path, back) = read_recovery(&a.path).unwrap();
+        assert_eq!(path, PathBuf::from("/x/look.slsession"));
+        assert!(back == session, "the layer comes back");
+        // Without a layer the old one goes; saving removes both.
+        a.on_exit(&Session::default(), true).unwrap();
+        assert!(!layer_file.exists());
+        a.on_exit(&session, true).unwrap();
+        a.saved(None);
+        assert!(!a.path.exists() && !layer_file.exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
