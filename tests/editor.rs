@@ -1068,12 +1068,26 @@ fn paint_stroke(h: &mut Harness<'static, EditorApp>, brush: strandlight::paint::
     }
     h.state_mut().brush = brush;
     let f = image(h);
-    let covered: Vec<usize> = (0..f.beauty.len()).filter(|&i| f.beauty[i][3] > 0.0).collect();
+    let covered: Vec<usize> = (0..f.beauty.len())
+        .filter(|&i| f.beauty[i][3] > 0.0)
+        .collect();
     let n = covered.len() as f32;
-    let cx = covered.iter().map(|&i| (i % f.width as usize) as f32 + 0.5).sum::<f32>() / n;
-    let cy = covered.iter().map(|&i| (i / f.width as usize) as f32 + 0.5).sum::<f32>() / n;
+    let cx = covered
+        .iter()
+        .map(|&i| (i % f.width as usize) as f32 + 0.5)
+        .sum::<f32>()
+        / n;
+    let cy = covered
+        .iter()
+        .map(|&i| (i / f.width as usize) as f32 + 0.5)
+        .sum::<f32>()
+        / n;
     let at = |x: f32, y: f32| {
-        rect.min + egui::vec2(x / f.width as f32 * rect.width(), y / f.height as f32 * rect.height())
+        rect.min
+            + egui::vec2(
+                x / f.width as f32 * rect.width(),
+                y / f.height as f32 * rect.height(),
+            )
     };
     brush_stroke(h, at(cx - 10.0, cy), at(cx + 10.0, cy), 8);
     let layer = h.state().session.paint_layer.clone().expect("a layer");
@@ -1104,7 +1118,10 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     let path = dir.join("painted.slsession");
     h.state_mut().save_session(&path);
     let layer_file = path.with_extension("slpaint");
-    assert!(path.is_file() && layer_file.is_file(), "session and layer written");
+    assert!(
+        path.is_file() && layer_file.is_file(),
+        "session and layer written"
+    );
     assert!(!h.state().modified());
     converge(&mut h);
     let edited = image(&h);
@@ -1129,7 +1146,10 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
         });
     again.state_mut().view.scale = 0.25;
     converge(&mut again);
-    assert!(again.state().session == session, "the same session, paint included");
+    assert!(
+        again.state().session == session,
+        "the same session, paint included"
+    );
     assert!(!again.state().modified());
     let d = max_relative_difference(&image(&again), &edited);
     println!("reopened against edited: {d:.2e}");
@@ -1153,7 +1173,11 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
         .arg(&cli)
         .output()
         .expect("runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let (a, b) = (read_exr_beauty(&exr, 96, 64), read_exr_beauty(&cli, 96, 64));
     let d = max_relative_difference(&a, &b);
     println!("export against render --paint: {d:.2e} of the peak");
@@ -1170,14 +1194,22 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
             .arg(out_file)
             .output()
             .expect("runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let live = again.state().live.as_ref().unwrap();
     let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
     let bytes = std::fs::read(&hair_file).unwrap();
-    let (back, _, _) = strandlight::hair::cyhair::read_cyhair(&bytes, &hair_file).expect("re-reads");
+    let (back, _, _) =
+        strandlight::hair::cyhair::read_cyhair(&bytes, &hair_file).expect("re-reads");
     let colours = back.colour.clone().expect("a colour array");
-    assert_eq!((back.point_count(), back.strand_count(), colours.len()), (points, strands, points));
+    assert_eq!(
+        (back.point_count(), back.strand_count(), colours.len()),
+        (points, strands, points)
+    );
     // The look is uniform: the unpainted points share one colour, the painted ones differ.
     let base = colours[0];
     let tinted = colours

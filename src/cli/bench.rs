@@ -51,6 +51,10 @@ pub struct BenchArgs {
     /// adapter, 80 on a software GPU, 30 on a hardware one).
     #[arg(long)]
     pub unit_budget_ms: Option<f64>,
+    /// Brush dabs painted after the progressive run (one stroke across the hair, each dab refined
+    /// until it shows); 0 skips it.
+    #[arg(long, default_value_t = 100)]
+    pub dabs: usize,
     /// Write the JSON here as well as to stdout.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -110,6 +114,9 @@ struct ProgressiveReport {
     /// Parameter changes after convergence, as the editor makes them (beta_R halved, then restored:
     /// the second with the preview's divisor adapted by the first).
     edits: Vec<EditReport>,
+    /// A brush stroke after that (`--dabs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    brush: Option<super::bench_brush::BrushReport>,
 }
 
 /// A parameter change as the editor makes it: the uniform at once, the tables on a worker thread,
@@ -407,6 +414,25 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 );
                 edits.push(edit);
             }
+            let brush = if args.dabs > 0 {
+                let b =
+                    super::bench_brush::brush_run(&ctx, &mut renderer, &hair, &sigma_a, args.dabs)?;
+                eprintln!(
+                    "{} brush: {} dabs of {:.0} px, {:.2} ms CPU per dab (max {:.2}), {:.0} points each, visible after {:.0} ms (max {:.0}); picker {:.0} ms",
+                    scene.name,
+                    b.dabs,
+                    b.radius_px,
+                    b.cpu_ms_median,
+                    b.cpu_ms_max,
+                    b.points_per_dab_mean,
+                    b.visible_ms_median,
+                    b.visible_ms_max,
+                    b.picker_ms
+                );
+                Some(b)
+            } else {
+                None
+            };
             Some(ProgressiveReport {
                 unit_budget_ms: budget.as_secs_f64() * 1e3,
                 preview_factor: renderer.preview_factor(),
@@ -424,6 +450,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 first_pass_ms,
                 converged_ms: run.converged_ms,
                 edits,
+                brush,
             })
         };
         reports.push(SceneReport {

@@ -1,6 +1,7 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
 pub mod bench;
+pub mod bench_brush;
 pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;

@@ -221,25 +221,35 @@ impl EditorApp {
 /// V / Esc navigate, [ and ] radius, F radius and Shift+F strength by pointer distance.
 pub fn tool_keys(app: &mut EditorApp, ctx: &egui::Context, pointer: Option<egui::Pos2>) {
     use egui::Key;
-    let (b, v, esc, smaller, larger, f, shift) = ctx.input(|i| {
+    let (b, v, esc, smaller, larger) = ctx.input(|i| {
         (
             i.key_pressed(Key::B),
             i.key_pressed(Key::V),
             i.key_pressed(Key::Escape),
             i.key_pressed(Key::OpenBracket),
             i.key_pressed(Key::CloseBracket),
-            i.key_pressed(Key::F),
-            i.modifiers.shift,
         )
     });
+    // F with the modifiers it was pressed with (Shift may be released within the same frame).
+    let f = ctx.input(|i| {
+        i.events.iter().find_map(|e| match e {
+            egui::Event::Key {
+                key: Key::F,
+                pressed: true,
+                repeat: false,
+                modifiers,
+                ..
+            } => Some(modifiers.shift),
+            _ => None,
+        })
+    });
+    let (f, shift) = (f.is_some(), f.unwrap_or(false));
     if b {
         app.tool = Tool::Brush;
     }
-    if v || esc {
-        if app.radius_drag.take().is_none() {
-            app.end_stroke();
-            app.tool = Tool::Navigate;
-        }
+    if (v || esc) && app.radius_drag.take().is_none() {
+        app.end_stroke();
+        app.tool = Tool::Navigate;
     }
     if app.tool != Tool::Brush {
         return;

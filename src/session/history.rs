@@ -216,7 +216,7 @@ mod tests {
         for k in 0..3u32 {
             let indices: Vec<u32> = (100 * k..100 * k + 100).collect();
             let layer = s.paint_layer.as_mut().unwrap().make_mut();
-            let mut undo = PaintDelta {
+            let undo = PaintDelta {
                 values: indices.iter().map(|&i| layer.points[i as usize]).collect(),
                 indices: indices.clone(),
             };

@@ -1,0 +1,126 @@
+//! The brush's benchmark inside `bench`: after the scene converged, one stroke of N dabs across the
+//! hair as the editor paints it (picking from the frame's view depth, the layer, the points' upload)
+//! and, after each dab, refinement until its preview is on screen. CPU time per dab and time until
+//! the dab is visible.
+
+use serde::Serialize;
+use std::time::Instant;
+use strandlight::gpu::GpuContext;
+use strandlight::hair::Hair;
+use strandlight::paint::brush::{Stroke, effective};
+use strandlight::paint::pick::{Picker, ViewDepth};
+use strandlight::paint::{Brush, PaintLayer};
+use strandlight::render::Renderer;
+
+#[derive(Serialize)]
+pub struct BrushReport {
+    pub dabs: usize,
+    /// Brush radius, render pixels.
+    pub radius_px: f32,
+    /// Reading the view depth back and projecting every point (once per view, on a worker in the
+    /// editor).
+    pub picker_ms: f64,
+    /// CPU milliseconds per dab: finding the points, the layer, their absorption and its upload.
+    pub cpu_ms_median: f64,
+    pub cpu_ms_max: f64,
+    pub points_per_dab_mean: f64,
+    /// From the dab to its preview being complete (the dab visible), milliseconds.
+    pub visible_ms_median: f64,
+    pub visible_ms_max: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Paints `dabs` dabs across the converged frame of `renderer` (whose points are `hair`, with the
+/// absorption `base` before paint).
+pub fn brush_run(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    hair: &Hair,
+    base: &[[f32; 3]],
+    dabs: usize,
+) -> anyhow::Result<BrushReport> {
+    let t = Instant::now();
+    let frame = renderer.read_frame(ctx)?;
+    let camera = renderer.view_camera();
+    let (lo, hi) = hair.bounds();
+    let view = ViewDepth {
+        width: frame.width,
+        height: frame.height,
+        depth: frame.depth.clone(),
+        camera,
+    };
+    let picker = Picker::new(hair, view, 0.5 * (lo.x + hi.x));
+    let picker_ms = t.elapsed().as_secs_f64() * 1e3;
+    // A horizontal stroke through the middle of the hair on screen, half the image wide.
+    let covered: Vec<usize> = (0..frame.depth.len())
+        .filter(|&i| frame.depth[i] < 1e9)
+        .collect();
+    anyhow::ensure!(!covered.is_empty(), "no hair on screen to paint");
+    let w = frame.width as usize;
+    let n = covered.len() as f32;
+    let cx = covered.iter().map(|&i| (i % w) as f32 + 0.5).sum::<f32>() / n;
+    let cy = covered.iter().map(|&i| (i / w) as f32 + 0.5).sum::<f32>() / n;
+    let radius = 0.04 * frame.width as f32;
+    let brush = Brush {
+        radius_px: radius,
+        ..Default::default()
+    };
+    let length = 0.5 * frame.width as f32;
+    let mut layer = PaintLayer::empty(hair.point_count(), hair.strand_count());
+    let mut sigma: Vec<[f32; 3]> = base.to_vec();
+    let mut stroke = Stroke::new();
+    let eumelanin =
+        strandlight::scattering::params::sigma_a_from_melanin(1.0, 0.0).map(|x| x as f32);
+    let offsets = &hair.strand_offsets;
+    let (mut cpu, mut visible, mut points) = (Vec::new(), Vec::new(), 0usize);
+    for k in 0..dabs {
+        let x = cx - 0.5 * length + length * k as f32 / dabs.max(2).saturating_sub(1) as f32;
+        let t = Instant::now();
+        let under = picker.dab(&brush, [x, cy], radius, 1.0);
+        let changed = stroke.dab(
+            &brush,
+            &under,
+            &mut layer.points,
+            base,
+            |i| {
+                let s = offsets.partition_point(|&o| o <= i).saturating_sub(1);
+                offsets[s]..offsets[s + 1]
+            },
+            eumelanin,
+        );
+        for &i in &changed {
+            sigma[i as usize] = effective(base[i as usize], layer.points[i as usize]);
+        }
+        renderer.set_absorption_points_deferred(ctx, &sigma, &changed)?;
+        renderer.restart();
+        cpu.push(t.elapsed().as_secs_f64() * 1e3);
+        points += changed.len();
+        // Refine until the dab shows (its preview, or the full image without one).
+        loop {
+            let p = renderer.refine(ctx)?;
+            if p.ready.is_some() || p.converged {
+                break;
+            }
+            if p.submitted.is_some() || p.busy {
+                ctx.device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+            }
+        }
+        visible.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(BrushReport {
+        dabs,
+        radius_px: radius,
+        picker_ms,
+        cpu_ms_max: cpu.iter().copied().fold(0.0, f64::max),
+        cpu_ms_median: median(cpu),
+        points_per_dab_mean: points as f64 / dabs.max(1) as f64,
+        visible_ms_max: visible.iter().copied().fold(0.0, f64::max),
+        visible_ms_median: median(visible),
+    })
+}
