@@ -135,6 +135,8 @@ pub struct EditorApp {
     pub brush_stats: super::brush_tool::BrushStats,
     /// F / Shift+F held: the pointer's distance sets the radius or the strength.
     pub radius_drag: Option<super::brush_tool::RadiusDrag>,
+    /// The click that confirmed a radius adjustment is held: the brush ignores it until released.
+    pub brush_idle_until_release: bool,
     /// A hair export being written (its message when done).
     pub hair_export: Option<Job<Result<String, String>>>,
     /// The viewport's size in physical pixels and its rectangle in points (last frame).
@@ -248,6 +250,7 @@ impl EditorApp {
             stroke: None,
             brush_stats: Default::default(),
             radius_drag: None,
+            brush_idle_until_release: false,
             hair_export: None,
             viewport_px: [640, 400],
             viewport_rect: None,
@@ -686,8 +689,12 @@ impl EditorApp {
         }
     }
 
-    /// Moves the camera (not an edit; saved with the session).
+    /// Moves the camera (not an edit; saved with the session). A stroke under way ends: its dabs
+    /// were placed in the old view.
     pub fn set_camera(&mut self, c: Camera) {
+        if self.camera != Some(c) {
+            self.end_stroke();
+        }
         self.camera = Some(c);
         let vc = ViewCamera::from_camera(&c);
         if vc != self.session.camera {

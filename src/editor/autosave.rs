@@ -28,7 +28,8 @@ struct Recovery {
 /// What a recovery write puts on disk: the JSON, and the paint layer's bytes and file.
 struct Contents {
     json: Vec<u8>,
-    layer: Option<(PathBuf, Vec<u8>)>,
+    /// Encoded where it is written (a worker for the periodic writes).
+    layer: Option<(PathBuf, crate::paint::SharedLayer)>,
 }
 
 pub struct Autosave {
@@ -76,7 +77,7 @@ impl Autosave {
         let layer = session
             .paint_layer
             .as_ref()
-            .map(|l| (layer_file.clone(), l.get().encode()));
+            .map(|l| (layer_file.clone(), l.clone()));
         let r = Recovery {
             session_path: self.session_path.clone(),
             session: serde_json::to_value(session).unwrap_or_default(),
@@ -147,6 +148,8 @@ impl Autosave {
             std::thread::sleep(Duration::from_millis(1));
         }
         self.delete_when_written = false;
+        // Written (or removed) now: no periodic write is due after this.
+        self.dirty_since = None;
         if modified {
             write_recovery(&self.path, &self.contents(session))
         } else {
@@ -187,8 +190,14 @@ pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session), String> {
     let json = serde_json::to_string(&r.session).map_err(|e| e.to_string())?;
     let mut session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
     if let Some(layer) = &r.paint_layer {
-        let layer = crate::paint::PaintLayer::read(layer).map_err(|e| e.to_string())?;
-        session.paint_layer = Some(crate::paint::SharedLayer::new(layer));
+        // A missing or damaged layer costs the paint, not the rest of the work.
+        match crate::paint::PaintLayer::read(layer) {
+            Ok(l) => session.paint_layer = Some(crate::paint::SharedLayer::new(l)),
+            Err(e) => {
+                eprintln!("warning: {e}; the recovered session opens without its paint");
+                let _ = session.load_paint();
+            }
+        }
     } else {
         // The work had no layer in memory: the paint is the session's file, as saved.
         let _ = session.load_paint();
@@ -208,9 +217,8 @@ fn write_recovery(path: &Path, contents: &Contents) -> Result<(), String> {
     }
     // The layer first: a recovery file never names a layer that is not there.
     match &contents.layer {
-        Some((file, bytes)) => {
-            write_atomic(file, bytes).map_err(|e| format!("autosave to {}: {e}", file.display()))?
-        }
+        Some((file, layer)) => write_atomic(file, &layer.get().encode())
+            .map_err(|e| format!("autosave to {}: {e}", file.display()))?,
         None => {
             let _ = std::fs::remove_file(path.with_extension("slpaint"));
         }

@@ -23,8 +23,11 @@ pub struct StrokeState {
     stroke: Stroke,
     last: [f32; 2],
     carry: f32,
-    /// Dabs that found no picker for the view yet (painted once it is ready).
+    /// Dabs found no picker for the view yet (they are dropped: the stroke paints from where the
+    /// picker is ready); reported once.
     waiting: bool,
+    /// The session had no paint layer before this stroke: its undo step removes the layer again.
+    created_layer: bool,
 }
 
 /// What the brush measured (the status bar and the benchmark).
@@ -43,6 +46,8 @@ pub struct BrushStats {
 pub struct RadiusDrag {
     pub centre: egui::Pos2,
     pub strength: bool,
+    /// The radius and strength before (Esc restores them).
+    pub before: (f32, f32),
 }
 
 impl EditorApp {
@@ -61,6 +66,7 @@ impl EditorApp {
                 last: p,
                 carry: 0.0,
                 waiting: false,
+                created_layer: false,
             });
             self.dab_at(&[p], pressure);
         } else if let (Some(p), Some(s)) = (to, &self.stroke) {
@@ -98,6 +104,10 @@ impl EditorApp {
         let Some(live) = &mut self.live else {
             return;
         };
+        // A hair change still loading: the scene on screen is not the session's.
+        if live.needs_rebuild(&self.session) {
+            return;
+        }
         let Some(picker) = live.picker() else {
             if let Some(s) = &mut self.stroke
                 && !s.waiting
@@ -110,23 +120,32 @@ impl EditorApp {
             }
             return;
         };
+        let under: Vec<Vec<crate::paint::brush::Touch>> = centres
+            .iter()
+            .map(|c| picker.dab(&self.brush, *c, radius, pressure))
+            .collect();
+        if under.iter().all(Vec::is_empty) {
+            return;
+        }
         let hair = live.hair.clone();
         let (points, strands) = (hair.point_count(), hair.strand_count());
+        let created = self.session.paint_layer.is_none();
         let layer = self
             .session
             .paint_layer
             .get_or_insert_with(|| SharedLayer::new(PaintLayer::empty(points, strands)));
         if !layer.get().fits(points, strands) {
-            self.stroke = None;
+            self.end_stroke();
             self.message(
                 Level::Error,
-                "the paint layer was made for another hair: it cannot be painted on this one",
+                "the paint layer was painted on another hair: clear it (brush panel) to paint this one",
             );
             return;
         }
         let Some(stroke) = &mut self.stroke else {
             return;
         };
+        stroke.created_layer |= created;
         let eumelanin = crate::scattering::params::sigma_a_from_melanin(1.0, 0.0).map(|x| x as f32);
         let offsets = &hair.strand_offsets;
         let strand_of = |i: u32| {
@@ -135,11 +154,10 @@ impl EditorApp {
         };
         let mut changed: Vec<u32> = Vec::new();
         let points_mut = &mut layer.make_mut().points;
-        for &c in centres {
-            let under = picker.dab(&self.brush, c, radius, pressure);
+        for u in &under {
             changed.extend(stroke.stroke.dab(
                 &self.brush,
-                &under,
+                u,
                 points_mut,
                 &live.base_sigma_a,
                 strand_of,
@@ -149,7 +167,9 @@ impl EditorApp {
         changed.sort_unstable();
         changed.dedup();
         let n = changed.len();
-        if let Err(e) = live.paint_points(&self.session, &changed) {
+        if n > 0
+            && let Err(e) = live.paint_points(&self.session, &changed)
+        {
             self.message(Level::Error, e.to_string());
         }
         let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -160,7 +180,8 @@ impl EditorApp {
         st.last_points = n;
     }
 
-    /// The stroke ends: it becomes one undo step.
+    /// The stroke ends: it becomes one undo step (one that removes the layer again when the stroke
+    /// made it).
     pub fn end_stroke(&mut self) {
         let Some(s) = self.stroke.take() else {
             return;
@@ -168,14 +189,34 @@ impl EditorApp {
         let Some(layer) = &self.session.paint_layer else {
             return;
         };
-        if let Some(delta) = s.stroke.finish(&layer.get().points) {
-            self.history.record(Edit::Paint(Box::new(delta)));
-            self.autosave.changed();
+        let delta = s.stroke.finish(&layer.get().points);
+        match (delta, s.created_layer) {
+            (None, true) => self.session.paint_layer = None,
+            (None, false) => {}
+            (Some(_), true) => {
+                self.history.record(Edit::PaintLayer(Box::new((
+                    None,
+                    self.session.paint.clone(),
+                ))));
+                self.autosave.changed();
+            }
+            (Some(delta), false) => {
+                self.history.record(Edit::Paint(Box::new(delta)));
+                self.autosave.changed();
+            }
         }
         if let Some(live) = &mut self.live
             && let Err(e) = live.paint_finished(&self.session)
         {
             self.message(Level::Error, e.to_string());
+        }
+    }
+
+    /// Removes the paint layer (one undo step; the look shows unpainted).
+    pub fn clear_paint(&mut self) {
+        self.end_stroke();
+        if self.session.paint_layer.is_some() || self.session.paint.is_some() {
+            self.perform(Edit::PaintLayer(Box::new((None, None))), false);
         }
     }
 
@@ -221,33 +262,46 @@ impl EditorApp {
 /// V / Esc navigate, [ and ] radius, F radius and Shift+F strength by pointer distance.
 pub fn tool_keys(app: &mut EditorApp, ctx: &egui::Context, pointer: Option<egui::Pos2>) {
     use egui::Key;
-    let (b, v, esc, smaller, larger) = ctx.input(|i| {
-        (
-            i.key_pressed(Key::B),
-            i.key_pressed(Key::V),
-            i.key_pressed(Key::Escape),
-            i.key_pressed(Key::OpenBracket),
-            i.key_pressed(Key::CloseBracket),
-        )
-    });
-    // F with the modifiers it was pressed with (Shift may be released within the same frame).
-    let f = ctx.input(|i| {
-        i.events.iter().find_map(|e| match e {
-            egui::Event::Key {
-                key: Key::F,
-                pressed: true,
-                repeat: false,
-                modifiers,
-                ..
-            } => Some(modifiers.shift),
-            _ => None,
+    // Plain keys only (Ctrl+V pastes, Ctrl+B is not the brush); each with the modifiers it was
+    // pressed with (Shift may be released within the same frame).
+    let pressed = |key: Key, shift_ok: bool| {
+        ctx.input(|i| {
+            i.events.iter().find_map(|e| match e {
+                egui::Event::Key {
+                    key: k,
+                    pressed: true,
+                    repeat: false,
+                    modifiers,
+                    ..
+                } if *k == key
+                    && !modifiers.ctrl
+                    && !modifiers.alt
+                    && !modifiers.command
+                    && (shift_ok || !modifiers.shift) =>
+                {
+                    Some(modifiers.shift)
+                }
+                _ => None,
+            })
         })
-    });
+    };
+    let (b, v, esc) = (
+        pressed(Key::B, false).is_some(),
+        pressed(Key::V, false).is_some(),
+        pressed(Key::Escape, true).is_some(),
+    );
+    let smaller = pressed(Key::OpenBracket, false).is_some();
+    let larger = pressed(Key::CloseBracket, false).is_some();
+    let f = pressed(Key::F, true);
     let (f, shift) = (f.is_some(), f.unwrap_or(false));
     if b {
         app.tool = Tool::Brush;
     }
-    if (v || esc) && app.radius_drag.take().is_none() {
+    if esc && let Some(d) = app.radius_drag.take() {
+        // Esc cancels an adjustment.
+        (app.brush.radius_px, app.brush.strength) = d.before;
+    } else if v || esc {
+        app.radius_drag = None;
         app.end_stroke();
         app.tool = Tool::Navigate;
     }
@@ -267,9 +321,11 @@ pub fn tool_keys(app: &mut EditorApp, ctx: &egui::Context, pointer: Option<egui:
         } else {
             app.brush.radius_px
         };
+        app.end_stroke();
         app.radius_drag = Some(RadiusDrag {
             centre: p - egui::vec2(d, 0.0),
             strength: shift,
+            before: (app.brush.radius_px, app.brush.strength),
         });
     }
 }

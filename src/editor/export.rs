@@ -54,14 +54,25 @@ impl ExportJob {
             std::iter::once(exr.as_path()).chain(png.as_deref()),
         )
         .map_err(|e| e.to_string())?;
+        // A layer painted on another hair is left out, as the viewport leaves it out.
+        let mut session = session.clone();
+        let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
+        if session
+            .paint_layer
+            .as_ref()
+            .is_some_and(|l| !l.get().fits(points, strands))
+        {
+            session.paint_layer = None;
+            session.paint = None;
+        }
         let hair = LoadedHairSource {
             hair: (*live.hair).clone(),
             name: live.hair_name.clone(),
             warning: None,
         };
-        let scene = Scene::from_parts(session, hair, live.environment.clone(), None)
+        let scene = Scene::from_parts(&session, hair, live.environment.clone(), None)
             .map_err(|e| e.to_string())?;
-        Self::with_scene(live, luts, session, scene, exr, png, wake, tile)
+        Self::with_scene(live, luts, &session, scene, exr, png, wake, tile)
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -91,7 +91,7 @@ pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_
 /// Computes [`Prepared`] (off the UI thread).
 pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
     let base_sigma_a = base_absorption(&session.look, hair)?;
-    let (layer, warning) = paint_for(session, hair);
+    let (layer, warning) = paint_for(session, hair, &mut None);
     let sigma_a = painted(&base_sigma_a, layer.as_ref());
     let look = renderer_look(&session.look, mean_absorption(&sigma_a));
     let tables = build_tables(&look.params, None);
@@ -106,14 +106,28 @@ pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError
 
 /// The session's paint for this hair: the layer in memory, else its file. A layer made for another
 /// hair is left out with a warning (the session keeps it: undoing the hair change brings it back).
-pub fn paint_for(session: &Session, hair: &Hair) -> (Option<SharedLayer>, Option<String>) {
+pub fn paint_for(
+    session: &Session,
+    hair: &Hair,
+    file: &mut PaintFileCache,
+) -> (Option<SharedLayer>, Option<String>) {
     let (points, strands) = (hair.point_count(), hair.strand_count());
     let layer = match (&session.paint_layer, &session.paint) {
         (Some(l), _) => l.clone(),
-        (None, Some(path)) => match crate::paint::PaintLayer::read(path) {
-            Ok(l) => SharedLayer::new(l),
-            Err(e) => return (None, Some(format!("{e}; the hair is shown unpainted"))),
-        },
+        (None, Some(path)) => {
+            // Read once per file (a colour drag asks every frame).
+            if file.as_ref().is_none_or(|(p, _)| p != path) {
+                let read = crate::paint::PaintLayer::read(path)
+                    .map(SharedLayer::new)
+                    .map_err(|e| format!("{e}; the hair is shown unpainted"));
+                *file = Some((path.clone(), read));
+            }
+            match file.as_ref().map(|(_, r)| r.clone()) {
+                Some(Ok(l)) => l,
+                Some(Err(e)) => return (None, Some(e)),
+                None => return (None, None),
+            }
+        }
         (None, None) => return (None, None),
     };
     if layer.get().fits(points, strands) {
@@ -128,6 +142,9 @@ pub fn paint_for(session: &Session, hair: &Hair) -> (Option<SharedLayer>, Option
         (None, Some(text))
     }
 }
+
+/// The paint file last read for a session without a layer in memory, and what it gave.
+pub type PaintFileCache = Option<(std::path::PathBuf, Result<SharedLayer, String>)>;
 
 /// Each point's absorption: the base with the layer over it.
 pub fn painted(base: &[[f32; 3]], layer: Option<&SharedLayer>) -> Vec<[f32; 3]> {
@@ -184,8 +201,11 @@ pub struct LiveScene {
     /// Each point's absorption without paint, and with it (what the renderer has).
     pub base_sigma_a: Vec<[f32; 3]>,
     pub sigma_a: Vec<[f32; 3]>,
-    /// The session's paint could not be shown (reported once by the app).
+    /// The session's paint could not be shown (reported once by the app), the last such report, and
+    /// the paint file last read.
     pub paint_warning: Option<String>,
+    last_paint_warning: Option<String>,
+    paint_file: PaintFileCache,
     /// The brush's view of the hair (view depth read back, points projected).
     pub picking: super::picking::Picking,
     /// A dab changed the absorption while a preview was under way: the refinement restarts when
@@ -272,7 +292,9 @@ impl LiveScene {
             mean_sigma_a: look.params.sigma_a,
             base_sigma_a,
             sigma_a,
+            last_paint_warning: warning.clone(),
             paint_warning: warning,
+            paint_file: None,
             picking: Default::default(),
             paint_restart: false,
             thickness_scale: session.look.thickness_scale,
@@ -332,8 +354,12 @@ impl LiveScene {
                 if base_changed {
                     self.base_sigma_a = base_absorption(&session.look, &self.hair)?;
                 }
-                let (layer, warning) = paint_for(session, &self.hair);
-                self.paint_warning = warning;
+                let (layer, warning) = paint_for(session, &self.hair, &mut self.paint_file);
+                // Reported once, not once per frame of a colour drag.
+                if warning != self.last_paint_warning {
+                    self.paint_warning.clone_from(&warning);
+                    self.last_paint_warning = warning;
+                }
                 self.sigma_a = painted(&self.base_sigma_a, layer.as_ref());
                 // Shown at once; the volume and grid follow the first image (`step`).
                 self.renderer

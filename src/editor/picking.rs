@@ -81,10 +81,13 @@ impl LiveScene {
         let Some(layer) = &session.paint_layer else {
             return Ok(());
         };
-        let points = &layer.get().points;
-        if points.len() != self.sigma_a.len() {
+        if !layer
+            .get()
+            .fits(self.hair.point_count(), self.hair.strand_count())
+        {
             return Ok(());
         }
+        let points = &layer.get().points;
         for &i in changed {
             let i = i as usize;
             self.sigma_a[i] = effective(self.base_sigma_a[i], points[i]);

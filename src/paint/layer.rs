@@ -20,7 +20,7 @@ pub const MAGIC: &[u8; 8] = b"SLPAINT1";
 pub const VERSION: u32 = 1;
 const HEADER: usize = 32;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PaintLayer {
     pub strand_count: u64,
     /// (sigma_a RGB, weight) per point.
@@ -201,9 +201,23 @@ impl SharedLayer {
     }
 }
 
+/// Edits are data: a layer serialises as its plain values.
+impl serde::Serialize for SharedLayer {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.layer.serialize(s)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for SharedLayer {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        PaintLayer::deserialize(d).map(SharedLayer::new)
+    }
+}
+
 impl PartialEq for SharedLayer {
     fn eq(&self, other: &Self) -> bool {
         self.revision == other.revision
+            || Arc::ptr_eq(&self.layer, &other.layer)
             || (self.layer.strand_count == other.layer.strand_count
                 && bytemuck::cast_slice::<[f32; 4], u8>(&self.layer.points)
                     == bytemuck::cast_slice::<[f32; 4], u8>(&other.layer.points))

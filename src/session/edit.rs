@@ -3,8 +3,9 @@
 //! Camera moves are not edits (they are saved with the session but not undone).
 
 use super::model::{EnvironmentSource, HairSource, Look, RenderOptions, Session};
-use crate::paint::PaintDelta;
+use crate::paint::{PaintDelta, SharedLayer};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// One change of the session. Each carries the new value of what it changes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -20,6 +21,9 @@ pub enum Edit {
     /// A paint stroke's points and the layer values they take (applying swaps them with the
     /// layer's: the inverse holds the values they had).
     Paint(Box<PaintDelta>),
+    /// The whole paint layer and the file it is saved to (clearing it; undoing a stroke that made
+    /// the layer).
+    PaintLayer(Box<(Option<SharedLayer>, Option<PathBuf>)>),
 }
 
 /// What an edit touches: consecutive edits of the same kind during one gesture (a slider drag) merge
@@ -32,6 +36,7 @@ pub enum EditKind {
     Hair,
     Environment,
     Paint,
+    PaintLayer,
 }
 
 impl Edit {
@@ -43,6 +48,7 @@ impl Edit {
             Edit::Hair(_) => EditKind::Hair,
             Edit::Environment(_) => EditKind::Environment,
             Edit::Paint(_) => EditKind::Paint,
+            Edit::PaintLayer(_) => EditKind::PaintLayer,
         }
     }
 
@@ -55,6 +61,7 @@ impl Edit {
             Edit::Hair(_) => "hair",
             Edit::Environment(_) => "environment",
             Edit::Paint(_) => "paint stroke",
+            Edit::PaintLayer(_) => "paint layer",
         }
     }
 
@@ -63,6 +70,7 @@ impl Edit {
         std::mem::size_of::<Edit>()
             + match self {
                 Edit::Paint(d) => d.bytes(),
+                Edit::PaintLayer(l) => l.0.as_ref().map_or(0, |l| 16 * l.get().points.len()),
                 Edit::Look(_) => std::mem::size_of::<Look>(),
                 Edit::Environment(e) => match e.as_ref() {
                     EnvironmentSource::File {
@@ -94,6 +102,13 @@ pub fn apply(session: &mut Session, edit: Edit) -> Edit {
                 d.swap(&mut layer.make_mut().points);
             }
             Edit::Paint(d)
+        }
+        Edit::PaintLayer(l) => {
+            let (layer, path) = *l;
+            Edit::PaintLayer(Box::new((
+                std::mem::replace(&mut session.paint_layer, layer),
+                std::mem::replace(&mut session.paint, path),
+            )))
         }
     }
 }

@@ -212,7 +212,8 @@ mod tests {
         };
         let before = s.clone();
         // Three strokes of 100 points each; the budget holds two.
-        let mut h = History::with_budget(100, 2 * 100 * 20 + 100);
+        let step = 100 * 20 + std::mem::size_of::<Edit>();
+        let mut h = History::with_budget(100, 2 * step + 10);
         for k in 0..3u32 {
             let indices: Vec<u32> = (100 * k..100 * k + 100).collect();
             let layer = s.paint_layer.as_mut().unwrap().make_mut();
@@ -226,7 +227,7 @@ mod tests {
             assert_eq!(undo.bytes(), 100 * 20);
             h.record(Edit::Paint(Box::new(undo)));
         }
-        assert!(h.bytes() <= 2 * 100 * 20 + 100, "{}", h.bytes());
+        assert!(h.bytes() <= 2 * step + 10, "{}", h.bytes());
         let painted = s.clone();
         assert!(h.undo(&mut s).is_some() && h.undo(&mut s).is_some());
         assert!(h.undo(&mut s).is_none(), "the oldest stroke was dropped");
@@ -237,5 +238,30 @@ mod tests {
         h.redo(&mut s);
         assert!(s == painted, "redo restores the strokes bit for bit");
         assert!(s != before);
+    }
+
+    #[test]
+    fn clearing_the_paint_layer_is_one_step_that_undoes() {
+        use crate::paint::{PaintLayer, SharedLayer};
+        let mut layer = PaintLayer::empty(4, 1);
+        layer.points[2] = [1.0, 0.5, 0.25, 1.0];
+        let mut s = Session {
+            paint_layer: Some(SharedLayer::new(layer)),
+            paint: Some("look.slpaint".into()),
+            ..Default::default()
+        };
+        let painted = s.clone();
+        let mut h = History::default();
+        assert!(h.perform(&mut s, Edit::PaintLayer(Box::new((None, None))), false));
+        assert!(s.paint_layer.is_none() && s.paint.is_none());
+        assert!(h.bytes() >= 4 * 16, "the step holds the layer");
+        h.undo(&mut s);
+        assert!(s == painted);
+        h.redo(&mut s);
+        assert!(s.paint_layer.is_none());
+        // Edits are data: the layer serialises with them.
+        let e = Edit::PaintLayer(Box::new((painted.paint_layer.clone(), None)));
+        let back: Edit = serde_json::from_str(&serde_json::to_string(&e).unwrap()).unwrap();
+        assert_eq!(back, e);
     }
 }

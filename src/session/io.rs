@@ -113,15 +113,28 @@ impl Session {
     /// Saves the session to `path` with its paint layer in memory beside it (`path` with the
     /// extension `.slpaint`, which `paint` then names; both written atomically, the layer first).
     pub fn save(&mut self, path: &Path) -> Result<(), SessionError> {
-        if let Some(layer) = &self.paint_layer {
-            let file = path.with_extension("slpaint");
-            layer.get().write(&file).map_err(|e| SessionError::Io {
-                path: file.clone(),
-                message: format!("cannot write the paint layer: {e}"),
-            })?;
-            self.paint = Some(std::path::absolute(&file).unwrap_or(file));
+        let Some(layer) = &self.paint_layer else {
+            return self.write(path);
+        };
+        let file = path.with_extension("slpaint");
+        if file == path {
+            return Err(SessionError::Invalid {
+                path: path.into(),
+                message: "a session cannot be saved as .slpaint (the paint layer's name)".into(),
+            });
         }
-        self.write(path)
+        layer.get().write(&file).map_err(|e| SessionError::Io {
+            path: file.clone(),
+            message: format!("cannot write the paint layer: {e}"),
+        })?;
+        let before = self
+            .paint
+            .replace(std::path::absolute(&file).unwrap_or(file));
+        let written = self.write(path);
+        if written.is_err() {
+            self.paint = before;
+        }
+        written
     }
 
     /// Reads the paint file the session names into memory (the editor paints on it); the session is

@@ -124,7 +124,7 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
         });
     }
     ui.add(
-        egui::Slider::new(&mut b.radius_px, 2.0..=300.0)
+        egui::Slider::new(&mut b.radius_px, 2.0..=500.0)
             .text("radius")
             .suffix(" px"),
     )
@@ -179,6 +179,14 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
         .on_hover_text("Also paint the footprint mirrored across the hair's symmetry plane (even where that side is hidden)");
     ui.add(egui::Slider::new(&mut b.spacing, 0.05..=1.0).text("spacing"))
         .on_hover_text("Dab spacing along the stroke, as a fraction of the radius");
+    let painted = app.session.paint_layer.is_some() || app.session.paint.is_some();
+    if ui
+        .add_enabled(painted, egui::Button::new("Clear paint"))
+        .on_hover_text("Remove the paint layer: the hair shows the look alone (one undo step)")
+        .clicked()
+    {
+        app.clear_paint();
+    }
     let st = app.brush_stats;
     if st.dabs > 0 {
         ui.weak(format!(

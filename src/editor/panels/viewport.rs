@@ -84,7 +84,13 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
         );
         if ui.input(|i| i.pointer.any_pressed() || i.key_pressed(egui::Key::Enter)) {
             app.radius_drag = None;
+            // The click that confirms does not paint.
+            app.brush_idle_until_release = ui.input(|i| i.pointer.any_down());
         }
+        return;
+    }
+    if app.brush_idle_until_release {
+        app.brush_idle_until_release = ui.input(|i| i.pointer.any_down());
         return;
     }
     if let Some(p) = pointer {
