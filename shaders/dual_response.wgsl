@@ -1,46 +1,91 @@
 // Multiple scattering per SRBF light by dual scattering (Xu 2011 Sec. 4.3, Zinke 2008): twin of
 // src/scattering/dual_response.rs and of DualTables::lookup / mean_delta_sigma in dual_terms.rs.
 // Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response. The includer
-// binds `dual_tables`: DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample, RGB) followed by
-// (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b).
+// binds `dual_tables`: one row per sample of the absorption axis (DUAL_ROW vec4 each), a row holding
+// DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample; one absorption: component 0) followed
+// by (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b). Each channel reads the rows at
+// its own sigma_a (DualTables::lookup).
 
 const DUAL_SAMPLES: u32 = 128u;
+const DUAL_ROW: u32 = 4u * DUAL_SAMPLES + 2u * (DUAL_SAMPLES + 1u);
 const DUAL_GLOBAL: u32 = 0u;
 const DUAL_LOCAL: u32 = 1u;
+// The absorption axis (dual_terms.rs axis_sigma / axis_pos with DUAL_SIGMA_SAMPLES rows).
+const DUAL_SIGMA_SAMPLES: u32 = 65u;
+const DUAL_SIGMA_MIN: f32 = 0.005;
+const DUAL_SIGMA_MAX: f32 = 50.0;
 
 fn dual_position(theta: f32) -> f32 {
     return clamp((theta + FRAC_PI_2) / PI, 0.0, 1.0) * f32(DUAL_SAMPLES - 1u);
 }
 
-// DualTables::lookup, term k (0 = A_b, 1 = Delta_b, 2 = sigma_b, 3 = a_f).
-fn dual_lookup(k: u32, theta: f32) -> vec3<f32> {
+// sigma_cell: the axis row below sigma_a and the weight of the one above.
+struct DualCell {
+    row: u32,
+    w: f32,
+}
+
+fn dual_sigma_cell(s: f32) -> DualCell {
+    var y = max(s / DUAL_SIGMA_MIN, 0.0);
+    if (s > DUAL_SIGMA_MIN) {
+        y = 1.0 + log(s / DUAL_SIGMA_MIN) / log(DUAL_SIGMA_MAX / DUAL_SIGMA_MIN) * f32(DUAL_SIGMA_SAMPLES - 2u);
+    }
+    y = clamp(y, 0.0, f32(DUAL_SIGMA_SAMPLES - 1u));
+    let j = min(u32(y), DUAL_SIGMA_SAMPLES - 2u);
+    return DualCell(j, y - f32(j));
+}
+
+// DualRow::lookup of one row, term k (0 = A_b, 1 = Delta_b, 2 = sigma_b, 3 = a_f).
+fn dual_row_lookup(row: u32, k: u32, theta: f32) -> f32 {
     let x = dual_position(theta);
     let i = min(u32(x), DUAL_SAMPLES - 2u);
     let w = x - f32(i);
-    return mix(dual_tables[4u * i + k].xyz, dual_tables[4u * (i + 1u) + k].xyz, w);
+    let base = row * DUAL_ROW;
+    return mix(dual_tables[base + 4u * i + k].x, dual_tables[base + 4u * (i + 1u) + k].x, w);
 }
 
-fn dual_sat(k: u32, x: f32) -> vec3<f32> {
+// geometric_mix (dual_terms.rs): A_b and a_f fall off about exponentially with the absorption.
+fn geometric_mix(a: f32, b: f32, w: f32) -> f32 {
+    if (a > 0.0 && b > 0.0) {
+        return exp(mix(log(a), log(b), w));
+    }
+    return mix(a, b, w);
+}
+
+// DualTables::lookup, term k, at theta and absorption sigma_a (one channel): geometric between the
+// axis' rows for A_b and a_f, linear for the angles.
+fn dual_lookup(k: u32, theta: f32, sigma_a: f32) -> f32 {
+    let c = dual_sigma_cell(sigma_a);
+    let a = dual_row_lookup(c.row, k, theta);
+    let b = dual_row_lookup(c.row + 1u, k, theta);
+    if (k == 0u || k == 3u) {
+        return geometric_mix(a, b, c.w);
+    }
+    return mix(a, b, c.w);
+}
+
+fn dual_sat(row: u32, k: u32, x: f32) -> f32 {
     let i = min(u32(x), DUAL_SAMPLES - 1u);
     let w = x - f32(i);
-    let base = 4u * DUAL_SAMPLES;
-    return mix(dual_tables[base + 2u * i + k].xyz, dual_tables[base + 2u * (i + 1u) + k].xyz, w);
+    let base = row * DUAL_ROW + 4u * DUAL_SAMPLES;
+    return mix(dual_tables[base + 2u * i + k].x, dual_tables[base + 2u * (i + 1u) + k].x, w);
 }
 
-struct DeltaSigma {
-    delta: vec3<f32>,
-    sigma: vec3<f32>,
-}
-
-// DualTables::mean_delta_sigma: means of Delta_b and sigma_b over theta in [lo, hi] (Xu Eq. 31).
-fn mean_delta_sigma(lo: f32, hi: f32) -> DeltaSigma {
+// DualRow::mean_delta_sigma of one row: means of Delta_b and sigma_b over theta in [lo, hi] (Xu Eq. 31).
+fn dual_row_mean(row: u32, lo: f32, hi: f32) -> vec2<f32> {
     let a = dual_position(min(lo, hi)) + 0.5;
     let b = dual_position(max(lo, hi)) + 0.5;
     if (b - a < 1e-4) {
         let t = 0.5 * (lo + hi);
-        return DeltaSigma(dual_lookup(1u, t), dual_lookup(2u, t));
+        return vec2<f32>(dual_row_lookup(row, 1u, t), dual_row_lookup(row, 2u, t));
     }
-    return DeltaSigma((dual_sat(0u, b) - dual_sat(0u, a)) / (b - a), (dual_sat(1u, b) - dual_sat(1u, a)) / (b - a));
+    return vec2<f32>(dual_sat(row, 0u, b) - dual_sat(row, 0u, a), dual_sat(row, 1u, b) - dual_sat(row, 1u, a)) / (b - a);
+}
+
+// DualTables::mean_delta_sigma for one channel of absorption sigma_a: (Delta_b, sigma_b).
+fn mean_delta_sigma(lo: f32, hi: f32, sigma_a: f32) -> vec2<f32> {
+    let c = dual_sigma_cell(sigma_a);
+    return mix(dual_row_mean(c.row, lo, hi), dual_row_mean(c.row + 1u, lo, hi), c.w);
 }
 
 // Standard deviation of the forward-scattered light's longitudinal spread.
@@ -79,7 +124,8 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_table_box(d.lobe, p.sigma_a.xyz, theta_d, d.dphi);
     }
-    let a = dual_lookup(0u, theta_d)[d.channel] * backscatter_depth_fraction(dual_lookup(3u, theta_d)[d.channel], d.depth_behind);
+    let s = p.sigma_a[d.channel];
+    let a = dual_lookup(0u, theta_d, s) * backscatter_depth_fraction(dual_lookup(3u, theta_d, s), d.depth_behind);
     return vec3<f32>(w * a);
 }
 
@@ -135,12 +181,15 @@ fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
 fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32, depth_behind: f32) -> vec3<f32> {
     let sigma = forward_spread(sigma_f2, light.lambda);
     let azimuthal = (PI - abs(wrap_angle(light.phi - phi_o))) / (PI * PI);
-    let ds = mean_delta_sigma(0.5 * (theta_o - (light.theta + sigma)), 0.5 * (theta_o - (light.theta - sigma)));
+    let lo = 0.5 * (theta_o - (light.theta + sigma));
+    let hi = 0.5 * (theta_o - (light.theta - sigma));
     var out = vec3<f32>(0.0);
     for (var c = 0u; c < 3u; c++) {
-        let sb = max(ds.sigma[c], 1e-3);
+        // Each channel at the point's own absorption.
+        let ds = mean_delta_sigma(lo, hi, p.sigma_a[c]);
+        let sb = max(ds.y, 1e-3);
         // Zinke's back lobe as M with tilt Delta_b / 2 and width sigma_b / 2 (dual_response.rs).
-        let back = longitudinal_lobe(p.longitudinal, theta_o, 0.5 * ds.delta[c], 0.5 * sb);
+        let back = longitudinal_lobe(p.longitudinal, theta_o, 0.5 * ds.x, 0.5 * sb);
         let g = gaussian_product(light.theta, SQRT_2 * sigma, back.mu, SQRT_2 * sb);
         let k = azimuthal * g.x / (2.0 * PI * sigma * sb * max(cos(light.theta), 1e-3));
         if (k < 1e-30) {

@@ -1,9 +1,11 @@
 //! Dual-scattering fiber terms against brute force (Zinke 2008 Eq. 6, 11-17; Xu 2011 Eq. 32-33).
 
+mod common;
+
 use std::f64::consts::{FRAC_PI_2, PI};
 use strandlight::scattering::dual_terms::{
-    DualTables, HairBehind, backscatter_attenuation, backscatter_depth_fraction, backscatter_shift,
-    backscatter_width, dual_sample, dual_theta,
+    DualRow, DualTables, HairBehind, backscatter_attenuation, backscatter_depth_fraction,
+    backscatter_shift, backscatter_width, dual_sample, dual_theta,
 };
 use strandlight::scattering::marschner::{
     AzimuthalLobe, azimuthal_n_p, deon_variance, ln_longitudinal_deon, longitudinal_m_p,
@@ -228,7 +230,7 @@ fn backscatter_depth_fraction_equals_the_truncated_sums() {
 #[test]
 fn tables_interpolate_and_their_sats_average() {
     let p = HairParams::with_sigma_a([0.3, 0.6, 1.2]);
-    let t = DualTables::build(&p, XU_ROOTS);
+    let t = DualRow::build(&p, XU_ROOTS);
     // Lookup at a sample returns the sample.
     let s = t.lookup(dual_theta(40) as f32);
     assert!((s.a_f[1] - t.samples[40].a_f[1]).abs() < 1e-5);
@@ -275,6 +277,9 @@ fn global_and_local_terms_against_direct_quadrature() {
     use strandlight::scattering::marschner::longitudinal_m_p_normalized;
     let p = HairParams::with_sigma_a([0.2, 0.5, 1.0]);
     let tables = DualTables::build(&p, XU_ROOTS);
+    // The direct integrand reads the terms at the exact absorption (the fast path interpolates the
+    // absorption axis).
+    let exact = DualRow::build(&p, XU_ROOTS);
     let azimuthal = strandlight::scattering::azimuthal_table::AzimuthalTable::for_params(
         &FastHairParams::new(&p, 4),
     );
@@ -370,7 +375,7 @@ fn global_and_local_terms_against_direct_quadrature() {
             let azim = (PI - dphi.abs()) / (PI * PI);
             let fl = |ti: f64| {
                 let td = 0.5 * (theta_o - ti);
-                let s = tables.lookup(td as f32);
+                let s = exact.lookup(td as f32);
                 let sb = s.sigma_b[ch] as f64;
                 let delta_b = s.delta_b[ch] as f64;
                 // Zinke's back lobe: published 2 g(theta_i + theta_o - Delta_b; sigma_b) cos^2/cos^2(theta_d);
@@ -396,4 +401,41 @@ fn global_and_local_terms_against_direct_quadrature() {
     println!("worst: global {worst_g:.2e}, local {worst_l:.2e}");
     assert!(worst_g < 0.02, "global {worst_g}");
     assert!(worst_l < 0.1, "local {worst_l}");
+}
+
+#[test]
+fn the_absorption_axis_interpolates_the_exact_terms() {
+    let base = HairParams::default();
+    let t = DualTables::build(&base, XU_ROOTS);
+    let mut rng = common::Uniform::new(7);
+    let mut errors: [Vec<f64>; 4] = Default::default();
+    for _ in 0..400 {
+        let sigma = (rng.random_range(0.0..1.0) * (8.0f32 / 0.01).ln()).exp() * 0.01;
+        let theta = rng.random_range(-1.4..1.4);
+        let got = t.lookup(theta, [sigma; 3]);
+        let p = HairParams {
+            sigma_a: [sigma as f64; 3],
+            ..base
+        };
+        // The exact terms at theta, interpolated along theta as the table does.
+        let row = DualRow::build(&p, XU_ROOTS);
+        let want = row.lookup(theta);
+        let rel = |a: f32, b: f32, scale: f32| ((a - b).abs() / scale.max(1e-6)) as f64;
+        errors[0].push(rel(got.big_a_b[0], want.big_a_b[0], want.big_a_b[0]));
+        errors[1].push(rel(got.a_f[0], want.a_f[0], want.a_f[0]));
+        // Shifts and widths are angles: relative to the lobe's width.
+        errors[2].push(rel(got.delta_b[0], want.delta_b[0], want.sigma_b[0]));
+        errors[3].push(rel(got.sigma_b[0], want.sigma_b[0], want.sigma_b[0]));
+    }
+    for (name, e) in ["A_b", "a_f", "Delta_b", "sigma_b"]
+        .iter()
+        .zip(errors.iter_mut())
+    {
+        e.sort_by(f64::total_cmp);
+        let (median, p95, max) = (e[e.len() / 2], e[e.len() * 95 / 100], e[e.len() - 1]);
+        println!(
+            "{name}: absorption axis against the exact absorption: median {median:.2e}, p95 {p95:.2e}, max {max:.2e}"
+        );
+        assert!(p95 < 0.01 && max < 0.02, "{name}: p95 {p95}, max {max}");
+    }
 }

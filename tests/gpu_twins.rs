@@ -446,11 +446,15 @@ fn wgsl_dual_scattering_responses_equal_the_rust_twins() {
         let azimuthal_buffer = upload_azimuthal_table(&ctx.device, &azimuthal);
         let mut qs = queries(256);
         for (i, q) in qs.iter_mut().enumerate() {
+            // Each query at its own absorption (0.05-2: the tables' absorption axis), the preset's
+            // other parameters.
+            let sigma_a = q.params.sigma_a;
             q.params = if i % 5 == 0 {
                 fast.with_longitudinal(LongitudinalModel::Published)
             } else {
                 fast
             };
+            q.params.sigma_a = sigma_a;
             q._pad[0] = 0.02 * ((i * 7 + k) % 11) as f32; // sigma_f^2 in 0..0.2 rad^2
             // Optical depth behind the point: none, thin, a few fibers, Zinke's unbounded hair.
             q._pad[1] = [0.0, 0.3, 1.0, 3.0, 1e30][(i * 3 + k) % 5];

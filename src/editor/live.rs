@@ -430,7 +430,7 @@ impl LiveScene {
         let held_fits = self
             .held_tables
             .as_ref()
-            .is_some_and(|(p, _)| *p == look.params);
+            .is_some_and(|(p, _)| crate::render::renderer::same_tables(p, &look.params));
         if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
             let params = look.params;
             // The azimuthal table of the held tables when it fits (an eta change in the works),

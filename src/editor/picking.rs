@@ -9,7 +9,7 @@ use crate::paint::brush::effective;
 use crate::paint::pick::{Picker, ViewDepth};
 use crate::render::camera::CameraUniform;
 use crate::session::Session;
-use crate::session::assemble::{mean_absorption, renderer_look};
+use crate::session::assemble::mean_absorption;
 use std::sync::Arc;
 
 #[derive(Default)]
@@ -104,15 +104,11 @@ impl LiveScene {
         Ok(())
     }
 
-    /// The stroke ended: the dual-scattering tables follow the points' new mean absorption (built
-    /// off the UI thread as for a look change).
-    pub fn paint_finished(&mut self, session: &Session) -> Result<(), LiveError> {
-        let mean = mean_absorption(&self.sigma_a);
-        if mean != self.mean_sigma_a {
-            self.mean_sigma_a = mean;
-            let look = renderer_look(&session.look, mean);
-            self.set_look_deferred(look);
-        }
+    /// The stroke ended. Nothing more to send: the volume and shadow grid follow the dabs by
+    /// themselves (a deferred rebuild once the image shows), and every table reads each point's own
+    /// absorption, so the points' mean (kept for the look's uniform) changes no table.
+    pub fn paint_finished(&mut self, _session: &Session) -> Result<(), LiveError> {
+        self.mean_sigma_a = mean_absorption(&self.sigma_a);
         Ok(())
     }
 }

@@ -5,24 +5,31 @@
 use super::context::{GpuContext, compute_pipeline};
 use super::fast_eval::FastQuery;
 use super::shaders;
-use crate::scattering::dual_terms::DualTables;
+use crate::scattering::dual_terms::{DUAL_SAMPLES, DualTables};
 use wgpu::util::DeviceExt;
 
-/// A_b, Delta_b, sigma_b, a_f per sample (4 vec4), then the prefix sums of Delta_b and sigma_b (2 vec4 per
-/// entry), as `dual_response.wgsl` reads them.
+/// Per row of the absorption axis ([`DUAL_ROW`] vec4): A_b, Delta_b, sigma_b, a_f per sample (4 vec4),
+/// then the prefix sums of Delta_b and sigma_b (2 vec4 per entry), as `dual_response.wgsl` reads them.
+/// A row's channels are equal (one absorption); the shader reads component 0.
 pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
     let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
-    let mut out: Vec<[f32; 4]> = t
-        .samples
-        .iter()
-        .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b), v4(s.a_f)])
-        .collect();
-    for (d, s) in t.sat_delta.iter().zip(&t.sat_sigma) {
-        out.push(v4(*d));
-        out.push(v4(*s));
+    let mut out = Vec::with_capacity(t.rows.len() * DUAL_ROW);
+    for row in &t.rows {
+        out.extend(
+            row.samples
+                .iter()
+                .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b), v4(s.a_f)]),
+        );
+        for (d, s) in row.sat_delta.iter().zip(&row.sat_sigma) {
+            out.push(v4(*d));
+            out.push(v4(*s));
+        }
     }
     out
 }
+
+/// vec4 per row of the absorption axis in the dual tables' buffer.
+pub const DUAL_ROW: usize = 4 * DUAL_SAMPLES + 2 * (DUAL_SAMPLES + 1);
 
 pub fn upload_dual_tables(device: &wgpu::Device, t: &DualTables) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

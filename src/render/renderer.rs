@@ -103,13 +103,23 @@ impl HairLook {
 }
 
 /// The tables that depend on hair parameters and are built on the CPU: the forward table (eta, alpha,
-/// beta; read per crossed fiber's absorption), the dual-scattering tables (all parameters) and the
-/// azimuthal table of the exact window integrals (eta and eccentricity; read per point's absorption).
+/// beta; read per crossed fiber's absorption), the dual-scattering tables (all parameters but the
+/// absorption, which is their second axis: read per point's) and the azimuthal table of the exact
+/// window integrals (eta and eccentricity; read per point's absorption).
 /// The editor builds them on a worker thread ([`Renderer::set_params_deferred`], [`Renderer::set_tables`]).
 pub struct ParamTables {
     pub forward: ForwardTable,
     pub dual: DualTables,
     pub azimuthal: Arc<AzimuthalTable>,
+}
+
+/// Whether tables built for `a` serve `b`: every table reads each point's absorption on its own
+/// axis, so only the other parameters matter (a melanin, dye or paint change needs no rebuild).
+pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
+    HairParams {
+        sigma_a: b.sigma_a,
+        ..*a
+    } == *b
 }
 
 /// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same.
@@ -495,7 +505,7 @@ impl Renderer {
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
         self.look = *look;
-        if look.params != self.tables_for {
+        if !same_tables(&look.params, &self.tables_for) {
             let tables = build_tables(&look.params, Some(&self.azimuthal));
             self.set_tables(ctx, &look.params, &tables);
         }
@@ -528,7 +538,7 @@ impl Renderer {
     /// tables, and a new eta or eccentricity waits for its azimuthal table (the frame keeps the old
     /// index: `write_params`).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
-        let tables_needed = look.params != self.tables_for;
+        let tables_needed = !same_tables(&look.params, &self.tables_for);
         self.look = *look;
         self.write_params(ctx);
         self.restart_refinement();
@@ -560,7 +570,7 @@ impl Renderer {
         params: &HairParams,
         tables: &ParamTables,
     ) -> bool {
-        if *params != self.look.params {
+        if !same_tables(params, &self.look.params) {
             return false;
         }
         ctx.queue.write_buffer(

@@ -115,7 +115,9 @@ pub fn local_response_behind(
     let azimuthal = (PI - wrap_angle_f32(light.phi - phi_o).abs()) / (PI * PI);
     let lo = 0.5 * (theta_o - (light.theta + sigma));
     let hi = 0.5 * (theta_o - (light.theta - sigma));
-    let (delta, sig_b) = tables.mean_delta_sigma(lo, hi);
+    // Each channel at the point's own absorption (a painted strand's, not the hair's mean).
+    let sigma_a = p.sigma_a_rgb();
+    let (delta, sig_b) = tables.mean_delta_sigma(lo, hi, sigma_a);
     let mut out = [0.0; 3];
     for c in 0..3 {
         let sb = sig_b[c].max(1e-3);
@@ -130,8 +132,8 @@ pub fn local_response_behind(
         }
         let v = linear_quadrature(p.quadrature_segments, mu, l, |ti| {
             let theta_d = 0.5 * (theta_o - ti);
-            let t = tables.lookup(theta_d);
-            let a = t.big_a_b[c] * behind.fraction(t.a_f[c]);
+            let (big_a_b, a_f) = tables.backscatter_at(theta_d, sigma_a[c]);
+            let a = big_a_b * behind.fraction(a_f);
             [a * back.factor(ti); 3]
         });
         out[c] = (k * v[0]).max(0.0);

@@ -206,9 +206,10 @@ pub fn dual_sample(params: &HairParams, variant: ModelVariant, theta: f64) -> Du
     s
 }
 
-/// The 1D tables over theta with summed-area tables of Delta_b and sigma_b (Xu Sec. 4.3.2).
+/// The 1D tables over theta for one absorption, with summed-area tables of Delta_b and sigma_b (Xu
+/// Sec. 4.3.2): one row of [`DualTables`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct DualTables {
+pub struct DualRow {
     pub samples: Vec<DualSample>,
     /// sat_delta[i][c] = sum_{k < i} delta_b[k][c] (DUAL_SAMPLES + 1 entries).
     pub sat_delta: Vec<[f32; 3]>,
@@ -220,8 +221,8 @@ pub fn dual_theta(i: usize) -> f64 {
     -FRAC_PI_2 + PI * i as f64 / (DUAL_SAMPLES - 1) as f64
 }
 
-impl DualTables {
-    /// Builds the tables (rayon; a few ms on two cores).
+impl DualRow {
+    /// Builds the row for `params` as they are, absorption included (rayon; a few ms on two cores).
     pub fn build(params: &HairParams, variant: ModelVariant) -> Self {
         use rayon::prelude::*;
         let samples: Vec<DualSample> = (0..DUAL_SAMPLES)
@@ -294,5 +295,134 @@ impl DualTables {
             std::array::from_fn(|c| (v[c] - u[c]) / (b - a))
         };
         (mean(&self.sat_delta), mean(&self.sat_sigma))
+    }
+}
+
+/// The absorption axis of the tables that each point reads at its own sigma_a (the forward table, the
+/// dual-scattering tables): 0, then SIGMA_SAMPLES - 1 values log-spaced over [SIGMA_MIN, SIGMA_MAX]
+/// (per unit fibre radius). `shaders/forward_scattering.wgsl` and `dual_response.wgsl` read the same.
+pub const SIGMA_SAMPLES: usize = 33;
+pub const SIGMA_MIN: f32 = 0.005;
+pub const SIGMA_MAX: f32 = 50.0;
+
+/// sigma_a of axis sample j of `n` (0, then n - 1 log-spaced over [SIGMA_MIN, SIGMA_MAX]).
+pub fn axis_sigma(j: usize, n: usize) -> f32 {
+    if j == 0 {
+        0.0
+    } else {
+        SIGMA_MIN * (SIGMA_MAX / SIGMA_MIN).powf((j - 1) as f32 / (n - 2) as f32)
+    }
+}
+
+/// Continuous index of sigma_a on an axis of `n` samples (linear between 0 and SIGMA_MIN,
+/// logarithmic above).
+pub fn axis_pos(s: f32, n: usize) -> f32 {
+    if s <= SIGMA_MIN {
+        (s / SIGMA_MIN).max(0.0)
+    } else {
+        1.0 + (s / SIGMA_MIN).ln() / (SIGMA_MAX / SIGMA_MIN).ln() * (n - 2) as f32
+    }
+}
+
+/// sigma_a of sample j of the forward table's axis.
+pub fn sigma_at(j: usize) -> f32 {
+    axis_sigma(j, SIGMA_SAMPLES)
+}
+
+/// Continuous index on the forward table's axis.
+pub fn sigma_pos(s: f32) -> f32 {
+    axis_pos(s, SIGMA_SAMPLES)
+}
+
+/// Rows of the dual-scattering tables' absorption axis: A_b falls off fast with the absorption, so
+/// its axis is twice as fine as the forward table's (same range).
+pub const DUAL_SIGMA_SAMPLES: usize = 65;
+
+/// The dual tables' axis cell of sigma_a: the lower row and the weight of the one above (clamped).
+pub fn sigma_cell(s: f32) -> (usize, f32) {
+    let n = DUAL_SIGMA_SAMPLES;
+    let y = axis_pos(s, n).clamp(0.0, (n - 1) as f32);
+    let j = (y as usize).min(n - 2);
+    (j, y - j as f32)
+}
+
+/// Interpolation between two rows of the absorption axis for a term that falls off about
+/// exponentially with the absorption (A_b, a_f): geometric, which linear interpolation overstates by up
+/// to 16 % between the axis' samples (linear where either is 0).
+pub fn geometric_mix(a: f32, b: f32, w: f32) -> f32 {
+    if a > 0.0 && b > 0.0 {
+        (a.ln() + w * (b.ln() - a.ln())).exp()
+    } else {
+        a + w * (b - a)
+    }
+}
+
+/// The dual-scattering tables over (theta, sigma_a): one [`DualRow`] per absorption of the axis, so that
+/// each point's local multiple scattering reads its own absorption (a painted strand's, not the hair's
+/// mean) and an absorption change needs no rebuild. Each channel reads the rows at its own sigma_a.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DualTables {
+    pub rows: Vec<DualRow>,
+}
+
+impl DualTables {
+    /// Builds every row for the other parameters of `params` (its sigma_a is not used).
+    pub fn build(params: &HairParams, variant: ModelVariant) -> Self {
+        use rayon::prelude::*;
+        let rows = (0..DUAL_SIGMA_SAMPLES)
+            .into_par_iter()
+            .map(|j| {
+                let mut p = *params;
+                p.sigma_a = [axis_sigma(j, DUAL_SIGMA_SAMPLES) as f64; 3];
+                DualRow::build(&p, variant)
+            })
+            .collect();
+        Self { rows }
+    }
+
+    /// The terms at theta, channel c read at absorption sigma_a[c] (bilinear in theta and the axis).
+    pub fn lookup(&self, theta: f32, sigma_a: [f32; 3]) -> DualSample {
+        let mut out = DualSample::default();
+        for (c, s) in sigma_a.iter().enumerate() {
+            let (j, w) = sigma_cell(*s);
+            let (a, b) = (self.rows[j].lookup(theta), self.rows[j + 1].lookup(theta));
+            let mix = |u: [f32; 3], v: [f32; 3]| u[0] + w * (v[0] - u[0]);
+            let geo = |u: [f32; 3], v: [f32; 3]| geometric_mix(u[0], v[0], w);
+            out.a_f[c] = geo(a.a_f, b.a_f);
+            out.a_b[c] = mix(a.a_b, b.a_b);
+            out.alpha_f[c] = mix(a.alpha_f, b.alpha_f);
+            out.alpha_b[c] = mix(a.alpha_b, b.alpha_b);
+            out.beta_f2[c] = mix(a.beta_f2, b.beta_f2);
+            out.beta_b2[c] = mix(a.beta_b2, b.beta_b2);
+            out.big_a_b[c] = geo(a.big_a_b, b.big_a_b);
+            out.delta_b[c] = mix(a.delta_b, b.delta_b);
+            out.sigma_b[c] = mix(a.sigma_b, b.sigma_b);
+        }
+        out
+    }
+
+    /// A_b and a_f at theta for one channel of absorption sigma_a (what M^L's integrand reads).
+    pub fn backscatter_at(&self, theta: f32, sigma_a: f32) -> (f32, f32) {
+        let (j, w) = sigma_cell(sigma_a);
+        let (a, b) = (self.rows[j].lookup(theta), self.rows[j + 1].lookup(theta));
+        (
+            geometric_mix(a.big_a_b[0], b.big_a_b[0], w),
+            geometric_mix(a.a_f[0], b.a_f[0], w),
+        )
+    }
+
+    /// [`DualRow::mean_delta_sigma`], channel c at absorption sigma_a[c].
+    pub fn mean_delta_sigma(&self, lo: f32, hi: f32, sigma_a: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        let (mut delta, mut sigma) = ([0.0; 3], [0.0; 3]);
+        for (c, s) in sigma_a.iter().enumerate() {
+            let (j, w) = sigma_cell(*s);
+            let (a, b) = (
+                self.rows[j].mean_delta_sigma(lo, hi),
+                self.rows[j + 1].mean_delta_sigma(lo, hi),
+            );
+            delta[c] = a.0[0] + w * (b.0[0] - a.0[0]);
+            sigma[c] = a.1[0] + w * (b.1[0] - a.1[0]);
+        }
+        (delta, sigma)
     }
 }

@@ -40,27 +40,7 @@ pub struct ForwardTable {
 }
 
 pub const THETA_SAMPLES: usize = 64;
-/// sigma_a samples: 0, then SIGMA_SAMPLES - 1 log-spaced over [SIGMA_MIN, SIGMA_MAX].
-pub const SIGMA_SAMPLES: usize = 33;
-pub const SIGMA_MIN: f32 = 0.005;
-pub const SIGMA_MAX: f32 = 50.0;
-
-fn sigma_at(j: usize) -> f32 {
-    if j == 0 {
-        0.0
-    } else {
-        SIGMA_MIN * (SIGMA_MAX / SIGMA_MIN).powf((j - 1) as f32 / (SIGMA_SAMPLES - 2) as f32)
-    }
-}
-
-/// Continuous sigma_a index (piecewise: linear between 0 and SIGMA_MIN, logarithmic above).
-fn sigma_pos(s: f32) -> f32 {
-    if s <= SIGMA_MIN {
-        (s / SIGMA_MIN).max(0.0)
-    } else {
-        1.0 + (s / SIGMA_MIN).ln() / (SIGMA_MAX / SIGMA_MIN).ln() * (SIGMA_SAMPLES - 2) as f32
-    }
-}
+pub use crate::scattering::dual_terms::{SIGMA_MAX, SIGMA_MIN, SIGMA_SAMPLES, sigma_at, sigma_pos};
 
 impl ForwardTable {
     pub fn build(params: &HairParams, variant: ModelVariant) -> Self {
