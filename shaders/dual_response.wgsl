@@ -52,10 +52,9 @@ fn geometric_mix(a: f32, b: f32, w: f32) -> f32 {
     return mix(a, b, w);
 }
 
-// DualTables::lookup, term k, at theta and absorption sigma_a (one channel): geometric between the
-// axis' rows for A_b and a_f, linear for the angles.
-fn dual_lookup(k: u32, theta: f32, sigma_a: f32) -> f32 {
-    let c = dual_sigma_cell(sigma_a);
+// DualTables::lookup, term k, at theta and the axis cell of one channel's absorption: geometric
+// between the axis' rows for A_b and a_f, linear for the angles.
+fn dual_lookup(k: u32, theta: f32, c: DualCell) -> f32 {
     let a = dual_row_lookup(c.row, k, theta);
     let b = dual_row_lookup(c.row + 1u, k, theta);
     if (k == 0u || k == 3u) {
@@ -82,9 +81,8 @@ fn dual_row_mean(row: u32, lo: f32, hi: f32) -> vec2<f32> {
     return vec2<f32>(dual_sat(row, 0u, b) - dual_sat(row, 0u, a), dual_sat(row, 1u, b) - dual_sat(row, 1u, a)) / (b - a);
 }
 
-// DualTables::mean_delta_sigma for one channel of absorption sigma_a: (Delta_b, sigma_b).
-fn mean_delta_sigma(lo: f32, hi: f32, sigma_a: f32) -> vec2<f32> {
-    let c = dual_sigma_cell(sigma_a);
+// DualTables::mean_delta_sigma for one channel, at the axis cell of its absorption: (Delta_b, sigma_b).
+fn mean_delta_sigma(lo: f32, hi: f32, c: DualCell) -> vec2<f32> {
     return mix(dual_row_mean(c.row, lo, hi), dual_row_mean(c.row + 1u, lo, hi), c.w);
 }
 
@@ -103,6 +101,8 @@ struct DualIntegrand {
     longitudinal: LongitudinalLobe,
     // Optical depth of the hair behind the point (local term).
     depth_behind: f32,
+    // The absorption axis cell of the channel's sigma_a (local term).
+    cell: DualCell,
 }
 
 // Optical depth that stands for Zinke's unbounded hair behind the point.
@@ -124,8 +124,7 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_table_box(d.lobe, p.sigma_a.xyz, theta_d, d.dphi);
     }
-    let s = p.sigma_a[d.channel];
-    let a = dual_lookup(0u, theta_d, s) * backscatter_depth_fraction(dual_lookup(3u, theta_d, s), d.depth_behind);
+    let a = dual_lookup(0u, theta_d, d.cell) * backscatter_depth_fraction(dual_lookup(3u, theta_d, d.cell), d.depth_behind);
     return vec3<f32>(w * a);
 }
 
@@ -172,7 +171,7 @@ fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
     if (c < 1e-30) {
         return vec3<f32>(0.0);
     }
-    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, longitudinal, 0.0);
+    let d = DualIntegrand(DUAL_GLOBAL, lobe, 0u, theta_o, phi_o - light.phi, longitudinal, 0.0, DualCell(0u, 0.0));
     return max(c * dual_quadrature(p, d, g.y, g.z), vec3<f32>(0.0));
 }
 
@@ -185,8 +184,9 @@ fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f3
     let hi = 0.5 * (theta_o - (light.theta - sigma));
     var out = vec3<f32>(0.0);
     for (var c = 0u; c < 3u; c++) {
-        // Each channel at the point's own absorption.
-        let ds = mean_delta_sigma(lo, hi, p.sigma_a[c]);
+        // Each channel at the point's own absorption (its axis cell found once).
+        let cell = dual_sigma_cell(p.sigma_a[c]);
+        let ds = mean_delta_sigma(lo, hi, cell);
         let sb = max(ds.y, 1e-3);
         // Zinke's back lobe as M with tilt Delta_b / 2 and width sigma_b / 2 (dual_response.rs).
         let back = longitudinal_lobe(p.longitudinal, theta_o, 0.5 * ds.x, 0.5 * sb);
@@ -195,7 +195,7 @@ fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f3
         if (k < 1e-30) {
             continue;
         }
-        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, back, depth_behind);
+        let d = DualIntegrand(DUAL_LOCAL, 0u, c, theta_o, 0.0, back, depth_behind, cell);
         out[c] = max(k * dual_quadrature(p, d, g.y, g.z).x, 0.0);
     }
     return out;

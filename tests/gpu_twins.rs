@@ -455,6 +455,10 @@ fn wgsl_dual_scattering_responses_equal_the_rust_twins() {
                 fast
             };
             q.params.sigma_a = sigma_a;
+            // The axis' ends and its linear start: 0, inside (0, SIGMA_MIN], and past SIGMA_MAX.
+            if i % 11 == 3 {
+                q.params.sigma_a[i % 3] = [0.0, 0.003, 0.005, 80.0][(i / 11) % 4];
+            }
             q._pad[0] = 0.02 * ((i * 7 + k) % 11) as f32; // sigma_f^2 in 0..0.2 rad^2
             // Optical depth behind the point: none, thin, a few fibers, Zinke's unbounded hair.
             q._pad[1] = [0.0, 0.3, 1.0, 3.0, 1e30][(i * 3 + k) % 5];

@@ -677,6 +677,7 @@ impl EditorApp {
 
     /// Frames the hair (Home).
     pub fn frame_hair(&mut self) {
+        self.end_stroke();
         self.session.camera.target = None;
         self.session.camera.distance = None;
         if let Some(live) = &self.live {

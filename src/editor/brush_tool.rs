@@ -61,6 +61,7 @@ impl EditorApp {
         pressure: f32,
     ) {
         if pressed && let Some(p) = to {
+            self.end_stroke();
             self.stroke = Some(StrokeState {
                 stroke: Stroke::new(),
                 last: p,
@@ -167,9 +168,10 @@ impl EditorApp {
         changed.sort_unstable();
         changed.dedup();
         let n = changed.len();
-        if n > 0
-            && let Err(e) = live.paint_points(&self.session, &changed)
-        {
+        if n == 0 {
+            // New revision, same values: the renderer has them already.
+            live.note_paint(&self.session);
+        } else if let Err(e) = live.paint_points(&self.session, &changed) {
             self.message(Level::Error, e.to_string());
         }
         let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -285,13 +287,21 @@ pub fn tool_keys(app: &mut EditorApp, ctx: &egui::Context, pointer: Option<egui:
             })
         })
     };
+    // [ and ] repeat while held, and are typed with AltGr on many layouts (reported as Ctrl+Alt).
+    let bracket = |key: Key| {
+        ctx.input(|i| {
+            i.events.iter().any(|e| {
+                matches!(e, egui::Event::Key { key: k, pressed: true, modifiers, .. }
+                    if *k == key && (modifiers.alt == modifiers.ctrl))
+            })
+        })
+    };
     let (b, v, esc) = (
         pressed(Key::B, false).is_some(),
         pressed(Key::V, false).is_some(),
         pressed(Key::Escape, true).is_some(),
     );
-    let smaller = pressed(Key::OpenBracket, false).is_some();
-    let larger = pressed(Key::CloseBracket, false).is_some();
+    let (smaller, larger) = (bracket(Key::OpenBracket), bracket(Key::CloseBracket));
     let f = pressed(Key::F, true);
     let (f, shift) = (f.is_some(), f.unwrap_or(false));
     if b {

@@ -54,17 +54,14 @@ impl ExportJob {
             std::iter::once(exr.as_path()).chain(png.as_deref()),
         )
         .map_err(|e| e.to_string())?;
-        // A layer painted on another hair is left out, as the viewport leaves it out.
+        // The paint the viewport shows: a layer painted on another hair, or a file that cannot be
+        // read, is left out as the viewport leaves it out.
         let mut session = session.clone();
-        let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
-        if session
-            .paint_layer
-            .as_ref()
-            .is_some_and(|l| !l.get().fits(points, strands))
-        {
-            session.paint_layer = None;
+        let (layer, _) = crate::editor::live::paint_for(&session, &live.hair, &mut None);
+        if layer.is_none() {
             session.paint = None;
         }
+        session.paint_layer = layer;
         let hair = LoadedHairSource {
             hair: (*live.hair).clone(),
             name: live.hair_name.clone(),

@@ -213,6 +213,8 @@ pub struct LiveScene {
     pub(super) paint_restart: bool,
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
+    /// The parameters of the tables being built.
+    tables_building: Option<HairParams>,
     /// A camera held back while a preview is under way.
     wanted_camera: Option<Camera>,
     /// Tables to build (for these parameters, reusing this azimuthal table when it fits).
@@ -307,6 +309,7 @@ impl LiveScene {
             },
             view: None,
             tables: None,
+            tables_building: None,
             wanted_camera: None,
             wanted_tables: None,
             held_tables: None,
@@ -347,6 +350,10 @@ impl LiveScene {
                 || new.strand_variation != old.strand_variation
                 || new.variation_seed != old.variation_seed;
             let absorption_changed = base_changed || paint != self.applied.paint;
+            if paint != self.applied.paint {
+                // Another file or layer: read it afresh.
+                self.paint_file = None;
+            }
             // Applied before anything can fail, so a failure is reported once, not every frame.
             self.applied.look = session.look;
             self.applied.paint = paint;
@@ -427,10 +434,10 @@ impl LiveScene {
     /// The look in the renderer's form goes to the renderer now (single scattering shows it at
     /// once); its tables are built off the UI thread when the parameters they depend on changed.
     pub(super) fn set_look_deferred(&mut self, look: HairLook) {
-        let held_fits = self
-            .held_tables
-            .as_ref()
-            .is_some_and(|(p, _)| crate::render::renderer::same_tables(p, &look.params));
+        let fits = |p: &HairParams| crate::render::renderer::same_tables(p, &look.params);
+        // Tables built or being built for parameters that differ only in the absorption serve.
+        let held_fits = self.held_tables.as_ref().is_some_and(|(p, _)| fits(p))
+            || (self.tables.is_some() && self.tables_building.as_ref().is_some_and(fits));
         if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
             let params = look.params;
             // The azimuthal table of the held tables when it fits (an eta change in the works),
@@ -513,7 +520,7 @@ impl LiveScene {
     }
 
     /// The session's paint as the renderer has it now (a dab wrote its points).
-    pub(super) fn note_paint(&mut self, session: &Session) {
+    pub fn note_paint(&mut self, session: &Session) {
         self.applied.paint = paint_key(session);
     }
 
@@ -574,6 +581,7 @@ impl LiveScene {
                         || !azimuthal.fits_hair(params))
             });
         if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
+            self.tables_building = Some(params);
             self.tables = Some(Job::spawn(
                 "hair tables",
                 || {},

@@ -75,8 +75,7 @@ impl LiveScene {
     }
 
     /// A dab changed the session's paint layer at the points `changed` (sorted): their absorption
-    /// goes to the renderer at once (only theirs); the volume, grid and the dual tables' mean
-    /// absorption follow when the stroke ends ([`LiveScene::paint_finished`]).
+    /// goes to the renderer at once (only theirs); the volume and grid follow (a deferred rebuild).
     pub fn paint_points(&mut self, session: &Session, changed: &[u32]) -> Result<(), LiveError> {
         let Some(layer) = &session.paint_layer else {
             return Ok(());

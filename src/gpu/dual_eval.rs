@@ -25,6 +25,7 @@ pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
             out.push(v4(*s));
         }
     }
+    debug_assert_eq!(out.len(), t.rows.len() * DUAL_ROW);
     out
 }
 

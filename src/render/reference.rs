@@ -245,7 +245,7 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
         let fibers = settings
             .shadows
             .then(|| FiberGrid::build(scene.hair, scene.sigma_a));
-        // The dual tables at the hair's mean absorption, as the renderer builds them.
+        // The tables as the renderer builds them (each point reads them at its own absorption).
         let (forward, dual) = rayon::join(
             || ForwardTable::build(params, REFERENCE_VARIANT),
             || DualTables::build(params, REFERENCE_VARIANT),

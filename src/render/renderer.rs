@@ -532,8 +532,8 @@ impl Renderer {
     }
 
     /// Hair parameters changed, without waiting for the tables: the uniform is rewritten now (single
-    /// scattering shows the change in the next frame); returns true when the exact parameters changed,
-    /// and then the caller builds the tables ([`build_tables`], off the UI thread) and hands them to
+    /// scattering shows the change in the next frame); returns true when parameters the tables depend
+    /// on changed (any but the absorption, [`same_tables`]), and then the caller builds the tables ([`build_tables`], off the UI thread) and hands them to
     /// [`Renderer::set_tables`]. Until then multiple scattering and forward transmittance use the old
     /// tables, and a new eta or eccentricity waits for its azimuthal table (the frame keeps the old
     /// index: `write_params`).
