@@ -45,24 +45,21 @@ fn harness_as(
     instance: Option<u32>,
 ) -> Harness<'static, EditorApp> {
     std::fs::create_dir_all(state_dir).expect("state dir");
-    let state_dir = state_dir.to_path_buf();
+    harness_with(EditorOptions {
+        session: Some(session),
+        offer_recovery: recovery,
+        state_dir: Some(state_dir.to_path_buf()),
+        instance,
+        ..Default::default()
+    })
+}
+
+/// An editor started with `options` (the test window's size, a quarter-resolution viewport).
+fn harness_with(options: EditorOptions) -> Harness<'static, EditorApp> {
     let mut h = Harness::builder()
         .with_size(egui::vec2(1100.0, 640.0))
         .wgpu_setup(strandlight::editor::wgpu_setup())
-        .build_eframe(move |cc| {
-            EditorApp::new(
-                cc,
-                EditorOptions {
-                    session_path: None,
-                    session: Some(session),
-                    offer_recovery: recovery,
-                    state_dir: Some(state_dir),
-                    instance,
-                    recover: None,
-                    relaunch_on_device_loss: false,
-                },
-            )
-        });
+        .build_eframe(move |cc| EditorApp::new(cc, options));
     h.state_mut().view.scale = 0.25;
     h
 }
@@ -741,24 +738,12 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
     assert_eq!(file, h.state().autosave.path);
     let session = h.state().session.clone();
     drop(h);
-    let mut again = Harness::builder()
-        .with_size(egui::vec2(1100.0, 640.0))
-        .wgpu_setup(strandlight::editor::wgpu_setup())
-        .build_eframe({
-            let (dir, file) = (dir.clone(), file.clone());
-            move |cc| {
-                EditorApp::new(
-                    cc,
-                    EditorOptions {
-                        recover: Some(file),
-                        state_dir: Some(dir),
-                        instance: Some(4_000_000_002),
-                        ..Default::default()
-                    },
-                )
-            }
-        });
-    again.state_mut().view.scale = 0.25;
+    let mut again = harness_with(EditorOptions {
+        recover: Some(file.clone()),
+        state_dir: Some(dir.clone()),
+        instance: Some(4_000_000_002),
+        ..Default::default()
+    });
     assert!(again.state().session == session, "the recovered session");
     assert!(again.state().modified(), "recovered work is unsaved work");
     assert!(!file.exists(), "the old recovery file was taken over");
@@ -1115,24 +1100,12 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     let edited = image(&h);
     let session = h.state().session.clone();
     // Reopened: the same model (layer included) and the same image.
-    let mut again = Harness::builder()
-        .with_size(egui::vec2(1100.0, 640.0))
-        .wgpu_setup(strandlight::editor::wgpu_setup())
-        .build_eframe({
-            let (dir, path) = (dir.clone(), path.clone());
-            move |cc| {
-                EditorApp::new(
-                    cc,
-                    EditorOptions {
-                        session_path: Some(path),
-                        state_dir: Some(dir),
-                        instance: Some(4_000_000_003),
-                        ..Default::default()
-                    },
-                )
-            }
-        });
-    again.state_mut().view.scale = 0.25;
+    let mut again = harness_with(EditorOptions {
+        session_path: Some(path.clone()),
+        state_dir: Some(dir.clone()),
+        instance: Some(4_000_000_003),
+        ..Default::default()
+    });
     converge(&mut again);
     assert!(
         again.state().session == session,

@@ -269,12 +269,15 @@ impl EditorApp {
         };
         if let Some(file) = &options.recover {
             match super::autosave::read_recovery(file) {
-                Ok((path, session)) => {
+                Ok((path, session, warning)) => {
                     app.adopt_recovery(file, path, session);
                     app.message(
                         Level::Info,
                         format!("reopened the session from {}", file.display()),
                     );
+                    if let Some(w) = warning {
+                        app.message(Level::Warning, w);
+                    }
                 }
                 Err(e) => app.message(Level::Error, e),
             }

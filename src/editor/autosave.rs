@@ -176,25 +176,29 @@ impl Autosave {
             .collect();
         found.sort();
         let (_, file) = found.pop()?;
-        let (path, session) = read_recovery(&file).ok()?;
+        let (path, session, _) = read_recovery(&file).ok()?;
         Some((file, path, session))
     }
 }
 
 /// A recovery file's session and the session file it belongs to (empty: an unsaved session).
-pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session), String> {
+/// A warning comes with it when the layer beside it could not be read (the rest of the work opens).
+pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session, Option<String>), String> {
     let text = std::fs::read_to_string(file)
         .map_err(|e| format!("{}: cannot read the recovery file: {e}", file.display()))?;
     let r: Recovery = serde_json::from_str(&text)
         .map_err(|e| format!("{}: not a recovery file: {e}", file.display()))?;
     let json = serde_json::to_string(&r.session).map_err(|e| e.to_string())?;
     let mut session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
+    let mut warning = None;
     if let Some(layer) = &r.paint_layer {
         // A missing or damaged layer costs the paint, not the rest of the work.
         match crate::paint::PaintLayer::read(layer) {
             Ok(l) => session.paint_layer = Some(crate::paint::SharedLayer::new(l)),
             Err(e) => {
-                eprintln!("warning: {e}; the recovered session opens without its paint");
+                warning = Some(format!(
+                    "{e}; the recovered session opens with its saved paint instead"
+                ));
                 let _ = session.load_paint();
             }
         }
@@ -202,7 +206,7 @@ pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session), String> {
         // The work had no layer in memory: the paint is the session's file, as saved.
         let _ = session.load_paint();
     }
-    Ok((r.session_path.unwrap_or_default(), session))
+    Ok((r.session_path.unwrap_or_default(), session, warning))
 }
 
 /// Whether a process with this id runs (Linux: /proc; elsewhere assumed gone).
@@ -250,7 +254,8 @@ mod tests {
         a.on_exit(&session, true).unwrap();
         let layer_file = a.path.with_extension("slpaint");
         assert!(a.path.is_file() && layer_file.is_file());
-        let (path, back) = read_recovery(&a.path).unwrap();
+        let (path, back, warning) = read_recovery(&a.path).unwrap();
+        assert!(warning.is_none());
         assert_eq!(path, PathBuf::from("/x/look.slsession"));
         assert!(back == session, "the layer comes back");
         // Without a layer the old one goes; saving removes both.

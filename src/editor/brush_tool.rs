@@ -130,6 +130,23 @@ impl EditorApp {
         }
         let hair = live.hair.clone();
         let (points, strands) = (hair.point_count(), hair.strand_count());
+        // A paint file the session names but that was not read (it failed to load): painting would
+        // start an empty layer and the next save would replace the file.
+        if self.session.paint_layer.is_none()
+            && let Some(path) = self.session.paint.clone()
+        {
+            match PaintLayer::read(&path) {
+                Ok(l) => self.session.paint_layer = Some(SharedLayer::new(l)),
+                Err(e) => {
+                    self.end_stroke();
+                    self.message(
+                        Level::Error,
+                        format!("{e}: painting would replace it; Clear paint first to start anew"),
+                    );
+                    return;
+                }
+            }
+        }
         let created = self.session.paint_layer.is_none();
         let layer = self
             .session
