@@ -64,6 +64,29 @@ fn harness_with(options: EditorOptions) -> Harness<'static, EditorApp> {
     h
 }
 
+/// Steps the UI until the export under way is written.
+fn wait_for_export(h: &mut Harness<'static, EditorApp>) {
+    let t = Instant::now();
+    while h.state().export.is_some() {
+        h.step();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(t.elapsed() < Duration::from_secs(300), "the export hangs");
+    }
+}
+
+/// Runs the strandlight binary with `args`, which must succeed.
+fn run_cli(args: &[&std::ffi::OsStr]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
+        .args(args)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Steps the UI until the viewport has converged (the GPU works between steps).
 fn converge(h: &mut Harness<'static, EditorApp>) {
     let t = Instant::now();
@@ -188,15 +211,13 @@ fn render_session(dir: &Path, name: &str, session: &Session) -> Frame {
     let path = dir.join(format!("{name}.slsession"));
     session.write(&path).expect("saved");
     let exr = dir.join(format!("{name}.exr"));
-    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
-        .args(["render", "--session"])
-        .arg(&path)
-        .arg("-o")
-        .arg(&exr)
-        .output()
-        .expect("runs");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    run_cli(&[
+        "render".as_ref(),
+        "--session".as_ref(),
+        path.as_os_str(),
+        "-o".as_ref(),
+        exr.as_os_str(),
+    ]);
     read_exr_beauty(&exr, session.render.width, session.render.height)
 }
 
@@ -641,28 +662,18 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
     converge(&mut h);
     let exr = dir.join("export.exr");
     strandlight::editor::panels::menu::start_export(h.state_mut(), exr.clone());
-    let t = Instant::now();
-    while h.state().export.is_some() {
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-        assert!(t.elapsed() < Duration::from_secs(300), "export hangs");
-    }
+    wait_for_export(&mut h);
     assert!(exr.is_file() && exr.with_extension("png").is_file());
     let path = dir.join("export.slsession");
     h.state().session.write(&path).expect("saved");
     let cli_exr = dir.join("cli.exr");
-    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
-        .args(["render", "--session"])
-        .arg(&path)
-        .arg("-o")
-        .arg(&cli_exr)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_cli(&[
+        "render".as_ref(),
+        "--session".as_ref(),
+        path.as_os_str(),
+        "-o".as_ref(),
+        cli_exr.as_os_str(),
+    ]);
     let (a, b) = (
         read_exr_beauty(&exr, 96, 64),
         read_exr_beauty(&cli_exr, 96, 64),
@@ -674,12 +685,7 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
     // The same still exported in 40-pixel tiles (3 x 2, with partial tiles at the edges).
     let tiled = dir.join("tiled.exr");
     strandlight::editor::panels::menu::start_export_tiled(h.state_mut(), tiled.clone(), Some(40));
-    let t = Instant::now();
-    while h.state().export.is_some() {
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-        assert!(t.elapsed() < Duration::from_secs(300), "tiled export hangs");
-    }
+    wait_for_export(&mut h);
     let c = read_exr_beauty(&tiled, 96, 64);
     let (d, mean) = (
         max_relative_difference(&a, &c),
@@ -1118,27 +1124,17 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     // The editor's export equals `render --session --paint` of the saved layer.
     let exr = dir.join("painted.exr");
     strandlight::editor::panels::menu::start_export(again.state_mut(), exr.clone());
-    let t = Instant::now();
-    while again.state().export.is_some() {
-        again.step();
-        std::thread::sleep(Duration::from_millis(2));
-        assert!(t.elapsed() < Duration::from_secs(300), "export hangs");
-    }
+    wait_for_export(&mut again);
     let cli = dir.join("painted-cli.exr");
-    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
-        .args(["render", "--session"])
-        .arg(&path)
-        .arg("--paint")
-        .arg(&layer_file)
-        .arg("-o")
-        .arg(&cli)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_cli(&[
+        "render".as_ref(),
+        "--session".as_ref(),
+        path.as_os_str(),
+        "--paint".as_ref(),
+        layer_file.as_os_str(),
+        "-o".as_ref(),
+        cli.as_os_str(),
+    ]);
     let (a, b) = (read_exr_beauty(&exr, 96, 64), read_exr_beauty(&cli, 96, 64));
     let d = max_relative_difference(&a, &b);
     println!("export against render --paint: {d:.2e} of the peak");
@@ -1148,18 +1144,13 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     let hair_file = dir.join("painted.hair");
     let usda = dir.join("painted.usda");
     for out_file in [&hair_file, &usda] {
-        let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
-            .args(["export-hair", "--session"])
-            .arg(&path)
-            .arg("-o")
-            .arg(out_file)
-            .output()
-            .expect("runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        run_cli(&[
+            "export-hair".as_ref(),
+            "--session".as_ref(),
+            path.as_os_str(),
+            "-o".as_ref(),
+            out_file.as_os_str(),
+        ]);
     }
     let live = again.state().live.as_ref().unwrap();
     let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
