@@ -159,16 +159,27 @@ impl Renderer {
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
+        range: std::ops::Range<u32>,
     ) {
         let Some(p) = &self.preview else {
             return;
         };
-        let camera = self.preview_camera(p.factor);
-        ctx.queue
-            .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
-        self.visibility_pass
-            .encode(&ctx.device, enc, &p.camera, &self.hair, &p.targets, None);
-        if let Some(p) = &mut self.preview {
+        if range.start == 0 {
+            let camera = self.preview_camera(p.factor);
+            ctx.queue
+                .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
+        }
+        let last = range.end >= self.hair.segment_count;
+        self.visibility_pass.encode_range(
+            &ctx.device,
+            enc,
+            &p.camera,
+            &self.hair,
+            &p.targets,
+            range,
+            None,
+        );
+        if last && let Some(p) = &mut self.preview {
             p.visible = true;
         }
     }

@@ -40,6 +40,8 @@ const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
 /// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
 const GUESS_SEGMENT_S: f64 = 1e-6;
+/// A segment drawn by the visibility pass (lavapipe: ~0.75 us each on two cores).
+const GUESS_VISIBILITY_SEGMENT_S: f64 = 1e-6;
 /// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
 const GUESS_ROW_LIGHTS: f64 = 16.0;
@@ -60,13 +62,15 @@ pub enum WorkUnit {
     VolumeResolve,
     /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
-    /// The visibility pass (skipped when the camera, size and fibres are those it last drew); the
-    /// components are cleared.
-    Visibility,
+    /// The visibility pass over segments [first, first + count) (the first part clears the targets;
+    /// count 0 when the camera, size and fibres are those it last drew); the last part clears the
+    /// components and resolves the image.
+    Visibility { first: u32, count: u32 },
     /// Frame batch `batch` (its lights at its visibility sample) over rows [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
-    /// The preview's visibility pass (after a camera move; a parameter change reuses the last).
-    PreviewVisibility,
+    /// The preview's visibility pass over segments [first, first + count) (after a camera move; a
+    /// parameter change reuses the last).
+    PreviewVisibility { first: u32, count: u32 },
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
 }
@@ -90,7 +94,10 @@ pub enum ImageReady {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage {
-    PreviewVisibility,
+    /// The preview's visibility from segment `first`.
+    PreviewVisibility {
+        first: u32,
+    },
     Preview {
         row: u32,
     },
@@ -99,7 +106,10 @@ enum Stage {
         first: u32,
     },
     ShadowGrid,
-    Visibility,
+    /// The frame's visibility from segment `first`.
+    Visibility {
+        first: u32,
+    },
     /// Frame batch `batch` from `row`; `band`: the rows of the band the first pass shades under
     /// every light batch (0: size a new band).
     Shade {
@@ -220,6 +230,8 @@ pub struct Refinement {
     /// Seconds per shadow-grid entry and per deposited segment (None: not measured yet).
     grid_cost: Option<f64>,
     volume_cost: Option<f64>,
+    /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
+    visibility_cost: Option<f64>,
     /// The frame's shading bands per visibility sample (costs per light: the first sample shades
     /// every covered pixel, the others only where a new segment appears, a few times cheaper), and
     /// the preview's (costs per row of all lights).
@@ -249,13 +261,14 @@ pub struct Refinement {
 impl Default for Refinement {
     fn default() -> Self {
         Self {
-            stage: Stage::Visibility,
+            stage: Stage::Visibility { first: 0 },
             grid_done: 0,
             grid_partial: Vec::new(),
             shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
             volume_cost: None,
+            visibility_cost: None,
             bands: Default::default(),
             preview_bands: Bands::default(),
             grid_last: 1,
@@ -360,10 +373,10 @@ impl Refinement {
             self.stats.longest_unit = Some(unit);
         }
         let pass = match unit {
-            WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility => 0,
+            WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. } => 0,
             WorkUnit::Volume { .. } | WorkUnit::VolumeResolve => 1,
             WorkUnit::ShadowGrid { .. } => 2,
-            WorkUnit::Visibility => 3,
+            WorkUnit::Visibility { .. } => 3,
             WorkUnit::Shade { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
@@ -385,7 +398,16 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.volume_cost = Some(self.volume_cost.map_or(per, |o| 0.5 * (o + per)));
             }
-            WorkUnit::VolumeResolve | WorkUnit::Visibility | WorkUnit::PreviewVisibility => {}
+            WorkUnit::Visibility { count, .. } | WorkUnit::PreviewVisibility { count, .. }
+                if count > 0 =>
+            {
+                // The clear and resolve of the last part ride along: a small overstatement.
+                let per = seconds / count as f64;
+                self.visibility_cost = Some(self.visibility_cost.map_or(per, |o| 0.5 * (o + per)));
+            }
+            WorkUnit::VolumeResolve
+            | WorkUnit::Visibility { .. }
+            | WorkUnit::PreviewVisibility { .. } => {}
         }
     }
 
@@ -478,13 +500,13 @@ impl Renderer {
         } else if self.grid_needed() {
             Stage::ShadowGrid
         } else {
-            Stage::Visibility
+            Stage::Visibility { first: 0 }
         }
     }
 
     pub(super) fn replan(&mut self) {
         let stage = if self.refinement.preview_owed && self.preview_factor() > 1 {
-            Stage::PreviewVisibility
+            Stage::PreviewVisibility { first: 0 }
         } else {
             self.main_stage()
         };
@@ -589,9 +611,11 @@ impl Renderer {
                 *d = Some(Instant::now());
             }
         });
-        self.refinement.preview_started |=
-            matches!(unit, WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility);
-        self.refinement.preview_new_view |= unit == WorkUnit::PreviewVisibility;
+        self.refinement.preview_started |= matches!(
+            unit,
+            WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
+        );
+        self.refinement.preview_new_view |= matches!(unit, WorkUnit::PreviewVisibility { .. });
         self.refinement.in_flight = Some(InFlight {
             unit,
             submitted: Instant::now(),
@@ -630,7 +654,7 @@ impl Renderer {
                 .refinement
                 .in_flight
                 .as_ref()
-                .is_some_and(|f| f.unit == WorkUnit::Visibility)
+                .is_some_and(|f| matches!(f.unit, WorkUnit::Visibility { .. }))
     }
 
     /// Starts reading the frame's view depth back (see [`Renderer::view_depth_ready`]) with the
@@ -666,12 +690,15 @@ impl Renderer {
     /// Whether a preview is part-way (its first unit submitted, its last not finished).
     pub fn preview_under_way(&self) -> bool {
         let r = &self.refinement;
-        let planned = matches!(r.stage, Stage::PreviewVisibility | Stage::Preview { .. });
+        let planned = matches!(
+            r.stage,
+            Stage::PreviewVisibility { .. } | Stage::Preview { .. }
+        );
         let in_flight = r.in_flight.as_ref().is_some_and(|f| {
             f.restart == r.restarts
                 && matches!(
                     f.unit,
-                    WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility
+                    WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
                 )
         });
         in_flight || (planned && r.preview_started)
@@ -780,6 +807,19 @@ impl Renderer {
         Some(WorkUnit::ShadowGrid { first, count })
     }
 
+    /// Segments of a visibility unit from `first`: as many as the budget holds at the measured cost
+    /// per segment (drawing costs about the same per segment whatever the resolution).
+    fn visibility_part(&self, first: u32) -> u32 {
+        let r = &self.refinement;
+        let remaining = self.hair.segment_count.saturating_sub(first);
+        r.items(
+            r.visibility_cost,
+            GUESS_VISIBILITY_SEGMENT_S,
+            u32::MAX / 2,
+            remaining,
+        )
+    }
+
     /// The next unit of the plan (sized to the budget); advances the plan past it. The shadow grid is
     /// built light batch by light batch, each just before the first shading batch that reads it: the
     /// first light batch's part before the visibility pass clears the image (the last image stays on
@@ -789,18 +829,25 @@ impl Renderer {
         let batches = self.shading_pass.frame_batches().count() as u32;
         let grid_needed = self.grid_needed();
         match self.refinement.stage {
-            Stage::PreviewVisibility => {
+            Stage::PreviewVisibility { first } => {
                 let Some(valid) = self.prepare_preview(device).map(|_| self.preview_visible())
                 else {
                     self.refinement.stage = self.main_stage();
                     return self.next_unit(device);
                 };
-                self.refinement.stage = Stage::Preview { row: 0 };
                 if valid {
-                    self.next_unit(device)
-                } else {
-                    Some(WorkUnit::PreviewVisibility)
+                    self.refinement.stage = Stage::Preview { row: 0 };
+                    return self.next_unit(device);
                 }
+                let count = self.visibility_part(first);
+                self.refinement.stage = if first + count >= self.hair.segment_count {
+                    Stage::Preview { row: 0 }
+                } else {
+                    Stage::PreviewVisibility {
+                        first: first + count,
+                    }
+                };
+                Some(WorkUnit::PreviewVisibility { first, count })
             }
             Stage::Preview { row } => {
                 let Some(p) = self.prepare_preview(device) else {
@@ -839,11 +886,22 @@ impl Renderer {
                 if grid_needed && let Some(unit) = self.grid_unit(self.grid_entries_for(0)) {
                     return Some(unit);
                 }
-                self.refinement.stage = Stage::Visibility;
+                self.refinement.stage = Stage::Visibility { first: 0 };
                 self.next_unit(device)
             }
-            Stage::Visibility => {
-                self.refinement.stage = if batches == 0 {
+            Stage::Visibility { first } => {
+                // A parameter change keeps the camera's visibility: one unit clears the components.
+                let segments = self.hair.segment_count;
+                let (first, count) = if self.visibility_valid {
+                    (segments, 0)
+                } else {
+                    (first, self.visibility_part(first))
+                };
+                self.refinement.stage = if first + count < segments {
+                    Stage::Visibility {
+                        first: first + count,
+                    }
+                } else if batches == 0 {
                     Stage::Converged
                 } else {
                     Stage::Shade {
@@ -852,7 +910,7 @@ impl Renderer {
                         band: 0,
                     }
                 };
-                Some(WorkUnit::Visibility)
+                Some(WorkUnit::Visibility { first, count })
             }
             Stage::Shade { batch, row, band } => {
                 if grid_needed
@@ -947,7 +1005,9 @@ impl Renderer {
     fn encode_unit(&mut self, ctx: &GpuContext, enc: &mut wgpu::CommandEncoder, unit: WorkUnit) {
         let device = &ctx.device;
         match unit {
-            WorkUnit::PreviewVisibility => self.encode_preview_visibility(ctx, enc),
+            WorkUnit::PreviewVisibility { first, count } => {
+                self.encode_preview_visibility(ctx, enc, first..first + count)
+            }
             WorkUnit::Preview { row0, rows } => self.encode_preview(ctx, enc, row0, rows),
             WorkUnit::Volume { first, count } => {
                 self.density_pass.encode_deposit(
@@ -985,19 +1045,23 @@ impl Renderer {
                     self.shadow_grid_dirty = false;
                 }
             }
-            WorkUnit::Visibility => {
-                // A parameter change keeps the camera's visibility: only the components restart.
-                if !self.visibility_valid {
-                    self.visibility_pass.encode(
+            WorkUnit::Visibility { first, count } => {
+                if count > 0 {
+                    self.visibility_pass.encode_range(
                         device,
                         enc,
                         &self.camera,
                         &self.hair,
                         &self.targets,
+                        first..first + count,
                         None,
                     );
-                    self.visibility_valid = true;
                 }
+                if first + count < self.hair.segment_count {
+                    return;
+                }
+                // The last part: the image's visibility is whole; the components restart.
+                self.visibility_valid = true;
                 ShadingPass::clear(enc, &self.targets);
                 self.encode_resolve(device, enc, 0..self.settings.height);
             }

@@ -66,6 +66,32 @@ impl VisibilityPass {
         targets: &FrameTargets,
         timestamps: Option<wgpu::RenderPassTimestampWrites>,
     ) {
+        self.encode_range(
+            device,
+            encoder,
+            camera,
+            hair,
+            targets,
+            0..hair.segment_count,
+            timestamps,
+        );
+    }
+
+    /// Draws segments `range` only (progressive refinement's bounded units); the range starting at 0
+    /// clears the targets, later ones draw over them (in order, so the depth test's ties resolve as
+    /// in one draw).
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_range(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &wgpu::Buffer,
+        hair: &GpuHair,
+        targets: &FrameTargets,
+        range: std::ops::Range<u32>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites>,
+    ) {
+        let clear = range.start == 0;
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("visibility"),
             layout: &self.pipeline.get_bind_group_layout(0),
@@ -91,14 +117,22 @@ impl VisibilityPass {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    load: if clear {
+                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &targets.depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: if clear {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
@@ -109,8 +143,9 @@ impl VisibilityPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        if hair.segment_count > 0 {
-            pass.draw(0..6 * hair.segment_count, 0..1);
+        let end = range.end.min(hair.segment_count);
+        if end > range.start {
+            pass.draw(6 * range.start..6 * end, 0..1);
         }
     }
 }
