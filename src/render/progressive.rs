@@ -2,15 +2,15 @@
 //! flight, each submitted on its own by [`Renderer::refine`]; shadow-grid ranges and shading row bands
 //! are sized from the measured cost of the units before them (row bands from each row's own cost in
 //! earlier batches) to a time budget, so egui, which shares the queue, does not wait behind a long
-//! submission (the volume's resolve and the visibility units are whole passes, not sized; a unit of one row or one
-//! sweep can still pass the budget).
+//! submission (the volume's resolve is a whole pass, not sized; a unit of one row or one sweep can
+//! still pass the budget).
 //!
 //! The plan after a change: first, when the renderer has one ([`Renderer::set_preview`]), a preview of
 //! the change (reduced resolution, one shading per pixel, all lights, the shadow grid as it stands:
 //! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed: its
 //! deposit in ranges of segments, whose fixed-point sums add up exactly, then its resolve), the
 //! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
-//! lights or the forward table changed), visibility, then every shading batch (a light batch at one
+//! lights or the forward table changed), visibility in ranges of segments, then every shading batch (a light batch at one
 //! visibility sample, every light batch at the first sample before any at the second) in bands of
 //! rows, each band followed by a resolve of its rows; the grid's entries for a light batch are built
 //! just before the first shading batch that reads them. [`Progress::ready`] says when a finished unit
