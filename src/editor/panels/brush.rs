@@ -122,11 +122,41 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
                 }
             }
         });
+        // The dye as melanin concentrations (d'Eon 2011), as the look panel makes hair from them.
+        let id = ui.scope_id().with("dye melanin");
+        let mut m: (f64, f64) = ui.data(|d| d.get_temp(id)).unwrap_or((1.0, 0.3));
+        let changed = ui
+            .horizontal(|ui| {
+                let e = ui
+                    .add(
+                        egui::DragValue::new(&mut m.0)
+                            .range(0.0..=20.0)
+                            .speed(0.02)
+                            .prefix("eu "),
+                    )
+                    .on_hover_text("Eumelanin concentration of the dye (brown-black)");
+                let p = ui
+                    .add(
+                        egui::DragValue::new(&mut m.1)
+                            .range(0.0..=20.0)
+                            .speed(0.02)
+                            .prefix("pheo "),
+                    )
+                    .on_hover_text("Pheomelanin concentration of the dye (red-yellow)");
+                ui.weak("melanin");
+                e.changed() || p.changed()
+            })
+            .inner;
+        if changed {
+            b.dye = sigma_a_from_melanin(m.0, m.1).map(|x| x as f32);
+        }
+        ui.data_mut(|d| d.insert_temp(id, m));
     }
     ui.add(
         egui::Slider::new(&mut b.radius_px, 2.0..=500.0)
             .text("radius")
-            .suffix(" px"),
+            .suffix(" px")
+            .fixed_decimals(0),
     )
     .on_hover_text("Brush radius in screen pixels ([ and ], or F then move)");
     ui.add(egui::Slider::new(&mut b.strength, 0.0..=1.0).text("strength"))
