@@ -7,7 +7,7 @@ use serde::Serialize;
 use std::time::Instant;
 use strandlight::gpu::GpuContext;
 use strandlight::hair::Hair;
-use strandlight::paint::brush::{Stroke, effective};
+use strandlight::paint::brush::{Stroke, effective, eumelanin_unit};
 use strandlight::paint::pick::{Picker, ViewDepth};
 use strandlight::paint::{Brush, PaintLayer};
 use strandlight::render::Renderer;
@@ -73,9 +73,6 @@ pub fn brush_run(
     let mut layer = PaintLayer::empty(hair.point_count(), hair.strand_count());
     let mut sigma: Vec<[f32; 3]> = base.to_vec();
     let mut stroke = Stroke::new();
-    let eumelanin =
-        strandlight::scattering::params::sigma_a_from_melanin(1.0, 0.0).map(|x| x as f32);
-    let offsets = &hair.strand_offsets;
     let (mut cpu, mut visible, mut points) = (Vec::new(), Vec::new(), 0usize);
     for k in 0..dabs {
         let x = cx - 0.5 * length + length * k as f32 / dabs.max(2).saturating_sub(1) as f32;
@@ -86,11 +83,8 @@ pub fn brush_run(
             &under,
             &mut layer.points,
             base,
-            |i| {
-                let s = offsets.partition_point(|&o| o <= i).saturating_sub(1);
-                offsets[s]..offsets[s + 1]
-            },
-            eumelanin,
+            |i| hair.strand_of_point(i),
+            eumelanin_unit(),
         );
         for &i in &changed {
             sigma[i as usize] = effective(base[i as usize], layer.points[i as usize]);

@@ -164,12 +164,6 @@ impl EditorApp {
             return;
         };
         stroke.created_layer |= created;
-        let eumelanin = crate::scattering::params::sigma_a_from_melanin(1.0, 0.0).map(|x| x as f32);
-        let offsets = &hair.strand_offsets;
-        let strand_of = |i: u32| {
-            let s = offsets.partition_point(|&o| o <= i).saturating_sub(1);
-            offsets[s]..offsets[s + 1]
-        };
         let mut changed: Vec<u32> = Vec::new();
         let points_mut = &mut layer.make_mut().points;
         for u in &under {
@@ -178,8 +172,8 @@ impl EditorApp {
                 u,
                 points_mut,
                 &live.base_sigma_a,
-                strand_of,
-                eumelanin,
+                |i| hair.strand_of_point(i),
+                crate::paint::brush::eumelanin_unit(),
             ));
         }
         changed.sort_unstable();

@@ -124,6 +124,13 @@ impl Hair {
         &self.positions[self.strand_range(s)]
     }
 
+    /// The points of the strand that holds point `i` (global indices).
+    pub fn strand_of_point(&self, i: u32) -> std::ops::Range<u32> {
+        let o = &self.strand_offsets;
+        let s = o.partition_point(|&x| x <= i).saturating_sub(1);
+        o[s]..o[(s + 1).min(o.len() - 1)]
+    }
+
     /// Thickness (diameter) at a point.
     pub fn thickness_at(&self, strand: usize, point: usize) -> f32 {
         match &self.thickness {

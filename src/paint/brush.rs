@@ -93,6 +93,11 @@ impl PaintMode {
     }
 }
 
+/// The absorption of a unit eumelanin concentration (what darken adds, [`MELANIN_STEP`] of it).
+pub fn eumelanin_unit() -> [f32; 3] {
+    crate::scattering::params::sigma_a_from_melanin(1.0, 0.0).map(|x| x as f32)
+}
+
 /// Eumelanin concentration a full-strength darken dab adds.
 pub const MELANIN_STEP: f64 = 1.0;
 /// What a full-strength lighten dab scales the absorption by (both melanins alike).

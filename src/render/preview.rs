@@ -170,7 +170,7 @@ impl Renderer {
                 .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
         }
         let last = range.end >= self.hair.segment_count;
-        self.visibility_pass.encode_range(
+        self.visibility_pass.encode(
             &ctx.device,
             enc,
             &p.camera,

@@ -1047,7 +1047,7 @@ impl Renderer {
             }
             WorkUnit::Visibility { first, count } => {
                 if count > 0 {
-                    self.visibility_pass.encode_range(
+                    self.visibility_pass.encode(
                         device,
                         enc,
                         &self.camera,

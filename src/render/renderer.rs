@@ -1050,6 +1050,7 @@ impl Renderer {
             &self.camera,
             &self.hair,
             &self.targets,
+            0..self.hair.segment_count,
             timer.and_then(|t| t.render_writes("visibility")),
         );
         let inputs = self.shading_inputs();

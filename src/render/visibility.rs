@@ -57,31 +57,11 @@ impl VisibilityPass {
         Self { pipeline }
     }
 
-    pub fn encode(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        camera: &wgpu::Buffer,
-        hair: &GpuHair,
-        targets: &FrameTargets,
-        timestamps: Option<wgpu::RenderPassTimestampWrites>,
-    ) {
-        self.encode_range(
-            device,
-            encoder,
-            camera,
-            hair,
-            targets,
-            0..hair.segment_count,
-            timestamps,
-        );
-    }
-
-    /// Draws segments `range` only (progressive refinement's bounded units); the range starting at 0
-    /// clears the targets, later ones draw over them (in order, so the depth test's ties resolve as
-    /// in one draw).
+    /// Draws segments `range` (all of them for a whole frame; progressive refinement's bounded units
+    /// draw parts): the range starting at 0 clears the targets, later ones draw over them (in order,
+    /// so the depth test's ties resolve as in one draw).
     #[allow(clippy::too_many_arguments)]
-    pub fn encode_range(
+    pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,

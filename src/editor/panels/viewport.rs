@@ -118,13 +118,7 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
             false => i.pointer.interact_pos(),
         })
         .filter(|_| dragging || pressed || clicked);
-    let to = pos.map(|p| {
-        let (w, h) = app.render_size();
-        [
-            (p.x - rect.min.x) / rect.width().max(1.0) * w as f32,
-            (p.y - rect.min.y) / rect.height().max(1.0) * h as f32,
-        ]
-    });
+    let to = pos.map(|p| render_px(app, rect, p));
     let pressure = ui.input(|i| {
         i.events.iter().rev().find_map(|e| match e {
             egui::Event::Touch { force: Some(f), .. } => Some(*f),
@@ -139,12 +133,7 @@ fn brush(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect: eg
         app.brush_input(to, start, released, pressure);
         // The move that started the drag paints from the press to here.
         if start && let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
-            let (w, h) = app.render_size();
-            let here = [
-                (p.x - rect.min.x) / rect.width().max(1.0) * w as f32,
-                (p.y - rect.min.y) / rect.height().max(1.0) * h as f32,
-            ];
-            app.brush_input(Some(here), false, false, pressure);
+            app.brush_input(Some(render_px(app, rect, p)), false, false, pressure);
         }
     }
 }
@@ -182,4 +171,13 @@ fn navigate(app: &mut EditorApp, ui: &egui::Ui, response: &egui::Response, rect:
     if (response.hovered() || response.has_focus()) && !ui.ctx().egui_wants_keyboard_input() {
         app.navigation_keys(ui.ctx());
     }
+}
+
+/// A viewport position (points) in the render's pixels (the image fills the viewport).
+fn render_px(app: &EditorApp, rect: egui::Rect, p: egui::Pos2) -> [f32; 2] {
+    let (w, h) = app.render_size();
+    [
+        (p.x - rect.min.x) / rect.width().max(1.0) * w as f32,
+        (p.y - rect.min.y) / rect.height().max(1.0) * h as f32,
+    ]
 }
