@@ -1,5 +1,6 @@
 // Display pass: the resolved beauty (linear, premultiplied by coverage) through the viewport's view
-// transform into an 8-bit sRGB-encoded image over a flat background (egui samples it as Rgba8Unorm).
+// transform into an 8-bit sRGB-encoded image (egui samples it as Rgba8Unorm), over the environment (the
+// image's background target, composited in linear light before the transform) or a flat colour.
 // A smaller image (the preview) is sampled bilinearly, premultiplied; while the preview shows, the rows
 // of the full image its first pass has finished are drawn over it. The EXR never passes here.
 // CPU twin: render/display.rs (`displayed_pixel`: `source_sample`, `display_pixel`).
@@ -17,8 +18,10 @@ struct DisplayInfo {
     render_scale: f32,
     // Size of the full image.
     source: vec2<u32>,
-    // Background, display-encoded.
+    // Flat background, display-encoded.
     background: vec3<f32>,
+    // 1: the beauty over the background target (the environment), in linear light.
+    environment: u32,
     // Size of the preview, and the rows of the full image drawn over it (all of them: no preview).
     preview_source: vec2<u32>,
     sharp_rows: u32,
@@ -30,6 +33,8 @@ struct DisplayInfo {
 @group(0) @binding(3) var<storage, read> component: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> preview_beauty: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> preview_component: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> background: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> preview_background: array<vec4<f32>>;
 
 fn aces_filmic(x: f32) -> f32 {
     let y = max(x, 0.0) * 0.6;
@@ -50,8 +55,18 @@ fn view_transform(x: f32, transform: u32) -> f32 {
     return srgb_encode(clamp(x, 0.0, 1.0));
 }
 
-// `beauty_px`: the beauty (its alpha is the coverage); `solo_px`: the solo component.
-fn display_pixel(beauty_px: vec4<f32>, solo_px: vec4<f32>) -> vec4<f32> {
+// `beauty_px`: the beauty (its alpha is the coverage); `solo_px`: the solo component; `bg_px`: the
+// environment behind the pixel.
+fn display_pixel(beauty_px: vec4<f32>, solo_px: vec4<f32>, bg_px: vec4<f32>) -> vec4<f32> {
+    if info.environment == 1u && info.solo == 0u {
+        let lin = info.exposure_scale * (beauty_px.xyz + clamp(1.0 - beauty_px.w, 0.0, 1.0) * bg_px.xyz);
+        return vec4<f32>(
+            view_transform(lin.x, info.transform),
+            view_transform(lin.y, info.transform),
+            view_transform(lin.z, info.transform),
+            1.0,
+        );
+    }
     var p = beauty_px;
     if info.solo == 1u {
         p = vec4<f32>(info.render_scale * solo_px.xyz, beauty_px.w);
@@ -102,16 +117,18 @@ fn display(@builtin(global_invocation_id) id: vec3<u32>) {
         let t = source_taps(id.xy, info.preview_source);
         let b = bilinear(preview_beauty[t.i00], preview_beauty[t.i10], preview_beauty[t.i01], preview_beauty[t.i11], t.f);
         let c = bilinear(preview_component[t.i00], preview_component[t.i10], preview_component[t.i01], preview_component[t.i11], t.f);
-        textureStore(image, vec2<i32>(id.xy), display_pixel(b, c));
+        let g = bilinear(preview_background[t.i00], preview_background[t.i10], preview_background[t.i01], preview_background[t.i11], t.f);
+        textureStore(image, vec2<i32>(id.xy), display_pixel(b, c, g));
         return;
     }
     if all(info.source == vec2<u32>(info.width, info.height)) {
         let i = id.y * info.width + id.x;
-        textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i]));
+        textureStore(image, vec2<i32>(id.xy), display_pixel(beauty[i], component[i], background[i]));
         return;
     }
     let t = source_taps(id.xy, info.source);
     let b = bilinear(beauty[t.i00], beauty[t.i10], beauty[t.i01], beauty[t.i11], t.f);
     let c = bilinear(component[t.i00], component[t.i10], component[t.i01], component[t.i11], t.f);
-    textureStore(image, vec2<i32>(id.xy), display_pixel(b, c));
+    let g = bilinear(background[t.i00], background[t.i10], background[t.i01], background[t.i11], t.f);
+    textureStore(image, vec2<i32>(id.xy), display_pixel(b, c, g));
 }

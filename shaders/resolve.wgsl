@@ -1,13 +1,20 @@
 // Resolve pass: per pixel, coverage (alpha) from the visibility samples, the nearest sample's view
 // depth, the segment ids under the pixel (for picking and the CPU twin), and the beauty = sum of the
 // accumulated components times the exposure scale 2^EV. Linear, premultiplied by coverage; no tonemap.
-// Prepended: camera.
+// Also the background behind each pixel: the environment map along the pixel's centre ray, exposed
+// (zero without a map); the composite is the picture's business (render/background.rs).
+// Prepended: circular_gaussian (PI), camera.
 
 struct ResolveInfo {
     exposure_scale: f32,
     samples: u32,
+    // The background's latitude-longitude map (0 x 0: none) and its turn about +Y, radians.
+    env_width: u32,
+    env_height: u32,
+    env_yaw: f32,
     _p0: u32,
     _p1: u32,
+    _p2: u32,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -30,6 +37,42 @@ struct ResolveRows {
     _p1: u32,
 }
 @group(0) @binding(12) var<storage, read> band: ResolveRows;
+@group(0) @binding(13) var<storage, read> environment: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> background: array<vec4<f32>>;
+
+// Radiance of the environment along the unit world direction d: the map turned back by the yaw
+// (envmap/direction.rs: rotate_yaw, uv_from_direction), bilinear between texel centres, wrapping in
+// azimuth, clamped at the poles. Twin of BackgroundMap::radiance (src/render/background.rs).
+fn background_radiance(d: vec3<f32>) -> vec3<f32> {
+    let w = i32(info.env_width);
+    let h = i32(info.env_height);
+    if (w == 0 || h == 0) {
+        return vec3<f32>(0.0);
+    }
+    let s = sin(-info.env_yaw);
+    let c = cos(-info.env_yaw);
+    let m = normalize(vec3<f32>(c * d.x + s * d.z, d.y, -s * d.x + c * d.z));
+    let theta = acos(clamp(m.y, -1.0, 1.0));
+    let phi = atan2(m.x, -m.z);
+    let u = fract(phi / (2.0 * PI) + 0.5);
+    let v = theta / PI;
+    let x = u * f32(w) - 0.5;
+    let y = clamp(v * f32(h) - 0.5, 0.0, f32(h - 1));
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let f = vec2<f32>(x - x0, y - y0);
+    let xa = ((i32(x0) % w) + w) % w;
+    let xb = (xa + 1) % w;
+    let ya = clamp(i32(y0), 0, h - 1);
+    let yb = clamp(i32(y0) + 1, 0, h - 1);
+    let a = environment[ya * w + xa].xyz;
+    let b = environment[ya * w + xb].xyz;
+    let e = environment[yb * w + xa].xyz;
+    let g = environment[yb * w + xb].xyz;
+    let top = a + (b - a) * f.x;
+    let bottom = e + (g - e) * f.x;
+    return top + (bottom - top) * f.y;
+}
 
 // Distance along the view axis of a [0, 1] depth (directx-style right-handed projection).
 fn linear_depth(d: f32) -> f32 {
@@ -62,4 +105,6 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     beauty[pixel] = vec4<f32>(info.exposure_scale * sum, alpha);
     view_depth[pixel] = select(1e10, linear_depth(nearest), covered > 0u);
     sample_ids[pixel] = ids;
+    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
+    background[pixel] = vec4<f32>(info.exposure_scale * background_radiance(ray.dir), 1.0);
 }

@@ -169,6 +169,9 @@ fn a_tiled_render_equals_the_untiled_one() {
             "16",
             "--volume-resolution",
             "48",
+            // The environment behind, looked up per tile through each tile's camera.
+            "--background",
+            "env",
             "-o",
         ])
         .arg(&exr);
@@ -181,7 +184,7 @@ fn a_tiled_render_equals_the_untiled_one() {
             "{}",
             String::from_utf8_lossy(&out.stderr)
         );
-        common::read_exr_channels(&exr, &["A", "B", "G", "R"]).concat()
+        common::read_exr_channels(&exr, &["coverage", "B", "G", "R"]).concat()
     };
     let whole = render("untiled.exr", None);
     let tiled = render("tiled.exr", Some("64"));

@@ -1,7 +1,7 @@
 //! The viewport's display pass (shaders/display.wgsl) against its CPU twin (`source_sample`,
 //! `display_pixel`), on lavapipe: both view transforms, the viewport exposure, partial coverage over the
-//! background, a solo component, a smaller image enlarged bilinearly, and a preview under the full
-//! image's first rows.
+//! background (a flat colour, and the environment target composited in linear light), a solo
+//! component, a smaller image enlarged bilinearly, and a preview under the full image's first rows.
 
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::display::{
@@ -32,6 +32,15 @@ fn the_display_pass_matches_its_cpu_twin() {
         .write_buffer(&targets.beauty, 0, bytemuck::cast_slice(&beauty));
     ctx.queue
         .write_buffer(&targets.components[1], 0, bytemuck::cast_slice(&component));
+    // The environment behind each pixel: a gradient up to ~3.
+    let background: Vec<[f32; 4]> = (0..n)
+        .map(|i| {
+            let x = 3.0 * (i % 7) as f32 / 6.0;
+            [x, 0.5 * x, 0.2 + 0.1 * x, 1.0]
+        })
+        .collect();
+    ctx.queue
+        .write_buffer(&targets.background, 0, bytemuck::cast_slice(&background));
     // A preview: a third of the size, other values.
     let (pw, ph) = (w.div_ceil(3), h.div_ceil(3));
     let preview = FrameTargets::new(&ctx.device, pw, ph, 4);
@@ -46,6 +55,13 @@ fn the_display_pass_matches_its_cpu_twin() {
         .iter()
         .map(|p| [p[2], p[1], p[0], 0.0])
         .collect();
+    let preview_background: Vec<[f32; 4]> =
+        (0..pn).map(|i| [0.1 * i as f32, 1.0, 0.5, 1.0]).collect();
+    ctx.queue.write_buffer(
+        &preview.background,
+        0,
+        bytemuck::cast_slice(&preview_background),
+    );
     ctx.queue
         .write_buffer(&preview.beauty, 0, bytemuck::cast_slice(&preview_beauty));
     ctx.queue.write_buffer(
@@ -58,14 +74,18 @@ fn the_display_pass_matches_its_cpu_twin() {
     // preview under the image's first 5 rows.
     for (dw, dh, with_preview) in [(w, h, false), (3 * w - 2, 3 * h + 1, false), (w, h, true)] {
         let pass = DisplayPass::new(&ctx.device, dw, dh);
-        for (transform, ev, solo) in [
-            (ViewTransform::Filmic, 0.0, Solo::Beauty),
-            (ViewTransform::Standard, 0.0, Solo::Beauty),
-            (ViewTransform::Filmic, 1.5, Solo::Beauty),
-            (ViewTransform::Standard, -1.0, Solo::Component(1)),
+        for (transform, ev, solo, environment) in [
+            (ViewTransform::Filmic, 0.0, Solo::Beauty, 0),
+            (ViewTransform::Standard, 0.0, Solo::Beauty, 0),
+            (ViewTransform::Filmic, 1.5, Solo::Beauty, 0),
+            (ViewTransform::Standard, -1.0, Solo::Component(1), 0),
+            (ViewTransform::Filmic, 0.5, Solo::Beauty, 1),
+            (ViewTransform::Standard, 0.0, Solo::Beauty, 1),
+            (ViewTransform::Filmic, 0.0, Solo::Component(1), 1),
         ] {
             let info = DisplayInfo {
                 render_scale: 2.0,
+                environment,
                 ..DisplayInfo::new(dw, dh, transform, ev, [0.2, 0.3, 0.4])
             };
             let sharp_rows = 5;
@@ -85,9 +105,13 @@ fn the_display_pass_matches_its_cpu_twin() {
                 sharp_rows: if with_preview { sharp_rows } else { u32::MAX },
                 ..info
             };
-            let full = (&beauty[..], &component[..]);
+            let full = (&beauty[..], &component[..], &background[..]);
             let small = if with_preview {
-                (&preview_beauty[..], &preview_component[..])
+                (
+                    &preview_beauty[..],
+                    &preview_component[..],
+                    &preview_background[..],
+                )
             } else {
                 full
             };

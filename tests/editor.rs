@@ -234,6 +234,7 @@ fn read_exr_beauty(path: &Path, width: u32, height: u32) -> Frame {
         depth: Vec::new(),
         sample_ids: Vec::new(),
         components: Vec::new(),
+        background: Vec::new(),
     }
 }
 

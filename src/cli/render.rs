@@ -8,6 +8,7 @@ use std::time::Instant;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
+use strandlight::render::background::{Background, BackgroundMap};
 use strandlight::render::camera::CAMERA_PRESETS;
 use strandlight::render::frame::check_output_folders;
 use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
@@ -131,6 +132,12 @@ pub struct RenderArgs {
     /// Linear float EXR (RGBA, alpha = coverage).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Behind the hair: env (the environment seen through the camera: its image, or the SRBF
+    /// reconstruction for a .srbf.json), transparent, or a colour #rrggbb. Default: the environment in
+    /// the PNG (with --session, the session's choice) and transparent in the EXR; given, it applies to
+    /// both, and the EXR then holds the hair over it with alpha 1 and the coverage in `coverage`.
+    #[arg(long)]
+    pub background: Option<Background>,
     /// Add AOV layers to the EXR: Z and the components R, TT, TRT, MS.global, MS.local.
     #[arg(long)]
     pub aovs: bool,
@@ -257,6 +264,7 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
             multiple_scattering: !args.single_scattering,
             volume_resolution: args.volume_resolution,
             shadow_grid_resolution: args.shadow_grid,
+            background: args.background.unwrap_or_default(),
         },
         paint: args.paint.clone(),
         paint_layer: None,
@@ -327,6 +335,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &env.lights.lights,
         &camera,
     )?;
+    // The PNG shows the session's background unless told otherwise; the EXR only a background asked
+    // for.
+    let png_background = args.background.unwrap_or(session.render.background);
+    let needs_map = (args.png.is_some() && png_background == Background::Environment)
+        || (args.output.is_some() && args.background == Some(Background::Environment));
+    if needs_map {
+        let map = BackgroundMap::from_environment(&env);
+        renderer.set_background(&ctx, Some(&map), map.yaw);
+    }
     let mut frame = if tile > 0 {
         eprintln!(
             "rendering {}x{} in tiles of {tile} pixels",
@@ -438,11 +455,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         },
     );
     if let Some(o) = &args.output {
-        frame.write_exr(o, &attributes, args.aovs)?;
+        frame.write_exr(o, &attributes, args.aovs, args.background)?;
         eprintln!("wrote {}", o.display());
     }
     if let Some(p) = &args.png {
-        frame.write_png(p)?;
+        frame.write_png(p, png_background)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

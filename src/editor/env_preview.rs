@@ -1,9 +1,12 @@
 //! The environment panel's pictures: the environment image beside its SRBF reconstruction (what the
-//! renderer actually lights with), both at the same exposure, with the fit's error.
+//! renderer actually lights with), both at the same exposure, with the fit's error; and the map the
+//! viewport shows behind the hair.
 
 use crate::envmap::EnvMap;
+use crate::render::background::BackgroundMap;
 use crate::render::frame::{aces_filmic, srgb_encode};
 use crate::render::scene::Environment;
+use std::sync::Arc;
 
 pub const PREVIEW_WIDTH: usize = 192;
 pub const PREVIEW_HEIGHT: usize = 96;
@@ -68,6 +71,8 @@ pub struct EnvPictures {
     pub image: Option<egui::ColorImage>,
     pub fit: egui::ColorImage,
     pub relative_l2: Option<f64>,
+    /// What the viewport shows behind the hair (for the unturned lights: the session's yaw is added).
+    pub background: Arc<BackgroundMap>,
 }
 
 /// The two pictures of `env`, exposed so that the image's median luminance sits at 0.18.
@@ -85,6 +90,7 @@ pub fn pictures(env: &Environment) -> EnvPictures {
         image: image.map(|p| to_image(&p, scale)),
         fit: to_image(&fit.pixels, scale),
         relative_l2: env.lights.fit.as_ref().map(|f| f.relative_l2),
+        background: Arc::new(BackgroundMap::from_environment(env)),
     }
 }
 

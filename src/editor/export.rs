@@ -7,6 +7,7 @@ use super::app::Level;
 use super::jobs::Job;
 use super::live::LiveScene;
 use crate::render::Renderer;
+use crate::render::background::Background;
 use crate::render::camera::Tile;
 use crate::render::frame::Frame;
 use crate::render::renderer::FrameReadBack;
@@ -108,6 +109,13 @@ impl ExportJob {
         renderer
             .set_camera_tile(&live.ctx, &scene.camera, tiles[0])
             .map_err(|e| e.to_string())?;
+        // The PNG shows the session's background: the live scene's map (made for its unturned lights),
+        // turned by the session's yaw. The EXR keeps the hair alone with its alpha.
+        if png.is_some() && session.render.background == Background::Environment {
+            let map = &live.environment_pictures.background;
+            let yaw = map.yaw + session.env_yaw.to_radians() as f32;
+            renderer.set_background(&live.ctx, Some(map), yaw);
+        }
         Ok(Self {
             exr,
             png,
@@ -184,6 +192,7 @@ impl ExportJob {
             },
         );
         let (exr, png) = (self.exr.clone(), self.png.clone());
+        let background = self.session.render.background;
         let seconds = self.started.elapsed().as_secs_f64();
         let wake = self.wake.clone();
         self.writing = Some(Job::spawn(
@@ -191,10 +200,10 @@ impl ExportJob {
             move || wake.request_repaint(),
             move |_| {
                 frame
-                    .write_exr(&exr, &attributes, true)
+                    .write_exr(&exr, &attributes, true, None)
                     .map_err(|e| e.to_string())?;
                 if let Some(p) = &png {
-                    frame.write_png(p).map_err(|e| e.to_string())?;
+                    frame.write_png(p, background).map_err(|e| e.to_string())?;
                 }
                 Ok(format!(
                     "exported {} ({}x{}) in {seconds:.1} s",

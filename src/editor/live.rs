@@ -10,6 +10,7 @@ use crate::gpu::GpuContext;
 use crate::hair::Hair;
 use crate::paint::SharedLayer;
 use crate::paint::brush::effective;
+use crate::render::background::Background;
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
@@ -280,7 +281,7 @@ impl LiveScene {
             renderer.set_thickness_scale(&ctx, &hair.hair, session.look.thickness_scale)?;
         }
         let display = DisplayPass::new(&ctx.device, width, height);
-        Ok(Self {
+        let mut live = Self {
             bounds: hair.hair.bounds(),
             hair: Arc::new(hair.hair),
             hair_name: hair.name,
@@ -324,7 +325,24 @@ impl LiveScene {
             restarts: 0,
             shown_converged: None,
             ctx,
-        })
+        };
+        live.apply_background(session.render.background, session.env_yaw);
+        Ok(live)
+    }
+
+    /// The session's background to the renderer: the environment's map turned by the yaw (the
+    /// display composites the image over it), or none (a flat colour is the display's alone).
+    fn apply_background(&mut self, background: Background, env_yaw: f64) {
+        let map = &self.environment_pictures.background;
+        match background {
+            Background::Environment => self.renderer.set_background(
+                &self.ctx,
+                Some(map),
+                map.yaw + env_yaw.to_radians() as f32,
+            ),
+            _ => self.renderer.set_background(&self.ctx, None, 0.0),
+        }
+        self.view = None;
     }
 
     /// Whether the renderer must be rebuilt for this session (hair or render settings it cannot
@@ -384,6 +402,9 @@ impl LiveScene {
         if session.env_yaw != self.applied.env_yaw {
             let lights = turned_lights(&self.environment.lights, session.env_yaw);
             self.renderer.set_lights(&self.ctx, &lights.lights);
+            let base = self.environment_pictures.background.yaw;
+            self.renderer
+                .set_background_yaw(&self.ctx, base + session.env_yaw.to_radians() as f32);
             self.applied.env_yaw = session.env_yaw;
             changed = true;
         }
@@ -392,6 +413,9 @@ impl LiveScene {
             self.renderer
                 .set_toggles(&self.ctx, b.shadows, b.multiple_scattering);
             changed = true;
+        }
+        if a.background != b.background {
+            self.apply_background(b.background, session.env_yaw);
         }
         if a.exposure != b.exposure {
             // Only the resolve changes: no restart, the display shows it at once.
@@ -473,6 +497,7 @@ impl LiveScene {
         self.environment_pictures = Arc::new(pictures);
         self.environment_source = source;
         self.applied.env_yaw = env_yaw;
+        self.apply_background(self.applied.render.background, env_yaw);
         self.restarted();
     }
 
@@ -673,14 +698,21 @@ impl LiveScene {
 
     /// The display pass of the image shown, through the view transform.
     fn show(&mut self, view: ViewSettings) {
+        let background = self.applied.render.background;
+        let flat = match background {
+            Background::Colour(c) => c.map(|v| v as f32 / 255.0),
+            _ => BACKGROUND,
+        };
         let info = DisplayInfo {
             render_scale: self.renderer.settings.exposure.exp2(),
+            environment: (background == Background::Environment && self.renderer.has_background())
+                as u32,
             ..DisplayInfo::new(
                 self.display.width,
                 self.display.height,
                 view.transform,
                 view.exposure,
-                BACKGROUND,
+                flat,
             )
         };
         let mut enc = self

@@ -1,5 +1,6 @@
 //! The viewport's display pass (`shaders/display.wgsl`): the resolved beauty through a view transform
-//! (standard or filmic, with a viewport exposure) over a flat background, into an Rgba8Unorm texture
+//! (standard or filmic, with a viewport exposure) over the environment (composited in linear light
+//! before the transform) or a flat colour (mixed after it), into an Rgba8Unorm texture
 //! that egui draws. Display only: stills and EXRs never pass here. [`display_pixel`] is the CPU twin.
 
 use super::frame::{aces_filmic, srgb_encode};
@@ -44,8 +45,10 @@ pub struct DisplayInfo {
     pub render_scale: f32,
     /// Size of the full image (the display's, or another, sampled bilinearly).
     pub source: [u32; 2],
+    /// The flat background, display-encoded (without `environment`, or with a solo component).
     pub background: [f32; 3],
-    pub _pad2: f32,
+    /// 1: the beauty over the image's background target (the environment), in linear light.
+    pub environment: u32,
     /// Size of the preview, and the rows of the full image drawn over it (every row: no preview).
     pub preview_source: [u32; 2],
     pub sharp_rows: u32,
@@ -71,7 +74,7 @@ impl DisplayInfo {
             render_scale: 1.0,
             source: [width, height],
             background,
-            _pad2: 0.0,
+            environment: 0,
             preview_source: [width, height],
             sharp_rows: u32::MAX,
             _pad3: 0,
@@ -87,9 +90,26 @@ pub fn view_transform(x: f32, transform: ViewTransform) -> f32 {
     }
 }
 
-/// One displayed pixel from a premultiplied beauty pixel and the solo component (twin of the WGSL
-/// `display_pixel`).
-pub fn display_pixel(info: &DisplayInfo, beauty: [f32; 4], component: [f32; 4]) -> [f32; 4] {
+/// One displayed pixel from a premultiplied beauty pixel, the solo component and the background
+/// behind the pixel (twin of the WGSL `display_pixel`).
+pub fn display_pixel(
+    info: &DisplayInfo,
+    beauty: [f32; 4],
+    component: [f32; 4],
+    background: [f32; 4],
+) -> [f32; 4] {
+    let t = if info.transform == 1 {
+        ViewTransform::Filmic
+    } else {
+        ViewTransform::Standard
+    };
+    if info.environment == 1 && info.solo == 0 {
+        let k = (1.0 - beauty[3]).clamp(0.0, 1.0);
+        let c: [f32; 3] = std::array::from_fn(|i| {
+            view_transform(info.exposure_scale * (beauty[i] + k * background[i]), t)
+        });
+        return [c[0], c[1], c[2], 1.0];
+    }
     let p = if info.solo == 1 {
         let s = info.render_scale;
         [
@@ -106,11 +126,6 @@ pub fn display_pixel(info: &DisplayInfo, beauty: [f32; 4], component: [f32; 4]) 
         info.exposure_scale / p[3]
     } else {
         0.0
-    };
-    let t = if info.transform == 1 {
-        ViewTransform::Filmic
-    } else {
-        ViewTransform::Standard
     };
     let c: [f32; 3] = std::array::from_fn(|i| view_transform(p[i] * un, t));
     let b = info.background;
@@ -152,8 +167,8 @@ pub fn source_sample(
     })
 }
 
-/// A beauty and a solo component of one image, as the display reads them.
-pub type DisplaySource<'a> = (&'a [[f32; 4]], &'a [[f32; 4]]);
+/// A beauty, a solo component and the background of one image, as the display reads them.
+pub type DisplaySource<'a> = (&'a [[f32; 4]], &'a [[f32; 4]], &'a [[f32; 4]]);
 
 /// Display pixel (x, y): the full image's rows above `info.sharp_rows`, the preview's below, each
 /// sampled to the display's size, through [`display_pixel`] (twin of the WGSL `display`).
@@ -166,7 +181,7 @@ pub fn displayed_pixel(
 ) -> [f32; 4] {
     let display = [info.width, info.height];
     let row = y * info.source[1] / info.height.max(1);
-    let (size, (beauty, component)) = if row >= info.sharp_rows {
+    let (size, (beauty, component, background)) = if row >= info.sharp_rows {
         (info.preview_source, preview)
     } else {
         (info.source, full)
@@ -175,6 +190,7 @@ pub fn displayed_pixel(
         info,
         source_sample(display, size, beauty, x, y),
         source_sample(display, size, component, x, y),
+        source_sample(display, size, background, x, y),
     )
 }
 
@@ -308,6 +324,14 @@ impl DisplayPass {
                 wgpu::BindGroupEntry {
                     binding: 5,
                     resource: preview.components[component_of(preview)].as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: targets.background.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: preview.background.as_entire_binding(),
                 },
             ],
         );

@@ -2,6 +2,7 @@
 //! optionally with AOV layers R, TT, TRT, MS.global, MS.local and depth Z), with the render's
 //! parameters as header attributes; a tonemapped PNG preview (ACES filmic, sRGB), never used for the EXR.
 
+use super::background::Background;
 use super::targets::COMPONENTS;
 use std::path::Path;
 
@@ -18,6 +19,9 @@ pub struct Frame {
     pub sample_ids: Vec<[u32; 4]>,
     /// R, TT, TRT, MS.global, MS.local, with the same exposure as the beauty; they add up to it.
     pub components: Vec<Vec<[f32; 3]>>,
+    /// The environment behind every pixel, exposed like the beauty (empty: the render had no
+    /// background map). Not in the beauty: [`Frame::composited`] puts the hair over it.
+    pub background: Vec<[f32; 3]>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -105,29 +109,78 @@ impl Frame {
         out
     }
 
+    /// The linear radiance behind pixel `i` for `background` (None: transparent, or no map for the
+    /// environment), exposed like the beauty.
+    pub fn background_at(&self, background: Background, i: usize) -> Option<[f32; 3]> {
+        match background {
+            Background::Transparent => None,
+            Background::Environment => self.background.get(i).copied(),
+            Background::Colour(c) => Some(Background::linear_colour(c)),
+        }
+    }
+
+    /// The beauty over `background`, linear: hair + (1 - alpha) background with alpha 1 (the beauty
+    /// itself where there is no background).
+    pub fn composited(&self, background: Background) -> Vec<[f32; 4]> {
+        (0..self.pixel_count())
+            .map(|i| {
+                let [r, g, b, a] = self.beauty[i];
+                match self.background_at(background, i) {
+                    Some(bg) => {
+                        let t = (1.0 - a).clamp(0.0, 1.0);
+                        [r + t * bg[0], g + t * bg[1], b + t * bg[2], 1.0]
+                    }
+                    None => [r, g, b, a],
+                }
+            })
+            .collect()
+    }
+
     /// Writes float32 EXR: R, G, B, A; with `aovs`, also Z and <component>.R/G/B for every component.
+    /// With a background (`Some`, not transparent) R, G, B are the hair over it and A is 1, the hair's
+    /// coverage goes to a `coverage` channel and, with `aovs`, (1 - coverage) background to
+    /// `background.R/G/B`, so the layers still add up to the beauty.
     pub fn write_exr(
         &self,
         path: &Path,
         attributes: &Attributes,
         aovs: bool,
+        background: Option<Background>,
     ) -> Result<(), OutputError> {
         use exr::prelude::*;
         let n = self.pixel_count();
         let channel = |name: &str, f: &dyn Fn(usize) -> f32| {
             AnyChannel::new(name, FlatSamples::F32((0..n).map(f).collect()))
         };
+        let background = background.filter(|b| {
+            *b != Background::Transparent
+                && !(*b == Background::Environment && self.background.len() != n)
+        });
+        let beauty = match background {
+            Some(b) => self.composited(b),
+            None => self.beauty.clone(),
+        };
         let mut channels: Vec<AnyChannel<FlatSamples>> = vec![
-            channel("R", &|i| self.beauty[i][0]),
-            channel("G", &|i| self.beauty[i][1]),
-            channel("B", &|i| self.beauty[i][2]),
-            channel("A", &|i| self.beauty[i][3]),
+            channel("R", &|i| beauty[i][0]),
+            channel("G", &|i| beauty[i][1]),
+            channel("B", &|i| beauty[i][2]),
+            channel("A", &|i| beauty[i][3]),
         ];
+        if background.is_some() {
+            channels.push(channel("coverage", &|i| self.beauty[i][3]));
+        }
         if aovs {
             channels.push(channel("Z", &|i| self.depth[i]));
             for (name, data) in COMPONENTS.iter().zip(&self.components) {
                 for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
                     channels.push(channel(&format!("{name}.{suffix}"), &|i| data[i][c]));
+                }
+            }
+            if background.is_some() {
+                for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
+                    channels.push(channel(&format!("background.{suffix}"), &|i| {
+                        beauty[i][c] - self.beauty[i][c]
+                    }));
                 }
             }
         }
@@ -152,20 +205,31 @@ impl Frame {
             .map_err(|e| out_err(path, format!("writing EXR: {e}")))
     }
 
-    /// The preview: ACES filmic (Narkowicz's fit) on the exposed linear colour, sRGB encoded, straight
-    /// alpha.
-    pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
+    /// The preview: ACES filmic (Narkowicz's fit) on the exposed linear colour, sRGB encoded. Over the
+    /// environment the composite is made in linear light before the tonemap, as the editor's display
+    /// does; a flat colour is mixed after it (the picture shows exactly that colour); transparent
+    /// keeps straight alpha.
+    pub fn write_png(&self, path: &Path, background: Background) -> Result<(), OutputError> {
         let mut img = image::RgbaImage::new(self.width, self.height);
+        let enc = |x: f32| srgb_encode(aces_filmic(x));
+        let byte = |x: f32| (255.0 * x.clamp(0.0, 1.0) + 0.5) as u8;
         for (i, px) in img.pixels_mut().enumerate() {
             let [r, g, b, a] = self.beauty[i];
             let un = if a > 0.0 { 1.0 / a } else { 0.0 };
-            let enc = |x: f32| (255.0 * srgb_encode(aces_filmic(x * un)) + 0.5) as u8;
-            *px = image::Rgba([
-                enc(r),
-                enc(g),
-                enc(b),
-                (255.0 * a.clamp(0.0, 1.0) + 0.5) as u8,
-            ]);
+            let hair = [enc(r * un), enc(g * un), enc(b * un)];
+            *px = match (background, self.background.get(i)) {
+                (Background::Environment, Some(bg)) => {
+                    let t = (1.0 - a).clamp(0.0, 1.0);
+                    let c = [r + t * bg[0], g + t * bg[1], b + t * bg[2]];
+                    image::Rgba([byte(enc(c[0])), byte(enc(c[1])), byte(enc(c[2])), 255])
+                }
+                (Background::Colour(c), _) => {
+                    let a = a.clamp(0.0, 1.0);
+                    let mix = |k: usize| byte(c[k] as f32 / 255.0 * (1.0 - a) + hair[k] * a);
+                    image::Rgba([mix(0), mix(1), mix(2), 255])
+                }
+                _ => image::Rgba([byte(hair[0]), byte(hair[1]), byte(hair[2]), byte(a)]),
+            };
         }
         img.save(path)
             .map_err(|e| out_err(path, format!("writing PNG: {e}")))

@@ -1,6 +1,7 @@
 //! The hair renderer (Xu et al. 2011 Sec. 5 on wgpu): visibility, per-SRBF shading batches with
 //! self-shadowing, resolve; shared by `strandlight render`, `bench` and the editor.
 
+pub mod background;
 pub mod camera;
 pub mod display;
 pub mod frame;

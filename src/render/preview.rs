@@ -237,6 +237,7 @@ impl Renderer {
             enc,
             &p.camera,
             &self.resolve_info,
+            &self.background_map,
             &p.targets,
             row0..row0 + rows,
             None,

@@ -1089,6 +1089,7 @@ impl Renderer {
             enc,
             &self.camera,
             &self.resolve_info,
+            &self.background_map,
             &self.targets,
             rows,
             None,

@@ -3,6 +3,7 @@
 //! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
 //! the per-light shadow grid when they or the lights changed, visibility, shading batches, resolve).
 
+use super::background::BackgroundMap;
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
 use super::preview::{Preview, PreviewMode};
@@ -12,7 +13,7 @@ use super::shading::{
     FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs, ShadingPass,
 };
 use super::shadow_grid::{GpuShadowGrid, ShadowGridInputs, ShadowGridPass};
-use super::targets::{FrameTargets, MAX_SEGMENTS};
+use super::targets::{COMPONENTS, FrameTargets, MAX_SEGMENTS};
 use super::timing::PassTimer;
 use super::visibility::VisibilityPass;
 use crate::envmap::SrbfLight;
@@ -237,6 +238,10 @@ pub struct Renderer {
     pub(super) lights: wgpu::Buffer,
     pub(super) light_count: u32,
     pub(super) resolve_info: wgpu::Buffer,
+    /// What `resolve_info` holds.
+    pub(super) resolve_params: ResolveInfo,
+    /// The background's map texels (one zero texel without one).
+    pub(super) background_map: wgpu::Buffer,
     pub(super) targets: FrameTargets,
     pub(super) density_pass: FiberDensityPass,
     pub(super) pyramid_pass: DensityPyramidPass,
@@ -262,6 +267,18 @@ pub struct Renderer {
     /// The frame's visibility pass has drawn the current camera and fibres (refinement reuses it
     /// after a parameter change).
     pub(super) visibility_valid: bool,
+}
+
+/// The background map's texels as a storage buffer (one zero texel for none: a binding cannot be
+/// empty).
+fn environment_buffer(device: &wgpu::Device, map: Option<&BackgroundMap>) -> wgpu::Buffer {
+    let zero = [[0f32; 4]];
+    let texels: &[[f32; 4]] = map.map_or(&zero, |m| &m.texels);
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("background map"),
+        contents: bytemuck::cast_slice(texels),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -381,11 +398,7 @@ impl Renderer {
             })
         };
         let camera_u = camera.uniform(settings.width, settings.height, settings.min_width_px);
-        let resolve_info = ResolveInfo {
-            exposure_scale: settings.exposure.exp2(),
-            samples: settings.samples,
-            _pad: [0; 2],
-        };
+        let resolve_info = ResolveInfo::new(settings.exposure, settings.samples, None);
         let skip = settings.shadow_skip(hair);
         let shadow_grid = GpuShadowGrid::new(
             device,
@@ -442,6 +455,8 @@ impl Renderer {
             }),
             light_count: lights.len() as u32,
             resolve_info: uniform("resolve", bytemuck::bytes_of(&resolve_info)),
+            resolve_params: resolve_info,
+            background_map: environment_buffer(device, None),
             targets: FrameTargets::new(device, settings.width, settings.height, settings.samples),
             density_pass: FiberDensityPass::new(device),
             pyramid_pass: DensityPyramidPass::new(device),
@@ -923,24 +938,49 @@ impl Renderer {
     /// Exposure in stops applied by the resolve pass (and by `read_frame`).
     pub fn set_exposure(&mut self, ctx: &GpuContext, exposure: f32) {
         self.settings.exposure = exposure;
-        let info = ResolveInfo {
-            exposure_scale: exposure.exp2(),
-            samples: self.settings.samples,
-            _pad: [0; 2],
+        self.resolve_params.exposure_scale = exposure.exp2();
+        self.resolve_again(ctx, "exposure");
+    }
+
+    /// The environment seen behind the hair (None: none; the background target holds zeros), turned
+    /// by `yaw` radians about +Y (world = rotate_yaw(map direction, yaw); a map made for turned lights
+    /// gives its own `yaw`). The resolve writes it with every image; here once more for the current one.
+    pub fn set_background(&mut self, ctx: &GpuContext, map: Option<&BackgroundMap>, yaw: f32) {
+        let samples = self.resolve_params.samples;
+        self.resolve_params = ResolveInfo {
+            exposure_scale: self.resolve_params.exposure_scale,
+            env_yaw: yaw,
+            ..ResolveInfo::new(0.0, samples, map)
         };
-        ctx.queue
-            .write_buffer(&self.resolve_info, 0, bytemuck::bytes_of(&info));
-        // Only the resolve changes: it runs after every unit; here once more for the current image.
+        self.background_map = environment_buffer(&ctx.device, map);
+        self.resolve_again(ctx, "background");
+    }
+
+    /// Turns the background (the environment's yaw changed; no upload).
+    pub fn set_background_yaw(&mut self, ctx: &GpuContext, yaw: f32) {
+        if self.resolve_params.env_yaw != yaw {
+            self.resolve_params.env_yaw = yaw;
+            self.resolve_again(ctx, "background yaw");
+        }
+    }
+
+    /// Writes the resolve's parameters and resolves the current image (and preview) again: only the
+    /// resolve changed, which runs after every unit anyway.
+    fn resolve_again(&mut self, ctx: &GpuContext, label: &str) {
+        ctx.queue.write_buffer(
+            &self.resolve_info,
+            0,
+            bytemuck::bytes_of(&self.resolve_params),
+        );
         let mut enc = ctx
             .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("exposure"),
-            });
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         self.resolve_pass.encode(
             &ctx.device,
             &mut enc,
             &self.camera,
             &self.resolve_info,
+            &self.background_map,
             &self.targets,
             0..self.settings.height,
             None,
@@ -951,12 +991,18 @@ impl Renderer {
                 &mut enc,
                 &p.camera,
                 &self.resolve_info,
+                &self.background_map,
                 &p.targets,
                 0..p.targets.height,
                 None,
             );
         }
         ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Whether the resolve writes a background (a map was given to [`Renderer::set_background`]).
+    pub fn has_background(&self) -> bool {
+        self.resolve_params.env_width > 0
     }
 
     /// The frame's targets (the display pass reads the beauty).
@@ -1066,6 +1112,7 @@ impl Renderer {
             &mut enc,
             &self.camera,
             &self.resolve_info,
+            &self.background_map,
             &self.targets,
             0..self.settings.height,
             timer.and_then(|t| t.compute_writes("resolve")),
@@ -1136,7 +1183,7 @@ impl Renderer {
         ctx: &GpuContext,
         t: &FrameTargets,
     ) -> Result<Frame, RenderError> {
-        let bytes = frame_buffers(t)
+        let bytes = frame_buffers(t, self.has_background())
             .iter()
             .map(|b| ctx.read_buffer::<u8>(b))
             .collect::<Result<Vec<_>, _>>()
@@ -1152,7 +1199,7 @@ impl Renderer {
     pub fn start_read_frame(&self, ctx: &GpuContext) -> FrameReadBack {
         let t = &self.targets;
         FrameReadBack {
-            pending: ctx.start_read(&frame_buffers(t)),
+            pending: ctx.start_read(&frame_buffers(t, self.has_background())),
             shape: (t.width, t.height, t.samples),
             exposure: self.settings.exposure,
         }
@@ -1178,10 +1225,14 @@ impl Renderer {
     }
 }
 
-/// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them.
-fn frame_buffers(t: &FrameTargets) -> Vec<&wgpu::Buffer> {
+/// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them (the background
+/// last, when there is one).
+fn frame_buffers(t: &FrameTargets, background: bool) -> Vec<&wgpu::Buffer> {
     let mut v = vec![&t.beauty, &t.view_depth, &t.sample_ids];
     v.extend(t.components.iter());
+    if background {
+        v.push(&t.background);
+    }
     v
 }
 
@@ -1206,7 +1257,17 @@ fn frame_from_bytes(
         beauty: bytemuck::pod_collect_to_vec(&bytes[0]),
         depth: bytemuck::pod_collect_to_vec(&bytes[1]),
         sample_ids: bytemuck::pod_collect_to_vec(&bytes[2]),
-        components: bytes[3..].iter().map(rgb).collect(),
+        components: bytes[3..3 + COMPONENTS.len()].iter().map(rgb).collect(),
+        // Exposed by the resolve already.
+        background: bytes
+            .get(3 + COMPONENTS.len())
+            .map(|b| {
+                bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b)
+                    .into_iter()
+                    .map(|p| [p[0], p[1], p[2]])
+                    .collect()
+            })
+            .unwrap_or_default(),
     }
 }
 

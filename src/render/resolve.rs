@@ -1,4 +1,5 @@
-//! The resolve pass (`shaders/resolve.wgsl`): coverage, depth, sample ids and the exposed beauty.
+//! The resolve pass (`shaders/resolve.wgsl`): coverage, depth, sample ids, the exposed beauty and the
+//! background behind every pixel.
 
 use super::targets::FrameTargets;
 use crate::gpu::context::{buffer_init, compute_pipeline};
@@ -11,10 +12,31 @@ pub struct ResolveInfo {
     /// 2^EV.
     pub exposure_scale: f32,
     pub samples: u32,
-    pub _pad: [u32; 2],
+    /// The background map's size (0 x 0: none) and its yaw, radians ([`super::background::BackgroundMap`]).
+    pub env_width: u32,
+    pub env_height: u32,
+    pub env_yaw: f32,
+    pub _pad: [u32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<ResolveInfo>() == 16);
+const _: () = assert!(std::mem::size_of::<ResolveInfo>() == 32);
+
+impl ResolveInfo {
+    pub fn new(
+        exposure: f32,
+        samples: u32,
+        map: Option<&super::background::BackgroundMap>,
+    ) -> Self {
+        Self {
+            exposure_scale: exposure.exp2(),
+            samples,
+            env_width: map.map_or(0, |m| m.width),
+            env_height: map.map_or(0, |m| m.height),
+            env_yaw: map.map_or(0.0, |m| m.yaw),
+            _pad: [0; 3],
+        }
+    }
+}
 
 pub struct ResolvePass {
     pipeline: wgpu::ComputePipeline,
@@ -41,6 +63,7 @@ impl ResolvePass {
         encoder: &mut wgpu::CommandEncoder,
         camera: &wgpu::Buffer,
         info: &wgpu::Buffer,
+        environment: &wgpu::Buffer,
         targets: &FrameTargets,
         rows: std::ops::Range<u32>,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
@@ -84,10 +107,12 @@ impl ResolvePass {
                 resource: b.as_entire_binding(),
             });
         }
-        entries.push(wgpu::BindGroupEntry {
-            binding: 12,
-            resource: band.as_entire_binding(),
-        });
+        for (binding, b) in [(12, &band), (13, environment), (14, &targets.background)] {
+            entries.push(wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            });
+        }
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &self.pipeline.get_bind_group_layout(0),

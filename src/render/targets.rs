@@ -21,6 +21,8 @@ pub struct FrameTargets {
     pub beauty: wgpu::Buffer,
     pub view_depth: wgpu::Buffer,
     pub sample_ids: wgpu::Buffer,
+    /// The environment behind every pixel, exposed (RGB, A = 1; zero without a background map).
+    pub background: wgpu::Buffer,
 }
 
 impl FrameTargets {
@@ -65,6 +67,7 @@ impl FrameTargets {
             beauty: buffer("beauty", 16),
             view_depth: buffer("view depth", 4),
             sample_ids: buffer("sample ids", 16),
+            background: buffer("background", 16),
         }
     }
 }

@@ -31,6 +31,7 @@ pub fn empty_frame(width: u32, height: u32, samples: u32, components: usize) -> 
         depth: vec![1e10; n],
         sample_ids: vec![[0; 4]; n],
         components: vec![vec![[0.0; 3]; n]; components],
+        background: Vec::new(),
     }
 }
 
@@ -45,6 +46,12 @@ pub fn paste(full: &mut Frame, tile: &Tile, part: &Frame) {
         full.sample_ids[dst..dst + tw].copy_from_slice(&part.sample_ids[src..src + tw]);
         for (f, p) in full.components.iter_mut().zip(&part.components) {
             f[dst..dst + tw].copy_from_slice(&p[src..src + tw]);
+        }
+        if !part.background.is_empty() {
+            if full.background.is_empty() {
+                full.background = vec![[0.0; 3]; full.pixel_count()];
+            }
+            full.background[dst..dst + tw].copy_from_slice(&part.background[src..src + tw]);
         }
     }
 }

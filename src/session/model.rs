@@ -293,6 +293,10 @@ pub struct RenderOptions {
     pub multiple_scattering: bool,
     pub volume_resolution: u32,
     pub shadow_grid_resolution: u32,
+    /// What the viewport and the PNG show behind the hair (the EXR writes it only when `render
+    /// --background` asks).
+    #[serde(default)]
+    pub background: crate::render::background::Background,
 }
 
 impl Default for RenderOptions {
@@ -307,6 +311,7 @@ impl Default for RenderOptions {
             multiple_scattering: s.multiple_scattering,
             volume_resolution: s.volume_resolution,
             shadow_grid_resolution: s.shadow_grid_resolution,
+            background: Default::default(),
         }
     }
 }

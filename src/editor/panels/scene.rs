@@ -5,6 +5,7 @@ use super::widgets::{Changed, slider, slider32};
 use crate::editor::app::EditorApp;
 use crate::editor::panels::menu;
 use crate::hair::procedural::{Style, StyleParams};
+use crate::render::background::Background;
 use crate::render::display::{Solo, ViewTransform};
 use crate::render::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
@@ -277,6 +278,48 @@ fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
             c.gesture |= resp.is_pointer_button_down_on() || resp.dragged();
         }
         [r.width, r.height] = size;
+    });
+    ui.horizontal(|ui| {
+        ui.label("background");
+        let now = r.background;
+        let colour = match now {
+            Background::Colour(c) => c,
+            _ => [51, 51, 56],
+        };
+        for (b, name, tip) in [
+            (
+                Background::Environment,
+                "environment",
+                "The environment seen through the camera (the PNG too)",
+            ),
+            (
+                Background::Transparent,
+                "transparent",
+                "Nothing: the PNG keeps the hair's coverage as alpha",
+            ),
+            (
+                Background::Colour(colour),
+                "colour",
+                "A flat colour (exactly this colour in the PNG)",
+            ),
+        ] {
+            let same = std::mem::discriminant(&now) == std::mem::discriminant(&b);
+            if ui.selectable_label(same, name).on_hover_text(tip).clicked() && !same {
+                r.background = b;
+                c.changed = true;
+            }
+        }
+        if let Background::Colour(mut rgb) = now
+            && ui
+                .color_edit_button_srgb(&mut rgb)
+                .on_hover_text("The background colour")
+                .changed()
+        {
+            r.background = Background::Colour(rgb);
+            c.changed = true;
+            // Dragging in the picker is one undo step.
+            c.gesture |= ui.input(|i| i.pointer.any_down());
+        }
     });
     ui.horizontal(|ui| {
         ui.label("samples");
