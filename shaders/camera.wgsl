@@ -13,6 +13,19 @@ struct Camera {
     far: f32,
 }
 
+// A visibility sample's value: segment + 1 for hair, -(triangle + 1) for the occluder, 0 for nothing
+// (twin of render/occluder.rs: VisibleSample).
+fn visible_hair(v: f32) -> u32 {
+    return select(0u, u32(v + 0.5), v > 0.5);
+}
+
+fn visible_occluder(v: f32) -> u32 {
+    return select(0u, u32(-v + 0.5), v < -0.5);
+}
+
+// The occluder's samples in the resolved sample ids: triangle + 1 with the top bit set.
+const OCCLUDER_ID_BIT: u32 = 0x80000000u;
+
 struct Ray {
     origin: vec3<f32>,
     dir: vec3<f32>,

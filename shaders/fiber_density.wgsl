@@ -23,7 +23,7 @@ const CHANNELS: u32 = 11u; // length, 6 tensor, 3 absorption, diameter (each x l
 // First point of each segment (the segment joins it to the next point).
 @group(0) @binding(3) var<storage, read> segments: array<u32>;
 @group(0) @binding(4) var<storage, read_write> sums: array<atomic<u32>>;
-// Three vec4 per voxel: (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, rho_L), (sigma_a.rgb, 0).
+// Three vec4 per voxel: (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, rho_L), (sigma_a.rgb, solid fraction).
 @group(0) @binding(5) var<storage, read_write> volume: array<vec4<f32>>;
 // The segments a deposit dispatch adds: [first, first + count) (all of them for a whole build, a
 // range per unit of progressive refinement; fixed-point sums make the parts add up exactly).
@@ -34,6 +34,12 @@ struct SegmentRange {
     _p1: u32,
 }
 @group(0) @binding(6) var<storage, read> range: SegmentRange;
+// The fraction of each voxel inside the occluder (0 without one; src/shadow/solid.rs).
+@group(0) @binding(7) var<storage, read> solid: array<f32>;
+
+// The occluder as an opaque solid (src/shadow/solid.rs): crossings per voxel of path, and its absorption.
+const SOLID_DEPTH_PER_VOXEL: f32 = 8.0;
+const SOLID_SIGMA_A: f32 = 50.0;
 
 fn voxel_index(p: vec3<f32>) -> i32 {
     let q = floor((p - info.origin) / info.voxel);
@@ -132,16 +138,20 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         s[c] = f32(atomicLoad(&sums[v * CHANNELS + c])) / FIXED_SCALE;
     }
     let len = s[0];
+    // The occluder's isotropic extinction, its absorption mixed in by extinction (FiberDensity::add_solid).
+    let a_s = SOLID_DEPTH_PER_VOXEL * solid[v] / info.voxel;
     if (len <= 0.0) {
-        volume[3u * v] = vec4<f32>(0.0);
+        volume[3u * v] = vec4<f32>(a_s, 0.0, 0.0, 0.0);
         volume[3u * v + 1u] = vec4<f32>(0.0);
-        volume[3u * v + 2u] = vec4<f32>(neighbour_absorption(v), 0.0);
+        volume[3u * v + 2u] = vec4<f32>(select(neighbour_absorption(v), vec3<f32>(SOLID_SIGMA_A), a_s > 0.0), solid[v]);
         return;
     }
     let rho = len / (info.voxel * info.voxel * info.voxel);
     let d = s[10] / len;
     let k = rho * d / len;
-    volume[3u * v] = vec4<f32>(rho * d, k * s[1], k * s[2], k * s[3]);
+    let a_h = rho * d;
+    let sig = vec3<f32>(s[7], s[8], s[9]) / len;
+    volume[3u * v] = vec4<f32>(a_h + a_s, k * s[1], k * s[2], k * s[3]);
     volume[3u * v + 1u] = vec4<f32>(k * (s[4] - len), k * (s[5] - len), k * (s[6] - len), rho);
-    volume[3u * v + 2u] = vec4<f32>(s[7] / len, s[8] / len, s[9] / len, 0.0);
+    volume[3u * v + 2u] = vec4<f32>((a_h * sig + a_s * SOLID_SIGMA_A) / (a_h + a_s), solid[v]);
 }

@@ -1,6 +1,7 @@
-// Resolve pass: per pixel, coverage (alpha) from the visibility samples, the nearest sample's view
-// depth, the segment ids under the pixel (for picking and the CPU twin), and the beauty = sum of the
-// accumulated components times the exposure scale 2^EV. Linear, premultiplied by coverage; no tonemap.
+// Resolve pass: per pixel, coverage (alpha) from the visibility samples (hair and occluder), the nearest
+// sample's view depth, the sample ids under the pixel (segment + 1, or the occluder's triangle + 1 with
+// the top bit set; for picking and the CPU twins), and the beauty = sum of the accumulated components
+// and the occluder's radiance times the exposure scale 2^EV. Linear, premultiplied by coverage; no tonemap.
 // Also the background behind each pixel: the environment map along the pixel's centre ray, exposed
 // (zero without a map); the composite is the picture's business (render/background.rs).
 // Prepended: circular_gaussian (PI), camera.
@@ -39,6 +40,8 @@ struct ResolveRows {
 @group(0) @binding(12) var<storage, read> band: ResolveRows;
 @group(0) @binding(13) var<storage, read> environment: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> background: array<vec4<f32>>;
+// The occluder's radiance (coverage-weighted, like the components); zero without one.
+@group(0) @binding(15) var<storage, read> occluder: array<vec4<f32>>;
 
 // Radiance of the environment along the unit world direction d: the map turned back by the yaw
 // (envmap/direction.rs: rotate_yaw, uv_from_direction), bilinear between texel centres, wrapping in
@@ -93,7 +96,9 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var covered = 0u;
     var nearest = 1.0;
     for (var s = 0u; s < info.samples; s++) {
-        let v = u32(textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x);
+        let f = textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x;
+        let tri = visible_occluder(f);
+        let v = select(visible_hair(f), OCCLUDER_ID_BIT | tri, tri != 0u);
         ids[s] = v;
         if (v != 0u) {
             covered = covered + 1u;
@@ -101,7 +106,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     let alpha = f32(covered) / f32(info.samples);
-    let sum = aov_r[pixel].xyz + aov_tt[pixel].xyz + aov_trt[pixel].xyz + aov_ms_global[pixel].xyz + aov_ms_local[pixel].xyz;
+    let sum = aov_r[pixel].xyz + aov_tt[pixel].xyz + aov_trt[pixel].xyz + aov_ms_global[pixel].xyz + aov_ms_local[pixel].xyz + occluder[pixel].xyz;
     beauty[pixel] = vec4<f32>(info.exposure_scale * sum, alpha);
     view_depth[pixel] = select(1e10, linear_depth(nearest), covered > 0u);
     sample_ids[pixel] = ids;

@@ -138,7 +138,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         // The preview: one shading per pixel, the first covered sample's segment standing for every
         // covered sample (representative_sample in shade.rs).
         for (var s = 0u; s < batch.samples; s++) {
-            let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
+            let other = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
             if (other != 0u) {
                 if (v == 0u) {
                     v = other;
@@ -150,12 +150,12 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
             return;
         }
     } else {
-        v = u32(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
+        v = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
         if (v == 0u) {
             return;
         }
         for (var s = 0u; s < batch.samples; s++) {
-            let other = u32(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
+            let other = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
             if (other == v) {
                 if (s < batch.slot) {
                     return;

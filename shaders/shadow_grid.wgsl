@@ -24,6 +24,8 @@ struct ShadowGridInfo {
 
 // Transmittances are stored as logarithms, floored here.
 const GRID_MIN_TRANSMITTANCE: f32 = 1e-8;
+// depth_behind of a point inside the occluder (left out of the interpolation).
+const GRID_INSIDE_SOLID: f32 = -1.0;
 
 struct GridShadow {
     transmittance: f32,
@@ -45,14 +47,32 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
     let n = g.dims.x * g.dims.y * g.dims.z;
     var v0 = vec4<f32>(0.0);
     var v1 = vec4<f32>(0.0);
+    // Also the sums without the points inside the occluder (used when any is outside).
+    var o0 = vec4<f32>(0.0);
+    var o1 = vec4<f32>(0.0);
+    var wo = 0.0;
+    var any_inside = false;
     for (var corner = 0u; corner < 8u; corner++) {
         let o = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
         let idx = min(vec3<u32>(base) + o, g.dims - vec3<u32>(1u));
         let w3 = select(vec3<f32>(1.0) - f, f, o == vec3<u32>(1u));
         let i = (idx.z * g.dims.y + idx.y) * g.dims.x + idx.x;
         let w = w3.x * w3.y * w3.z;
-        v0 = v0 + w * shadow_values[2u * (light * n + i)];
-        v1 = v1 + w * shadow_values[2u * (light * n + i) + 1u];
+        let a = shadow_values[2u * (light * n + i)];
+        let b = shadow_values[2u * (light * n + i) + 1u];
+        v0 = v0 + w * a;
+        v1 = v1 + w * b;
+        if (b.w >= 0.0) {
+            o0 = o0 + w * a;
+            o1 = o1 + w * b;
+            wo = wo + w;
+        } else {
+            any_inside = true;
+        }
     }
-    return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz, v1.w);
+    if (any_inside && wo > 1e-4) {
+        v0 = o0 / wo;
+        v1 = o1 / wo;
+    }
+    return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz, max(v1.w, 0.0));
 }

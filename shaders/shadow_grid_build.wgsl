@@ -184,17 +184,23 @@ fn accumulate(e: u32, d: SweepDirection, f: PathIntegrals, forward: bool, first:
 // finish in sweep.rs: the stored value from the sums (transmittances as logarithms: attenuation falls
 // off exponentially into the hair, so interpolating its logarithm follows it between grid points far
 // better).
+// A point in a voxel more than half inside the occluder gets depth_behind = GRID_INSIDE_SOLID: the
+// lookup leaves it out of its interpolation (FiberDensity::inside_solid).
 fn finish(e: u32, g: ShadowGridInfo) {
     let v0 = shadow_values[2u * e];
     let v1 = shadow_values[2u * e + 1u];
     let t = log(max(v0.x, GRID_MIN_TRANSMITTANCE));
+    let n = g.dims.x * g.dims.y * g.dims.z;
+    let voxel = forward_voxel_at(grid_point(g, e % n));
+    let inside = voxel >= 0 && volume[3u * u32(voxel) + 2u].w > 0.5;
     if (g.forward == 0u) {
         shadow_values[2u * e] = vec4<f32>(t, vec3<f32>(t));
-        shadow_values[2u * e + 1u] = vec4<f32>(0.0);
+        shadow_values[2u * e + 1u] = vec4<f32>(0.0, 0.0, 0.0, select(0.0, GRID_INSIDE_SOLID, inside));
         return;
     }
     shadow_values[2u * e] = vec4<f32>(t, log(max(v0.yzw, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
-    shadow_values[2u * e + 1u] = vec4<f32>(v1.xyz / max(v0.yzw - vec3<f32>(v0.x), vec3<f32>(1e-12)), v1.w);
+    let behind = select(v1.w, GRID_INSIDE_SOLID, inside);
+    shadow_values[2u * e + 1u] = vec4<f32>(v1.xyz / max(v0.yzw - vec3<f32>(v0.x), vec3<f32>(1e-12)), behind);
 }
 
 // A light's sweeps are slots 0-7 of its entries: 0 the centre, 1-6 the ring (empty for a narrow

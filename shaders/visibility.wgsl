@@ -1,6 +1,7 @@
 // Visibility pass: every hair segment drawn as a camera-facing ribbon (the fiber's true width, at least
 // camera.min_width_px pixels) into a multisampled R32Float target holding segment + 1 (exact up to 2^24) per sample, with
-// depth. The shading pass reads the samples back; 0 means no hair.
+// depth. The shading pass reads the samples back; 0 means no hair. The occluder (the head) is drawn
+// first, opaque, its samples holding -(triangle + 1) (`vs_occluder`, `fs_occluder`).
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> points: array<vec4<f32>>; // xyz, diameter (cm)
@@ -41,4 +42,28 @@ fn vs_ribbon(@builtin(vertex_index) vi: u32) -> RibbonOut {
 @fragment
 fn fs_ribbon(in: RibbonOut) -> @location(0) f32 {
     return f32(in.segment);
+}
+
+// The occluder: triangles pulled from storage (positions xyz, three indices per triangle), each
+// sample holding -(triangle + 1).
+@group(0) @binding(3) var<storage, read> occluder_positions: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> occluder_triangles: array<u32>;
+
+struct OccluderOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) triangle: u32,
+}
+
+@vertex
+fn vs_occluder(@builtin(vertex_index) vi: u32) -> OccluderOut {
+    var out: OccluderOut;
+    out.triangle = vi / 3u + 1u;
+    let p = occluder_positions[occluder_triangles[vi]].xyz;
+    out.position = camera.view_proj * vec4<f32>(p, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_occluder(in: OccluderOut) -> @location(0) f32 {
+    return -f32(in.triangle);
 }

@@ -164,6 +164,7 @@ fn render_puts_the_hair_over_the_background_asked_for() {
         "TRT.R",
         "MS.global.R",
         "MS.local.R",
+        "occluder.R",
     ];
     let c = common::read_exr_channels(&exr, &names);
     let linear = Background::linear_colour([0x33, 0x66, 0x99])[0];
@@ -177,7 +178,9 @@ fn render_puts_the_hair_over_the_background_asked_for() {
         worst = worst.max((sum - c[0][i]).abs() / c[0][i].abs().max(1e-6));
         hair += (cov > 0.0) as usize;
     }
-    println!("colour background: {hair} hair pixels; layers against the beauty: worst {worst:.2e}");
+    println!(
+        "colour background: {hair} covered pixels (hair and head); layers against the beauty: worst {worst:.2e}"
+    );
     assert!(hair > 20 && worst < 1e-5);
     // Transparent: the PNG keeps the coverage as alpha.
     let png = tmp("transparent.png");

@@ -110,10 +110,18 @@ fn render_writes_a_linear_exr_with_attributes_aovs_and_a_png() {
         }
     };
     let (r, a) = (get("R"), get("A"));
-    let lobes: Vec<Vec<f32>> = ["R.R", "TT.R", "TRT.R", "MS.global.R", "MS.local.R"]
-        .iter()
-        .map(|n| get(n))
-        .collect();
+    // The generated hair's head is in the picture: its own layer.
+    let lobes: Vec<Vec<f32>> = [
+        "R.R",
+        "TT.R",
+        "TRT.R",
+        "MS.global.R",
+        "MS.local.R",
+        "occluder.R",
+    ]
+    .iter()
+    .map(|n| get(n))
+    .collect();
     assert!(a.iter().all(|&x| (0.0..=1.0).contains(&x)));
     let covered = a.iter().filter(|&&x| x > 0.0).count();
     println!("{covered} of {} pixels covered", a.len());

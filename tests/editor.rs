@@ -235,6 +235,7 @@ fn read_exr_beauty(path: &Path, width: u32, height: u32) -> Frame {
         sample_ids: Vec::new(),
         components: Vec::new(),
         background: Vec::new(),
+        occluder: Vec::new(),
     }
 }
 
@@ -938,7 +939,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
             continue;
         }
         let touches = after.sample_ids[i].iter().any(|&id| {
-            id > 0 && {
+            strandlight::render::shade::is_hair(id) && {
                 let p = segment_start[id as usize - 1];
                 painted_point(p) || painted_point(p + 1)
             }

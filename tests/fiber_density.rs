@@ -273,6 +273,7 @@ fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
     };
     let src = GridSources {
         pyramid: &pyramid,
+        occluder: None,
         forward: None,
         skip: 0.0,
     };
@@ -474,6 +475,7 @@ fn swept_forward_scattering_matches_ray_shooting_through_explicit_fibers() {
     );
     let src = GridSources {
         pyramid: &f.pyramid,
+        occluder: None,
         forward: Some((&f.volume, &f.table)),
         skip: 0.0,
     };

@@ -60,6 +60,12 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 Some("ResolveInfo") => {
                     std::mem::size_of::<strandlight::render::resolve::ResolveInfo>()
                 }
+                Some("OccluderInfo") => {
+                    std::mem::size_of::<strandlight::render::occluder::OccluderInfo>()
+                }
+                Some("DisplayInfo") => {
+                    std::mem::size_of::<strandlight::render::display::DisplayInfo>()
+                }
                 _ => continue,
             };
             seen.insert(ty.name.clone().unwrap_or_default());
@@ -72,7 +78,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         println!("{name}: {} lines valid", source.lines().count());
     }
     println!("struct layouts compared: {seen:?}");
-    assert_eq!(seen.len(), 13, "every shared struct was found and compared");
+    assert_eq!(seen.len(), 15, "every shared struct was found and compared");
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {
@@ -200,7 +206,8 @@ fn wgsl_fast_response_equals_the_rust_twin() {
     assert!(worst <= 1e-3, "max relative difference {worst}");
 }
 
-/// The GPU fiber-density pass equals the CPU builder (its twin) voxel by voxel.
+/// The GPU fiber-density pass equals the CPU builder (its twin) voxel by voxel, with the generated
+/// head in it as a solid (`FiberDensity::add_solid`).
 #[test]
 fn gpu_fiber_density_equals_the_cpu_volume() {
     use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
@@ -218,10 +225,14 @@ fn gpu_fiber_density_equals_the_cpu_volume() {
         .map(|(i, &x)| [0.2 + x, 0.5 + 0.1 * (i % 7) as f32, 1.5 - x])
         .collect();
     let voxel = 0.5;
-    let cpu = FiberDensity::build(&hair, &sigma, voxel);
+    let mut cpu = FiberDensity::build(&hair, &sigma, voxel);
     let grid = VolumeGrid::around(&hair, voxel);
+    let head = strandlight::hair::procedural::Head::default().mesh(32, true);
+    let solid = strandlight::shadow::solid::solid_fraction(&grid, &head);
+    cpu.add_solid(&solid);
     let gpu_hair = GpuHair::new(&ctx.device, &hair, &sigma);
     let target = GpuFiberDensity::new(&ctx.device, grid, gpu_hair.segment_count);
+    target.set_solid(&ctx.queue, Some(&solid));
     let pass = FiberDensityPass::new(&ctx.device);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     pass.encode(&ctx.device, &mut enc, &gpu_hair, &target, None);
@@ -251,6 +262,7 @@ fn gpu_fiber_density_equals_the_cpu_volume() {
             (s[0], g[8]),
             (s[1], g[9]),
             (s[2], g[10]),
+            (cpu.solid[v], g[11]),
         ];
         for (k, (a, b)) in pairs.iter().enumerate() {
             // Tensor entries are compared against the voxel's extinction (they can be ~0).

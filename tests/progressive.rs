@@ -31,7 +31,13 @@ fn difference(a: &Frame, b: &Frame) -> f32 {
             worst = worst.max((x[c] - y[c]).abs());
         }
     }
-    for (ca, cb) in a.components.iter().zip(&b.components) {
+    assert_eq!(a.occluder.len(), b.occluder.len());
+    for (ca, cb) in a
+        .components
+        .iter()
+        .chain([&a.occluder])
+        .zip(b.components.iter().chain([&b.occluder]))
+    {
         for (x, y) in ca.iter().zip(cb) {
             for c in 0..3 {
                 worst = worst.max((x[c] - y[c]).abs());
@@ -70,8 +76,13 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let luts = Luts::default_tables();
     let lights = sunny_lights();
     let scene = small_bob(true);
+    // With the head: drawn, shaded batch by batch with the hair, and a solid in the volume.
+    let head = strandlight::render::occluder::Occluder::new(
+        strandlight::hair::procedural::Head::default().mesh(24, true),
+        strandlight::render::occluder::SKIN_ALBEDO,
+    );
     let new = || {
-        Renderer::new(
+        let mut r = Renderer::new(
             &ctx,
             scene.settings.clone(),
             &luts,
@@ -81,7 +92,9 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
             &lights,
             &scene.camera,
         )
-        .expect("renderer")
+        .expect("renderer");
+        r.set_occluder(&ctx, Some(&head));
+        r
     };
     let mut whole = new();
     let mut progressive = new();

@@ -109,6 +109,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             strandlight::scattering::azimuthal_table::AzimuthalTable::for_hair(&s.params);
         let sources = GridSources {
             pyramid: &pyramid,
+            occluder: None,
             forward: multiple.then_some((&volume, &forward)),
             skip: s.settings.shadow_skip(&s.hair),
         };
@@ -352,6 +353,7 @@ fn shadow_grid_sweeps_equal_the_cpu_twin_and_follow_the_cone_march() {
         let forward = ForwardTable::build(&s.params, REFERENCE_VARIANT);
         let sources = GridSources {
             pyramid: &pyramid,
+            occluder: None,
             forward: multiple.then_some((&volume, &forward)),
             skip: s.settings.shadow_skip(&s.hair),
         };

@@ -13,6 +13,7 @@ use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
 use strandlight::render::renderer::build_tables;
 use strandlight::render::scene::{StandardScene, default_environment};
+use strandlight::render::shade::is_hair;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
@@ -355,7 +356,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             .map(|ids| {
                 let ids = &ids[..samples];
                 (0..samples)
-                    .filter(|&k| ids[k] != 0 && !ids[..k].contains(&ids[k]))
+                    .filter(|&k| is_hair(ids[k]) && !ids[..k].contains(&ids[k]))
                     .count()
             })
             .sum();

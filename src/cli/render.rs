@@ -20,8 +20,8 @@ use strandlight::render::{Camera, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::session::assemble::{StillHeader, still_attributes};
 use strandlight::session::{
-    Absorption, EnvironmentSource, HairSource, Look, RenderOptions, SESSION_VERSION, Scene,
-    Session, ViewCamera,
+    Absorption, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions,
+    SESSION_VERSION, Scene, Session, ViewCamera,
 };
 
 #[derive(Args, Debug)]
@@ -75,6 +75,13 @@ pub struct RenderArgs {
     /// Seed of the per-strand variation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The head under the hair: an OBJ or glTF mesh (in the hair file's units and axes), or `none`;
+    /// default: the generated head for generated hair, the mesh a glTF hair file carries.
+    #[arg(long)]
+    pub occluder: Option<PathBuf>,
+    /// The head's diffuse colour (#rrggbb sRGB or r,g,b linear).
+    #[arg(long)]
+    pub skin: Option<String>,
     /// Paint layer (.slpaint, as the editor saves it) applied over the absorption (with --session:
     /// instead of the session's).
     #[arg(long)]
@@ -268,6 +275,16 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
         },
         paint: args.paint.clone(),
         paint_layer: None,
+        occluder: OccluderOptions {
+            show: args.occluder.as_deref() != Some(std::path::Path::new("none")),
+            mesh: args.occluder.clone().filter(|p| p.as_os_str() != "none"),
+            albedo: match &args.skin {
+                Some(c) => parse_colour(c)
+                    .map_err(anyhow::Error::msg)?
+                    .map(|v| v as f32),
+                None => OccluderOptions::default().albedo,
+            },
+        },
     })
 }
 
@@ -304,6 +321,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         look,
         camera,
         mut settings,
+        occluder,
         ..
     } = scene;
     settings.lights_per_pass = args.lights_per_pass;
@@ -335,6 +353,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &env.lights.lights,
         &camera,
     )?;
+    renderer.set_occluder(&ctx, occluder.as_ref());
     // The PNG shows the session's background unless told otherwise; the EXR only a background asked
     // for.
     let png_background = args.background.unwrap_or(session.render.background);

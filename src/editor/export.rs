@@ -67,8 +67,12 @@ impl ExportJob {
             hair: (*live.hair).clone(),
             name: live.hair_name.clone(),
             warning: None,
+            mesh: live.hair_mesh.clone(),
+            normalization: live.normalization,
         };
-        let scene = Scene::from_parts(&session, hair, live.environment.clone(), None)
+        // The head the viewport shows.
+        let occluder = live.occluder.clone();
+        let scene = Scene::from_parts(&session, hair, live.environment.clone(), None, occluder)
             .map_err(|e| e.to_string())?;
         Self::with_scene(live, luts, &session, scene, exr, png, wake, tile)
     }
@@ -106,6 +110,7 @@ impl ExportJob {
         )
         .map_err(|e| e.to_string())?;
         renderer.set_unit_budget(crate::editor::live::unit_budget(&live.ctx));
+        renderer.set_occluder(&live.ctx, scene.occluder.as_ref());
         renderer
             .set_camera_tile(&live.ctx, &scene.camera, tiles[0])
             .map_err(|e| e.to_string())?;

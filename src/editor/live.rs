@@ -8,10 +8,13 @@ use super::jobs::Job;
 use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
 use crate::hair::Hair;
+use crate::hair::TriangleMesh;
+use crate::hair::normalize::Normalization;
 use crate::paint::SharedLayer;
 use crate::paint::brush::effective;
 use crate::render::background::Background;
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
+use crate::render::occluder::Occluder;
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
 use crate::render::renderer::{ParamTables, build_tables};
@@ -21,9 +24,12 @@ use crate::scattering::HairParams;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{
-    LoadedHairSource, base_absorption, mean_absorption, renderer_look, turned_lights,
+    LoadedHairSource, base_absorption, mean_absorption, renderer_look, scene_occluder,
+    turned_lights,
 };
-use crate::session::{AssembleError, EnvironmentSource, HairSource, Look, RenderOptions, Session};
+use crate::session::{
+    AssembleError, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions, Session,
+};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -172,6 +178,7 @@ fn paint_key(session: &Session) -> (Option<std::path::PathBuf>, Option<u64>) {
 #[derive(Clone, Debug, PartialEq)]
 struct Applied {
     look: Look,
+    occluder: OccluderOptions,
     paint: (Option<std::path::PathBuf>, Option<u64>),
     env_yaw: f64,
     render: RenderOptions,
@@ -185,6 +192,11 @@ pub struct LiveScene {
     pub bounds: (glam::Vec3, glam::Vec3),
     pub hair_name: String,
     pub hair_source: HairSource,
+    /// The hair's own occluder mesh and how the hair came into world space (an occluder file of the
+    /// session is brought into it too), and the occluder shown.
+    pub hair_mesh: Option<TriangleMesh>,
+    pub normalization: Normalization,
+    pub occluder: Option<Occluder>,
     /// The environment with its lights unturned.
     pub environment: Environment,
     /// The environment panel's pictures of it (made where the environment was loaded).
@@ -281,11 +293,16 @@ impl LiveScene {
             renderer.set_thickness_scale(&ctx, &hair.hair, session.look.thickness_scale)?;
         }
         let display = DisplayPass::new(&ctx.device, width, height);
+        let occluder = scene_occluder(&session.occluder, hair.mesh.as_ref(), &hair.normalization)?;
+        renderer.set_occluder(&ctx, occluder.as_ref());
         let mut live = Self {
             bounds: hair.hair.bounds(),
             hair: Arc::new(hair.hair),
             hair_name: hair.name,
             hair_source: session.hair.clone(),
+            hair_mesh: hair.mesh,
+            normalization: hair.normalization,
+            occluder,
             environment_pictures: Arc::new(env_preview::pictures(&environment)),
             environment,
             environment_source: session.environment.clone(),
@@ -303,6 +320,7 @@ impl LiveScene {
             thickness_scale: session.look.thickness_scale,
             applied: Applied {
                 look: session.look,
+                occluder: session.occluder.clone(),
                 paint: paint_key(session),
                 env_yaw: session.env_yaw,
                 render: session.render,
@@ -350,6 +368,7 @@ impl LiveScene {
     pub fn needs_rebuild(&self, session: &Session) -> bool {
         let (a, b) = (&self.applied.render, &session.render);
         self.hair_source != session.hair
+            || self.applied.occluder.mesh != session.occluder.mesh
             || self.environment_source != session.environment
             || a.samples != b.samples
             || a.volume_resolution != b.volume_resolution
@@ -406,6 +425,30 @@ impl LiveScene {
             self.renderer
                 .set_background_yaw(&self.ctx, base + session.env_yaw.to_radians() as f32);
             self.applied.env_yaw = session.env_yaw;
+            changed = true;
+        }
+        if session.occluder != self.applied.occluder {
+            // Shown or hidden, or another albedo (another mesh file reloads the scene). Applied
+            // before anything can fail, so a failure is reported once.
+            let only_albedo = session.occluder.show == self.applied.occluder.show;
+            self.applied.occluder = session.occluder.clone();
+            let albedo = session.occluder.albedo;
+            match (&mut self.occluder, only_albedo) {
+                (Some(o), true) => {
+                    session.occluder.validate().map_err(AssembleError::Look)?;
+                    o.albedo = albedo;
+                    self.renderer.set_occluder_albedo(&self.ctx, albedo);
+                }
+                _ => {
+                    self.occluder = scene_occluder(
+                        &session.occluder,
+                        self.hair_mesh.as_ref(),
+                        &self.normalization,
+                    )?;
+                    self.renderer
+                        .set_occluder(&self.ctx, self.occluder.as_ref());
+                }
+            }
             changed = true;
         }
         let (a, b) = (self.applied.render, session.render);

@@ -85,6 +85,9 @@ pub struct GpuFiberDensity {
     pub info: wgpu::Buffer,
     pub sums: wgpu::Buffer,
     pub volume: wgpu::Buffer,
+    /// The fraction of each voxel inside the occluder ([`crate::shadow::solid::solid_fraction`]),
+    /// zero without one.
+    pub solid: wgpu::Buffer,
 }
 
 impl GpuFiberDensity {
@@ -116,6 +119,21 @@ impl GpuFiberDensity {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
+            solid: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("volume solid"),
+                size: n * 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        }
+    }
+
+    /// The occluder's fraction of each voxel (None: no occluder); the next resolve adds it.
+    pub fn set_solid(&self, queue: &wgpu::Queue, fraction: Option<&[f32]>) {
+        let n = self.grid.voxel_count();
+        match fraction {
+            Some(f) if f.len() == n => queue.write_buffer(&self.solid, 0, bytemuck::cast_slice(f)),
+            _ => queue.write_buffer(&self.solid, 0, bytemuck::cast_slice(&vec![0f32; n])),
         }
     }
 
@@ -232,6 +250,10 @@ impl FiberDensityPass {
                 entries.push(wgpu::BindGroupEntry {
                     binding: 5,
                     resource: target.volume.as_entire_binding(),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: target.solid.as_entire_binding(),
                 });
             }
             entries.push(wgpu::BindGroupEntry {

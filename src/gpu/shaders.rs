@@ -16,6 +16,7 @@ pub const CAMERA: &str = include_str!("../../shaders/camera.wgsl");
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const SHADING: &str = include_str!("../../shaders/shading.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
+pub const OCCLUDER: &str = include_str!("../../shaders/occluder.wgsl");
 pub const DUAL_RESPONSE: &str = include_str!("../../shaders/dual_response.wgsl");
 pub const DUAL_EVAL: &str = include_str!("../../shaders/dual_eval.wgsl");
 
@@ -40,6 +41,11 @@ pub fn shadow_grid_build_module() -> String {
 }
 
 /// The visibility pass (ribbons into the multisampled id target).
+/// The occluder's shading: PI, the shadow-grid lookup, camera, and the kernel.
+pub fn occluder_module() -> String {
+    [CIRCULAR_GAUSSIAN, SHADOW_GRID, CAMERA, OCCLUDER].join("\n")
+}
+
 pub fn visibility_module() -> String {
     [CIRCULAR_GAUSSIAN, CAMERA, VISIBILITY].join("\n")
 }
@@ -108,6 +114,8 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ("visibility", visibility_module()),
         ("shading", shading_module()),
         ("resolve", resolve_module()),
+        ("occluder", occluder_module()),
+        ("display", crate::render::display::DISPLAY_WGSL.to_string()),
         ("shadow_grid_build", shadow_grid_build_module()),
         ("dual_eval", dual_eval_module()),
     ]

@@ -34,12 +34,65 @@ impl TriangleMesh {
             .fold(f32::INFINITY, f32::min)
     }
 
+    /// Area-weighted vertex normals (the triangles' winding gives the outside: counter-clockwise seen
+    /// from outside, as OBJ and glTF have it).
+    pub fn vertex_normals(&self) -> Vec<Vec3> {
+        let mut n = vec![Vec3::ZERO; self.positions.len()];
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+            let face = (b - a).cross(c - a);
+            for &i in t {
+                n[i as usize] += face;
+            }
+        }
+        n.into_iter().map(|v| v.normalize_or(Vec3::Y)).collect()
+    }
+
+    /// The nearest hit of the ray (origin, unit direction) beyond `t_min`: (distance, triangle,
+    /// barycentrics (u, v) of the second and third vertices), Moller-Trumbore, both sides.
+    pub fn intersect(&self, origin: Vec3, dir: Vec3, t_min: f32) -> Option<(f32, usize, [f32; 2])> {
+        let mut best: Option<(f32, usize, [f32; 2])> = None;
+        for (k, t) in self.triangles.iter().enumerate() {
+            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+            if let Some((d, uv)) = ray_triangle(origin, dir, a, b, c)
+                && d > t_min
+                && best.is_none_or(|(bd, _, _)| d < bd)
+            {
+                best = Some((d, k, uv));
+            }
+        }
+        best
+    }
+
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.positions.iter().fold(
             (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         )
     }
+}
+
+/// Distance along the ray (origin, dir) to triangle abc and the barycentrics (u, v) of b and c at the
+/// hit (Moller and Trumbore 1997), either side; None when it misses or runs parallel.
+pub fn ray_triangle(origin: Vec3, dir: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Option<(f32, [f32; 2])> {
+    let (e1, e2) = (b - a, c - a);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 * e1.length_squared().max(e2.length_squared()) {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some((e2.dot(q) * inv, [u, v]))
 }
 
 /// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).

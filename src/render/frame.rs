@@ -22,6 +22,9 @@ pub struct Frame {
     /// The environment behind every pixel, exposed like the beauty (empty: the render had no
     /// background map). Not in the beauty: [`Frame::composited`] puts the hair over it.
     pub background: Vec<[f32; 3]>,
+    /// The occluder's radiance (the head), exposed like the components and part of the beauty (empty:
+    /// the render had no occluder).
+    pub occluder: Vec<[f32; 3]>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -136,7 +139,8 @@ impl Frame {
             .collect()
     }
 
-    /// Writes float32 EXR: R, G, B, A; with `aovs`, also Z and <component>.R/G/B for every component.
+    /// Writes float32 EXR: R, G, B, A; with `aovs`, also Z and <component>.R/G/B for every component
+    /// (and the occluder's `occluder.R/G/B` when there is one).
     /// With a background (`Some`, not transparent) R, G, B are the hair over it and A is 1, the hair's
     /// coverage goes to a `coverage` channel and, with `aovs`, (1 - coverage) background to
     /// `background.R/G/B`, so the layers still add up to the beauty.
@@ -171,7 +175,13 @@ impl Frame {
         }
         if aovs {
             channels.push(channel("Z", &|i| self.depth[i]));
-            for (name, data) in COMPONENTS.iter().zip(&self.components) {
+            let occluder = (self.occluder.len() == n).then_some(("occluder", &self.occluder));
+            for (name, data) in COMPONENTS
+                .iter()
+                .copied()
+                .zip(&self.components)
+                .chain(occluder)
+            {
                 for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
                     channels.push(channel(&format!("{name}.{suffix}"), &|i| data[i][c]));
                 }

@@ -175,6 +175,7 @@ impl Renderer {
             enc,
             &p.camera,
             &self.hair,
+            self.occluder.as_ref().map(|o| &o.gpu),
             &p.targets,
             range,
             None,

@@ -1052,6 +1052,7 @@ impl Renderer {
                         enc,
                         &self.camera,
                         &self.hair,
+                        self.occluder.as_ref().map(|o| &o.gpu),
                         &self.targets,
                         first..first + count,
                         None,

@@ -6,6 +6,7 @@
 use super::background::BackgroundMap;
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
+use super::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
 use super::preview::{Preview, PreviewMode};
 use super::progressive::Refinement;
 use super::resolve::{ResolveInfo, ResolvePass};
@@ -33,6 +34,7 @@ use crate::scattering::params::{HairParams, LongitudinalModel};
 use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
 use crate::shadow::forward::ForwardTable;
 use crate::shadow::grid::ShadowGrid;
+use crate::shadow::solid::solid_fraction;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
@@ -242,6 +244,8 @@ pub struct Renderer {
     pub(super) resolve_params: ResolveInfo,
     /// The background's map texels (one zero texel without one).
     pub(super) background_map: wgpu::Buffer,
+    /// The occluder (the head) drawn, shaded and held in the volume as a solid.
+    pub(super) occluder: Option<SceneOccluder>,
     pub(super) targets: FrameTargets,
     pub(super) density_pass: FiberDensityPass,
     pub(super) pyramid_pass: DensityPyramidPass,
@@ -267,6 +271,14 @@ pub struct Renderer {
     /// The frame's visibility pass has drawn the current camera and fibres (refinement reuses it
     /// after a parameter change).
     pub(super) visibility_valid: bool,
+}
+
+/// The occluder as the renderer holds it.
+pub(super) struct SceneOccluder {
+    pub(super) gpu: GpuOccluder,
+    /// Its fraction of each voxel of the volume.
+    solid: Vec<f32>,
+    shadow_offset: f32,
 }
 
 /// The background map's texels as a storage buffer (one zero texel for none: a binding cannot be
@@ -457,6 +469,7 @@ impl Renderer {
             resolve_info: uniform("resolve", bytemuck::bytes_of(&resolve_info)),
             resolve_params: resolve_info,
             background_map: environment_buffer(device, None),
+            occluder: None,
             targets: FrameTargets::new(device, settings.width, settings.height, settings.samples),
             density_pass: FiberDensityPass::new(device),
             pyramid_pass: DensityPyramidPass::new(device),
@@ -847,6 +860,41 @@ impl Renderer {
         Ok(())
     }
 
+    /// The occluder (None: none): drawn opaque in front of the hair behind it, shaded under the lights,
+    /// and added to the fiber-density volume as a solid so that it shadows the hair (the volume and the
+    /// shadow grid are rebuilt; the voxelisation runs here, on the CPU: ~10 ms for the generated head).
+    pub fn set_occluder(&mut self, ctx: &GpuContext, occluder: Option<&Occluder>) {
+        self.occluder = occluder.map(|o| {
+            let offset = SHADOW_OFFSET_SPACINGS * self.shadow_grid.grid.spacing;
+            SceneOccluder {
+                gpu: GpuOccluder::new(&ctx.device, o, offset),
+                solid: solid_fraction(&self.volume.grid, &o.mesh),
+                shadow_offset: offset,
+            }
+        });
+        self.volume.set_solid(
+            &ctx.queue,
+            self.occluder.as_ref().map(|o| o.solid.as_slice()),
+        );
+        self.invalidate_visibility();
+        self.mark_volume_dirty();
+    }
+
+    /// The occluder's albedo alone changed: its shading restarts, nothing else.
+    pub fn set_occluder_albedo(&mut self, ctx: &GpuContext, albedo: [f32; 3]) {
+        if let Some(o) = &self.occluder {
+            o.gpu.set_albedo(&ctx.queue, albedo);
+            self.restart_refinement();
+        }
+    }
+
+    /// The occluder's voxel fractions and the offset its shadow lookups use (tests: the CPU twins).
+    pub fn occluder_solid(&self) -> Option<(&[f32], f32)> {
+        self.occluder
+            .as_ref()
+            .map(|o| (o.solid.as_slice(), o.shadow_offset))
+    }
+
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
@@ -1000,6 +1048,13 @@ impl Renderer {
         ctx.queue.submit([enc.finish()]);
     }
 
+    fn extras(&self) -> Extras {
+        Extras {
+            background: self.has_background(),
+            occluder: self.occluder.is_some(),
+        }
+    }
+
     /// Whether the resolve writes a background (a map was given to [`Renderer::set_background`]).
     pub fn has_background(&self) -> bool {
         self.resolve_params.env_width > 0
@@ -1043,6 +1098,7 @@ impl Renderer {
             shadow_values: &self.shadow_grid.values,
             dual_tables: &self.dual_tables,
             azimuthal_table: &self.azimuthal_table,
+            occluder: self.occluder.as_ref().map(|o| &o.gpu),
         }
     }
 
@@ -1095,6 +1151,7 @@ impl Renderer {
             &mut enc,
             &self.camera,
             &self.hair,
+            self.occluder.as_ref().map(|o| &o.gpu),
             &self.targets,
             0..self.hair.segment_count,
             timer.and_then(|t| t.render_writes("visibility")),
@@ -1183,7 +1240,7 @@ impl Renderer {
         ctx: &GpuContext,
         t: &FrameTargets,
     ) -> Result<Frame, RenderError> {
-        let bytes = frame_buffers(t, self.has_background())
+        let bytes = frame_buffers(t, self.extras())
             .iter()
             .map(|b| ctx.read_buffer::<u8>(b))
             .collect::<Result<Vec<_>, _>>()
@@ -1191,6 +1248,7 @@ impl Renderer {
         Ok(frame_from_bytes(
             (t.width, t.height, t.samples),
             self.settings.exposure,
+            self.extras(),
             &bytes,
         ))
     }
@@ -1199,9 +1257,10 @@ impl Renderer {
     pub fn start_read_frame(&self, ctx: &GpuContext) -> FrameReadBack {
         let t = &self.targets;
         FrameReadBack {
-            pending: ctx.start_read(&frame_buffers(t, self.has_background())),
+            pending: ctx.start_read(&frame_buffers(t, self.extras())),
             shape: (t.width, t.height, t.samples),
             exposure: self.settings.exposure,
+            extras: self.extras(),
         }
     }
 
@@ -1225,13 +1284,23 @@ impl Renderer {
     }
 }
 
+/// What a frame reads besides the always-read buffers.
+#[derive(Clone, Copy, Debug)]
+struct Extras {
+    background: bool,
+    occluder: bool,
+}
+
 /// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them (the background
-/// last, when there is one).
-fn frame_buffers(t: &FrameTargets, background: bool) -> Vec<&wgpu::Buffer> {
+/// and the occluder last, when there are some).
+fn frame_buffers(t: &FrameTargets, extras: Extras) -> Vec<&wgpu::Buffer> {
     let mut v = vec![&t.beauty, &t.view_depth, &t.sample_ids];
     v.extend(t.components.iter());
-    if background {
+    if extras.background {
         v.push(&t.background);
+    }
+    if extras.occluder {
+        v.push(&t.occluder);
     }
     v
 }
@@ -1241,6 +1310,7 @@ fn frame_buffers(t: &FrameTargets, background: bool) -> Vec<&wgpu::Buffer> {
 fn frame_from_bytes(
     (width, height, samples): (u32, u32, u32),
     exposure: f32,
+    extras: Extras,
     bytes: &[Vec<u8>],
 ) -> Frame {
     let scale = exposure.exp2();
@@ -1259,15 +1329,17 @@ fn frame_from_bytes(
         sample_ids: bytemuck::pod_collect_to_vec(&bytes[2]),
         components: bytes[3..3 + COMPONENTS.len()].iter().map(rgb).collect(),
         // Exposed by the resolve already.
-        background: bytes
-            .get(3 + COMPONENTS.len())
-            .map(|b| {
-                bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b)
-                    .into_iter()
-                    .map(|p| [p[0], p[1], p[2]])
-                    .collect()
-            })
-            .unwrap_or_default(),
+        background: match extras.background {
+            true => bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes[3 + COMPONENTS.len()])
+                .into_iter()
+                .map(|p| [p[0], p[1], p[2]])
+                .collect(),
+            false => Vec::new(),
+        },
+        occluder: match extras.occluder {
+            true => rgb(&bytes[3 + COMPONENTS.len() + extras.background as usize]),
+            false => Vec::new(),
+        },
     }
 }
 
@@ -1276,6 +1348,7 @@ pub struct FrameReadBack {
     pending: crate::gpu::context::PendingRead,
     shape: (u32, u32, u32),
     exposure: f32,
+    extras: Extras,
 }
 
 impl FrameReadBack {
@@ -1285,6 +1358,11 @@ impl FrameReadBack {
             Ok(b) => b,
             Err(e) => return Some(Err(RenderError::Gpu(e))),
         };
-        Some(Ok(frame_from_bytes(self.shape, self.exposure, &bytes)))
+        Some(Ok(frame_from_bytes(
+            self.shape,
+            self.exposure,
+            self.extras,
+            &bytes,
+        )))
     }
 }

@@ -107,7 +107,12 @@ impl ResolvePass {
                 resource: b.as_entire_binding(),
             });
         }
-        for (binding, b) in [(12, &band), (13, environment), (14, &targets.background)] {
+        for (binding, b) in [
+            (12, &band),
+            (13, environment),
+            (14, &targets.background),
+            (15, &targets.occluder),
+        ] {
             entries.push(wgpu::BindGroupEntry {
                 binding,
                 resource: b.as_entire_binding(),

@@ -175,10 +175,15 @@ pub fn shade_point(
     out
 }
 
+/// Whether a resolved sample id names a hair segment (segment + 1; not 0, not the occluder's).
+pub fn is_hair(id: u32) -> bool {
+    id != 0 && id & super::occluder::OCCLUDER_ID_BIT == 0
+}
+
 /// The distinct segments among a pixel's sample ids with their counts (ids are segment + 1).
 pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
     let mut out: Vec<(u32, u32)> = Vec::new();
-    for &v in ids.iter().filter(|&&v| v != 0) {
+    for &v in ids.iter().filter(|&&v| is_hair(v)) {
         match out.iter_mut().find(|(id, _)| *id == v) {
             Some(e) => e.1 += 1,
             None => out.push((v, 1)),
@@ -190,8 +195,8 @@ pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
 /// The preview's one segment per pixel (twin of the WGSL's `SLOT_REPRESENTATIVE` branch): the first
 /// covered sample's segment id, standing for all the covered samples (their count).
 pub fn representative_sample(ids: &[u32]) -> Option<(u32, u32)> {
-    let first = *ids.iter().find(|&&v| v != 0)?;
-    Some((first, ids.iter().filter(|&&v| v != 0).count() as u32))
+    let first = *ids.iter().find(|&&v| is_hair(v))?;
+    Some((first, ids.iter().filter(|&&v| is_hair(v)).count() as u32))
 }
 
 /// Which of a pixel's samples are shaded: each distinct segment with its count (the frame), or one

@@ -3,6 +3,7 @@
 //! TRT radiance (and with multiple scattering MS.global and MS.local) to the component buffers; one
 //! dispatch per visibility sample within a batch.
 
+use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
 use super::targets::FrameTargets;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
@@ -58,10 +59,13 @@ pub struct ShadingInputs<'a> {
     pub shadow_values: &'a wgpu::Buffer,
     pub dual_tables: &'a wgpu::Buffer,
     pub azimuthal_table: &'a wgpu::Buffer,
+    /// The occluder, shaded with the first visibility sample's batches (and the preview's).
+    pub occluder: Option<&'a GpuOccluder>,
 }
 
 pub struct ShadingPass {
     pipeline: wgpu::ComputePipeline,
+    occluder: OccluderPass,
     batches: Vec<(ShadeBatch, wgpu::Buffer)>,
 }
 
@@ -82,6 +86,7 @@ impl ShadingPass {
         });
         Self {
             pipeline: compute_pipeline(device, &module, "shade"),
+            occluder: OccluderPass::new(device),
             batches: Vec::new(),
         }
     }
@@ -107,9 +112,9 @@ impl ShadingPass {
         self.batches.iter().map(|(b, _)| b)
     }
 
-    /// Zeroes the component buffers (the start of a frame's shading).
+    /// Zeroes the component buffers and the occluder's (the start of a frame's shading).
     pub fn clear(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
-        for b in &targets.components {
+        for b in targets.components.iter().chain([&targets.occluder]) {
             encoder.clear_buffer(b, 0, None);
         }
     }
@@ -187,7 +192,7 @@ impl ShadingPass {
             .map(|(_, batch)| self.bind(device, inputs, targets, batch))
             .collect();
         let last = binds.len().saturating_sub(1);
-        for (k, bind) in binds.iter().enumerate() {
+        for (k, (bind, (b, _))) in binds.iter().zip(&self.batches).enumerate() {
             let timestamp_writes = timestamps
                 .as_ref()
                 .filter(|_| k == 0 || k == last)
@@ -205,6 +210,25 @@ impl ShadingPass {
                 targets.height,
                 timestamp_writes,
             );
+            self.encode_occluder(device, encoder, inputs, targets, b);
+        }
+    }
+
+    /// The occluder's shading under the batch's lights, when there is an occluder and the batch is one
+    /// that shades it ([`shades_occluder`]).
+    fn encode_occluder(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        batch: &ShadeBatch,
+    ) {
+        if let Some(o) = inputs.occluder
+            && shades_occluder(batch)
+        {
+            self.occluder
+                .encode(device, encoder, inputs, o, targets, batch);
         }
     }
 
@@ -222,5 +246,6 @@ impl ShadingPass {
         let uniform = batch_uniform(device, batch);
         let bind = self.bind(device, inputs, targets, &uniform);
         self.dispatch(encoder, &bind, targets.width, batch.rows, timestamps);
+        self.encode_occluder(device, encoder, inputs, targets, batch);
     }
 }

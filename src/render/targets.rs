@@ -23,6 +23,8 @@ pub struct FrameTargets {
     pub sample_ids: wgpu::Buffer,
     /// The environment behind every pixel, exposed (RGB, A = 1; zero without a background map).
     pub background: wgpu::Buffer,
+    /// The occluder's radiance, coverage-weighted like the components (zero without one).
+    pub occluder: wgpu::Buffer,
 }
 
 impl FrameTargets {
@@ -68,6 +70,7 @@ impl FrameTargets {
             view_depth: buffer("view depth", 4),
             sample_ids: buffer("sample ids", 16),
             background: buffer("background", 16),
+            occluder: buffer("occluder", 16),
         }
     }
 }

@@ -32,6 +32,7 @@ pub fn empty_frame(width: u32, height: u32, samples: u32, components: usize) -> 
         sample_ids: vec![[0; 4]; n],
         components: vec![vec![[0.0; 3]; n]; components],
         background: Vec::new(),
+        occluder: Vec::new(),
     }
 }
 
@@ -39,6 +40,7 @@ pub fn empty_frame(width: u32, height: u32, samples: u32, components: usize) -> 
 pub fn paste(full: &mut Frame, tile: &Tile, part: &Frame) {
     let [x0, y0] = tile.origin.map(|v| v as usize);
     let (tw, fw) = (part.width as usize, full.width as usize);
+    let n = full.pixel_count();
     for y in 0..part.height as usize {
         let (src, dst) = (y * tw, (y0 + y) * fw + x0);
         full.beauty[dst..dst + tw].copy_from_slice(&part.beauty[src..src + tw]);
@@ -47,11 +49,16 @@ pub fn paste(full: &mut Frame, tile: &Tile, part: &Frame) {
         for (f, p) in full.components.iter_mut().zip(&part.components) {
             f[dst..dst + tw].copy_from_slice(&p[src..src + tw]);
         }
-        if !part.background.is_empty() {
-            if full.background.is_empty() {
-                full.background = vec![[0.0; 3]; full.pixel_count()];
+        for (f, p) in [
+            (&mut full.background, &part.background),
+            (&mut full.occluder, &part.occluder),
+        ] {
+            if !p.is_empty() {
+                if f.is_empty() {
+                    *f = vec![[0.0; 3]; n];
+                }
+                f[dst..dst + tw].copy_from_slice(&p[src..src + tw]);
             }
-            full.background[dst..dst + tw].copy_from_slice(&part.background[src..src + tw]);
         }
     }
 }

@@ -1,12 +1,14 @@
 //! The visibility pass: hair segments as camera-facing ribbons into the multisampled id and depth
 //! targets (`shaders/visibility.wgsl`).
 
+use super::occluder::GpuOccluder;
 use super::targets::{DEPTH_FORMAT, FrameTargets, VISIBILITY_FORMAT};
 use crate::gpu::fiber_density::GpuHair;
 use crate::gpu::shaders;
 
 pub struct VisibilityPass {
     pipeline: wgpu::RenderPipeline,
+    occluder: wgpu::RenderPipeline,
 }
 
 impl VisibilityPass {
@@ -15,12 +17,27 @@ impl VisibilityPass {
             label: Some("visibility"),
             source: wgpu::ShaderSource::Wgsl(shaders::visibility_module().into()),
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        Self {
+            pipeline: Self::pipeline(device, &module, samples, "ribbon"),
+            occluder: Self::pipeline(device, &module, samples, "occluder"),
+        }
+    }
+
+    /// The pipeline of entry points `vs_<what>` and `fs_<what>` (the same targets, depth test and
+    /// multisampling).
+    fn pipeline(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        samples: u32,
+        what: &str,
+    ) -> wgpu::RenderPipeline {
+        let (vs, fs) = (format!("vs_{what}"), format!("fs_{what}"));
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("visibility"),
             layout: None,
             vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_ribbon"),
+                module,
+                entry_point: Some(&vs),
                 compilation_options: Default::default(),
                 buffers: &[],
             },
@@ -42,8 +59,8 @@ impl VisibilityPass {
                 alpha_to_coverage_enabled: false,
             },
             fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_ribbon"),
+                module,
+                entry_point: Some(&fs),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: VISIBILITY_FORMAT,
@@ -53,13 +70,12 @@ impl VisibilityPass {
             }),
             multiview_mask: None,
             cache: None,
-        });
-        Self { pipeline }
+        })
     }
 
     /// Draws segments `range` (all of them for a whole frame; progressive refinement's bounded units
-    /// draw parts): the range starting at 0 clears the targets, later ones draw over them (in order,
-    /// so the depth test's ties resolve as in one draw).
+    /// draw parts): the range starting at 0 clears the targets and draws the occluder first, later
+    /// ones draw over them (in order, so the depth test's ties resolve as in one draw).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -67,6 +83,7 @@ impl VisibilityPass {
         encoder: &mut wgpu::CommandEncoder,
         camera: &wgpu::Buffer,
         hair: &GpuHair,
+        occluder: Option<&GpuOccluder>,
         targets: &FrameTargets,
         range: std::ops::Range<u32>,
         timestamps: Option<wgpu::RenderPassTimestampWrites>,
@@ -121,6 +138,29 @@ impl VisibilityPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        if let Some(o) = occluder.filter(|_| clear) {
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("visibility occluder"),
+                layout: &self.occluder.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: camera.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: o.positions.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: o.triangles.as_entire_binding(),
+                    },
+                ],
+            });
+            pass.set_pipeline(&self.occluder);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3 * o.triangle_count, 0..1);
+        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         let end = range.end.min(hair.segment_count);

@@ -2,12 +2,15 @@
 //! the per-point absorption, the look in the renderer's form, the camera and the render settings. The
 //! CLI's `render` and the editor both build their scenes here.
 
-use super::model::{EnvironmentSource, HairSource, Look, Session};
+use super::model::{EnvironmentSource, HairSource, Look, OccluderOptions, Session};
 use crate::envmap::{SrbfSet, load_env};
 use crate::hair::Hair;
-use crate::hair::load::{LoadOptions, load_hair};
+use crate::hair::TriangleMesh;
+use crate::hair::load::{LoadOptions, load_hair, load_mesh};
+use crate::hair::normalize::Normalization;
 use crate::hair::procedural::generate;
 use crate::paint::{AbsorptionSpec, PaintLayer};
+use crate::render::occluder::Occluder;
 use crate::render::scene::{Environment, default_environment, load_environment};
 use crate::render::{Camera, HairLook, RenderSettings};
 use std::path::Path;
@@ -34,7 +37,23 @@ pub struct LoadedHairSource {
     pub hair: Hair,
     pub name: String,
     pub warning: Option<String>,
+    /// The hair's own occluder: the generated head, or the mesh a glTF file carries.
+    pub mesh: Option<TriangleMesh>,
+    /// How the file came into world space (an occluder file of the session gets the same).
+    pub normalization: Normalization,
 }
+
+/// The generator's space: centimetres, +Y up, as it is.
+pub const GENERATOR_SPACE: Normalization = Normalization {
+    up: crate::hair::normalize::UpAxis::PosY,
+    up_source: "generator",
+    units: crate::hair::normalize::Units::Centimetres,
+    units_detected: false,
+    scale: 1.0,
+};
+
+/// Latitude rings of the generated head's mesh (64 vertices a ring: ~3k triangles).
+pub const HEAD_RINGS: usize = 32;
 
 /// BLAKE3 of a file's bytes, hex.
 pub fn file_blake3(path: &Path) -> std::io::Result<String> {
@@ -69,6 +88,8 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 hair: generate(&params).map_err(|e| AssembleError::Generator(name.clone(), e))?,
                 name,
                 warning: None,
+                mesh: Some(params.head.mesh(HEAD_RINGS, true)),
+                normalization: GENERATOR_SPACE,
             }
         }
         HairSource::File { path, blake3 } => {
@@ -77,6 +98,8 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 hair: loaded.file.hair,
                 name: path.display().to_string(),
                 warning: changed_warning(path, blake3),
+                mesh: loaded.file.mesh,
+                normalization: loaded.normalization,
             }
         }
     };
@@ -203,6 +226,27 @@ pub fn renderer_look(look: &Look, mean_sigma_a: [f64; 3]) -> HairLook {
         .with_longitudinal(look.longitudinal)
 }
 
+/// The occluder of options `o` for a hair with its own mesh `own` (in world space) that came into
+/// world space by `normalization`: none when hidden, else the options' mesh file (brought into the
+/// hair's space) or the hair's own, with the options' albedo.
+pub fn scene_occluder(
+    o: &OccluderOptions,
+    own: Option<&TriangleMesh>,
+    normalization: &Normalization,
+) -> Result<Option<Occluder>, AssembleError> {
+    if !o.show {
+        return Ok(None);
+    }
+    o.validate().map_err(AssembleError::Look)?;
+    let mesh = match &o.mesh {
+        Some(path) => Some(load_mesh(path, normalization)?),
+        None => own.cloned(),
+    };
+    Ok(mesh
+        .filter(|m| !m.triangles.is_empty())
+        .map(|m| Occluder::new(m, o.albedo)))
+}
+
 /// Everything the renderer is built from.
 pub struct Scene {
     pub hair: Hair,
@@ -213,6 +257,8 @@ pub struct Scene {
     pub look: HairLook,
     pub camera: Camera,
     pub settings: RenderSettings,
+    /// The head (or another mesh) the hair sits on.
+    pub occluder: Option<Occluder>,
     /// Files that changed since the session recorded them (the scene still opened).
     pub warnings: Vec<String>,
 }
@@ -222,15 +268,18 @@ impl Scene {
     pub fn assemble(session: &Session) -> Result<Self, AssembleError> {
         let hair = load_hair_source(&session.hair)?;
         let (environment, env_warning) = load_environment_source(&session.environment)?;
-        Self::from_parts(session, hair, environment, env_warning)
+        let occluder = scene_occluder(&session.occluder, hair.mesh.as_ref(), &hair.normalization)?;
+        Self::from_parts(session, hair, environment, env_warning, occluder)
     }
 
-    /// The scene from an already loaded hair and environment (the editor reloads only what changed).
+    /// The scene from an already loaded hair, environment and occluder (the editor reloads only what
+    /// changed).
     pub fn from_parts(
         session: &Session,
         mut hair: LoadedHairSource,
         mut environment: Environment,
         env_warning: Option<String>,
+        occluder: Option<Occluder>,
     ) -> Result<Self, AssembleError> {
         let (sigma_a, look) = session_absorption(session, &hair.hair)?;
         // The look's thickness scale (after absorption, which validated the look).
@@ -250,6 +299,7 @@ impl Scene {
             look,
             camera,
             settings: r.settings(r.width, r.height),
+            occluder,
         })
     }
 }

@@ -2,7 +2,7 @@
 //! session and returns the edit that undoes it. Undo/redo, autosave and the tests replay the same values.
 //! Camera moves are not edits (they are saved with the session but not undone).
 
-use super::model::{EnvironmentSource, HairSource, Look, RenderOptions, Session};
+use super::model::{EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions, Session};
 use crate::paint::{PaintDelta, SharedLayer};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -24,6 +24,8 @@ pub enum Edit {
     /// The whole paint layer and the file it is saved to (clearing it; undoing a stroke that made
     /// the layer).
     PaintLayer(Box<(Option<SharedLayer>, Option<PathBuf>)>),
+    /// The head (the occluder): shown or not, its mesh file, its albedo.
+    Occluder(Box<OccluderOptions>),
 }
 
 /// What an edit touches: consecutive edits of the same kind during one gesture (a slider drag) merge
@@ -37,6 +39,7 @@ pub enum EditKind {
     Environment,
     Paint,
     PaintLayer,
+    Occluder,
 }
 
 impl Edit {
@@ -49,6 +52,7 @@ impl Edit {
             Edit::Environment(_) => EditKind::Environment,
             Edit::Paint(_) => EditKind::Paint,
             Edit::PaintLayer(_) => EditKind::PaintLayer,
+            Edit::Occluder(_) => EditKind::Occluder,
         }
     }
 
@@ -62,6 +66,7 @@ impl Edit {
             Edit::Environment(_) => "environment",
             Edit::Paint(_) => "paint stroke",
             Edit::PaintLayer(_) => "paint layer",
+            Edit::Occluder(_) => "head",
         }
     }
 
@@ -103,6 +108,7 @@ pub fn apply(session: &mut Session, edit: Edit) -> Edit {
             }
             Edit::Paint(d)
         }
+        Edit::Occluder(o) => Edit::Occluder(Box::new(std::mem::replace(&mut session.occluder, *o))),
         Edit::PaintLayer(l) => {
             let (layer, path) = *l;
             Edit::PaintLayer(Box::new((

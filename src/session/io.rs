@@ -153,6 +153,7 @@ impl Session {
     /// Checks the values a file could get wrong.
     pub fn validate(&self) -> Result<(), String> {
         self.look.validate()?;
+        self.occluder.validate()?;
         let r = &self.render;
         if !matches!(r.samples, 2 | 4) {
             return Err(format!("render samples must be 2 or 4, got {}", r.samples));

@@ -13,6 +13,6 @@ pub use edit::{Edit, EditKind, apply};
 pub use history::History;
 pub use io::{SessionError, write_atomic};
 pub use model::{
-    Absorption, EnvironmentSource, HairSource, Look, RenderOptions, SESSION_VERSION, Session,
-    ViewCamera,
+    Absorption, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions,
+    SESSION_VERSION, Session, ViewCamera,
 };

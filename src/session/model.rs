@@ -356,6 +356,49 @@ pub struct Session {
     /// opened). When present it is the session's paint, whatever the file holds.
     #[serde(skip)]
     pub paint_layer: Option<crate::paint::SharedLayer>,
+    /// The head (or another mesh) the hair sits on: drawn, shaded and shadowing the hair.
+    #[serde(default)]
+    pub occluder: OccluderOptions,
+}
+
+/// The occluder: the generated head for generated hair, the mesh a glTF hair file carries, or a mesh
+/// file of its own (in the hair file's units and axes).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OccluderOptions {
+    pub show: bool,
+    /// An OBJ or glTF mesh instead of the hair's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    /// Diffuse albedo (linear RGB).
+    pub albedo: [f32; 3],
+}
+
+impl Default for OccluderOptions {
+    fn default() -> Self {
+        Self {
+            show: true,
+            mesh: None,
+            albedo: crate::render::occluder::SKIN_ALBEDO,
+        }
+    }
+}
+
+impl OccluderOptions {
+    pub fn validate(&self) -> Result<(), String> {
+        if self
+            .albedo
+            .iter()
+            .all(|a| a.is_finite() && (0.0..=1.0).contains(a))
+        {
+            Ok(())
+        } else {
+            Err(format!(
+                "the occluder's albedo lies in [0, 1], got {:?}",
+                self.albedo
+            ))
+        }
+    }
 }
 
 impl Default for Session {
@@ -372,6 +415,7 @@ impl Default for Session {
             render: RenderOptions::default(),
             paint: None,
             paint_layer: None,
+            occluder: OccluderOptions::default(),
         }
     }
 }

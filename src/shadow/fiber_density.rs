@@ -28,6 +28,8 @@ pub struct FiberDensity {
     pub absorption: Vec<[f32; 3]>,
     /// rho_L, cm of fiber per cm^3.
     pub length_density: Vec<f32>,
+    /// The fraction of the voxel inside an occluder ([`FiberDensity::add_solid`]; empty: none).
+    pub solid: Vec<f32>,
 }
 
 /// Distance from p along omega (unit) to where the ray leaves the box origin + voxel * [0, dims];
@@ -189,6 +191,7 @@ impl FiberDensity {
             extinction_tensor: vec![[0.0; 6]; n],
             absorption: vec![[0.0; 3]; n],
             length_density: vec![0.0; n],
+            solid: Vec::new(),
         };
         for v in 0..n {
             if length[v] <= 0.0 {
@@ -204,6 +207,38 @@ impl FiberDensity {
             out.absorption[v] = std::array::from_fn(|c| (absorption[v][c] / length[v]) as f32);
         }
         out
+    }
+
+    /// Adds an opaque solid (an occluder) with `fraction` of each voxel inside it
+    /// ([`super::solid::solid_fraction`]): its isotropic extinction, and the extinction-weighted mix of
+    /// the fibers' absorption with the solid's. Twin of `resolve` in `shaders/fiber_density.wgsl`.
+    pub fn add_solid(&mut self, fraction: &[f32]) {
+        use super::solid::{SOLID_SIGMA_A, solid_extinction};
+        self.solid = fraction.to_vec();
+        self.solid.resize(self.extinction.len(), 0.0);
+        for (v, &s) in fraction.iter().enumerate().take(self.extinction.len()) {
+            if s <= 0.0 {
+                continue;
+            }
+            let a_s = solid_extinction(s, self.voxel);
+            let a_h = self.extinction[v];
+            self.absorption[v] = self.absorption[v].map(|sig| {
+                if a_h > 0.0 {
+                    (a_h * sig + a_s * SOLID_SIGMA_A) / (a_h + a_s)
+                } else {
+                    SOLID_SIGMA_A
+                }
+            });
+            self.extinction[v] = a_h + a_s;
+        }
+    }
+
+    /// Whether p lies in a voxel more than half inside the occluder (the shadow grid's points there are
+    /// left out of its interpolation: their transmittance is the solid's, not the hair's).
+    pub fn inside_solid(&self, p: Vec3) -> bool {
+        self.voxel_at(p)
+            .and_then(|v| self.solid.get(v))
+            .is_some_and(|&s| s > 0.5)
     }
 
     /// The voxel containing p.

@@ -12,6 +12,8 @@ use glam::Vec3;
 
 /// Floor of the stored transmittances (they are stored as logarithms).
 pub const GRID_MIN_TRANSMITTANCE: f32 = 1e-8;
+/// depth_behind of a grid point inside the occluder: left out of the interpolation.
+pub const GRID_INSIDE_SOLID: f32 = -1.0;
 
 /// What the shading pass reads per light at a point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -60,6 +62,8 @@ pub fn srbf_forward(
 /// The sources the grid is built from (CPU twin).
 pub struct GridSources<'a> {
     pub pyramid: &'a DensityPyramid,
+    /// The volume whose solid marks the points inside the occluder ([`FiberDensity::inside_solid`]).
+    pub occluder: Option<&'a FiberDensity>,
     /// With the forward table: multiple scattering on.
     pub forward: Option<(&'a FiberDensity, &'a ForwardTable)>,
     pub skip: f32,
@@ -149,18 +153,41 @@ impl GridValues {
 
     /// The grid's trilinear reading at p for light `light` (of the logarithms, for the
     /// transmittances): what the shading pass reads (`grid_shadow` in `shaders/shadow_grid.wgsl`).
+    /// Points inside the occluder (depth_behind = [`GRID_INSIDE_SOLID`]) are left out and the
+    /// others' weights renormalised, unless every corner is inside.
     pub fn shadow(&self, p: Vec3, light: usize) -> GridShadow {
         let values = &self.lights[light];
-        let mut out = GridShadow::default();
-        for (i, w) in self.grid.corners(p) {
-            let v = values[i];
+        let add = |out: &mut GridShadow, v: &GridShadow, w: f32| {
             out.transmittance += w * v.transmittance;
             out.depth_behind += w * v.depth_behind;
             for c in 0..3 {
                 out.transmittance_f[c] += w * v.transmittance_f[c];
                 out.sigma_f2[c] += w * v.sigma_f2[c];
             }
+        };
+        let (mut all, mut outside, mut wo, mut any_inside) =
+            (GridShadow::default(), GridShadow::default(), 0.0, false);
+        for (i, w) in self.grid.corners(p) {
+            let v = values[i];
+            add(&mut all, &v, w);
+            if v.depth_behind >= 0.0 {
+                add(&mut outside, &v, w);
+                wo += w;
+            } else {
+                any_inside = true;
+            }
         }
+        let mut out = all;
+        if any_inside && wo > 1e-4 {
+            out = outside;
+            out.transmittance /= wo;
+            out.depth_behind /= wo;
+            for c in 0..3 {
+                out.transmittance_f[c] /= wo;
+                out.sigma_f2[c] /= wo;
+            }
+        }
+        out.depth_behind = out.depth_behind.max(0.0);
         out.transmittance = out.transmittance.exp();
         out.transmittance_f = out.transmittance_f.map(f32::exp);
         out

@@ -6,6 +6,7 @@ pub mod fiber_grid;
 pub mod forward;
 pub mod grid;
 pub mod ray_shooting;
+pub mod solid;
 pub mod sweep;
 
 pub use cone::DensityPyramid;

@@ -15,7 +15,7 @@
 use super::cone::{DensityPyramid, srbf_cones};
 use super::fiber_density::FiberDensity;
 use super::forward::{ForwardTable, PathIntegrals, forward_integrand, forward_spread_weighted};
-use super::grid::{GRID_MIN_TRANSMITTANCE, GridShadow, GridSources, ShadowGrid};
+use super::grid::{GRID_INSIDE_SOLID, GRID_MIN_TRANSMITTANCE, GridShadow, GridSources, ShadowGrid};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -258,5 +258,14 @@ pub fn sweep_light(
             accumulate(&mut acc[i], &d, f, forward);
         });
     }
-    acc.iter().map(|a| finish(a, forward)).collect()
+    acc.iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let mut g = finish(a, forward);
+            if src.occluder.is_some_and(|v| v.inside_solid(grid.point(i))) {
+                g.depth_behind = GRID_INSIDE_SOLID;
+            }
+            g
+        })
+        .collect()
 }

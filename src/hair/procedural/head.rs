@@ -1,6 +1,7 @@
 //! The generated head: an ellipsoid skull with a scalp region bounded by a hairline.
 //! Face towards +Z, crown towards +Y, centre at the origin, centimetres.
 
+use crate::hair::mesh::TriangleMesh;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -45,6 +46,77 @@ impl Head {
         }
         let v = if r > 1e-6 { v / r } else { Vec3::Y };
         self.centre + v * limit * self.radii
+    }
+
+    /// The skull as a closed triangle mesh (outward winding, counter-clockwise seen from outside):
+    /// latitude rings from the crown down, `2 rings` vertices each. With a neck, the rings stop at the
+    /// first one below the equator narrower than the neck (radius 0.45 of the head's narrower half
+    /// axis), a flat annulus joins it to a cylinder that runs down to two half-heights below the
+    /// centre, and a disc closes it.
+    pub fn mesh(&self, rings: usize, neck: bool) -> TriangleMesh {
+        use std::f32::consts::{PI, TAU};
+        let rings = rings.max(3);
+        let n = 2 * rings;
+        let narrow = self.radii.x.min(self.radii.z);
+        let neck_r = 0.45 * narrow;
+        let polar = |i: usize| PI * i as f32 / rings as f32;
+        let count = if neck {
+            (rings / 2 + 1..=rings)
+                .find(|&i| polar(i).sin() * narrow < neck_r)
+                .unwrap_or(rings)
+                + 1
+        } else {
+            rings + 1
+        };
+        let around = |j: usize| {
+            let az = TAU * j as f32 / n as f32;
+            Vec3::new(az.sin(), 0.0, az.cos())
+        };
+        let mut positions = Vec::new();
+        for i in 0..count {
+            let p = polar(i);
+            for j in 0..n {
+                let dir = around(j) * p.sin() + Vec3::Y * p.cos();
+                positions.push(self.centre + dir * self.radii);
+            }
+        }
+        let mut triangles = Vec::new();
+        // Quads between two rings starting at vertices `upper` and `lower`.
+        let band = |triangles: &mut Vec<[u32; 3]>, upper: usize, lower: usize| {
+            for j in 0..n {
+                let k = (j + 1) % n;
+                let (a, b, c, d) = (upper + j, upper + k, lower + j, lower + k);
+                triangles.push([a as u32, c as u32, b as u32]);
+                triangles.push([b as u32, c as u32, d as u32]);
+            }
+        };
+        for i in 0..count - 1 {
+            band(&mut triangles, i * n, (i + 1) * n);
+        }
+        if neck {
+            let top = (count - 1) * n;
+            let y0 = positions[top].y;
+            let bottom = self.centre.y - 2.0 * self.radii.y;
+            let base = positions.len();
+            for y in [y0, bottom] {
+                for j in 0..n {
+                    positions
+                        .push(self.centre + around(j) * neck_r + Vec3::Y * (y - self.centre.y));
+                }
+            }
+            band(&mut triangles, top, base);
+            band(&mut triangles, base, base + n);
+            let centre = positions.len() as u32;
+            positions.push(Vec3::new(self.centre.x, bottom, self.centre.z));
+            let low = base + n;
+            for j in 0..n {
+                triangles.push([(low + j) as u32, centre, (low + (j + 1) % n) as u32]);
+            }
+        }
+        TriangleMesh {
+            positions,
+            triangles,
+        }
     }
 
     /// Whether the unit direction from the centre lies on the scalp: above a hairline that sits at

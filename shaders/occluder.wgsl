@@ -1,0 +1,155 @@
+// Occluder shading (the head): for every pixel, the distinct occluder triangles among its visibility
+// samples, each shaded at the pixel ray's hit on the triangle's plane with the interpolated vertex
+// normal, as a diffuse surface under one batch of SRBF lights: albedo / pi times each light's
+// irradiance (Hill's fitted SG-cosine convolution, `sg_irradiance`) times its transmittance through
+// the hair, read from the shadow grid a little off the surface (outside the grid: 1). Weighted by the
+// samples' coverage and added to the occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
+// Prepended: circular_gaussian (PI), shadow_grid, camera.
+
+struct ShadeBatch {
+    first: u32,
+    count: u32,
+    flags: u32,
+    samples: u32,
+    slot: u32,
+    row0: u32,
+    rows: u32,
+    _p2: u32,
+}
+
+struct OccluderInfo {
+    albedo: vec3<f32>,
+    // How far off the surface, along its normal, the shadow grid is read (cm).
+    normal_offset: f32,
+}
+
+const FLAG_SHADOWS: u32 = 1u;
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var<storage, read> batch: ShadeBatch;
+@group(0) @binding(2) var<uniform> shadow_grid: ShadowGridInfo;
+@group(0) @binding(3) var<storage, read> lights: array<GpuLight>;
+@group(0) @binding(4) var<storage, read> shadow_values: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> normals: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> triangles: array<u32>;
+@group(0) @binding(8) var<storage, read> info: OccluderInfo;
+@group(0) @binding(9) var visibility: texture_multisampled_2d<f32>;
+@group(0) @binding(10) var<storage, read_write> occluder: array<vec4<f32>>;
+
+// Irradiance of an SRBF of unit amplitude, G(w) = exp(2 (w.xi - 1) / lambda^2), on a surface whose
+// normal makes cosine `mu` with its centre: Hill 2016's fitted convolution with the clamped cosine
+// (sharpness s = 2 / lambda^2), normalised, times 2 pi / s. Twin of sg_irradiance in occluder.rs.
+fn sg_irradiance(mu: f32, lambda: f32) -> f32 {
+    let s = 2.0 / (lambda * lambda);
+    let c0 = 0.36;
+    let c1 = 1.0 / (4.0 * c0);
+    let eml = exp(-s);
+    let em2l = eml * eml;
+    let rl = 1.0 / s;
+    let scale = 1.0 + 2.0 * em2l - rl;
+    let bias = (eml - em2l) * rl - em2l;
+    let x = sqrt(max(1.0 - scale, 0.0));
+    let x0 = c0 * mu;
+    let x1 = c1 * x;
+    let n = x0 + x1;
+    var y = clamp(mu, 0.0, 1.0);
+    if (abs(x0) <= x1) {
+        y = n * n / x;
+    }
+    // Hill normalises by the approximate integral 2 pi / s.
+    return max(scale * y + bias, 0.0) * 2.0 * PI / s;
+}
+
+// The hit of the ray on triangle `tri`'s plane and the barycentric normal there (facing the ray).
+struct Surface {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+fn occluder_surface(tri: u32, ray: Ray) -> Surface {
+    let i = vec3<u32>(triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u]);
+    let a = positions[i.x].xyz;
+    let b = positions[i.y].xyz;
+    let c = positions[i.z].xyz;
+    let e1 = b - a;
+    let e2 = c - a;
+    let face = cross(e1, e2);
+    let den = dot(face, ray.dir);
+    var t = 0.0;
+    if (abs(den) > 1e-20) {
+        t = dot(face, a - ray.origin) / den;
+    }
+    let p = ray.origin + t * ray.dir;
+    // Barycentrics of p (clamped to the triangle: a sample's centre can lie just outside it).
+    let d00 = dot(e1, e1);
+    let d01 = dot(e1, e2);
+    let d11 = dot(e2, e2);
+    let w = p - a;
+    let d20 = dot(w, e1);
+    let d21 = dot(w, e2);
+    let det = max(d00 * d11 - d01 * d01, 1e-30);
+    let v = clamp((d11 * d20 - d01 * d21) / det, 0.0, 1.0);
+    let u = clamp((d00 * d21 - d01 * d20) / det, 0.0, 1.0 - v);
+    var n = normals[i.x].xyz * (1.0 - u - v) + normals[i.y].xyz * v + normals[i.z].xyz * u;
+    n = normalize(n);
+    if (dot(n, ray.dir) > 0.0) {
+        n = -n;
+    }
+    return Surface(p, n);
+}
+
+fn inside_grid(g: ShadowGridInfo, p: vec3<f32>) -> bool {
+    let q = (p - g.origin) / g.spacing;
+    return all(q >= vec3<f32>(0.0)) && all(q <= vec3<f32>(g.dims));
+}
+
+// Radiance of the occluder's surface towards the camera under the batch's lights.
+fn shade_occluder(s: Surface) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    let shadowed = (batch.flags & FLAG_SHADOWS) != 0u;
+    let q = s.position + info.normal_offset * s.normal;
+    for (var k = 0u; k < batch.count; k++) {
+        let j = batch.first + k;
+        let l = lights[j];
+        var t = 1.0;
+        if (shadowed && inside_grid(shadow_grid, q)) {
+            t = grid_shadow(shadow_grid, q, j).transmittance;
+        }
+        sum = sum + t * sg_irradiance(dot(s.normal, l.direction), l.lambda) * l.rgb;
+    }
+    return info.albedo / PI * sum;
+}
+
+@compute @workgroup_size(8, 8)
+fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
+    let y = batch.row0 + id.y;
+    if (id.x >= camera.size.x || id.y >= batch.rows || y >= camera.size.y) {
+        return;
+    }
+    let xy = vec2<i32>(vec2<u32>(id.x, y));
+    let pixel = y * camera.size.x + id.x;
+    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(y) + 0.5);
+    var sum = vec3<f32>(0.0);
+    for (var s = 0u; s < batch.samples; s++) {
+        let tri = visible_occluder(textureLoad(visibility, xy, i32(s)).x);
+        if (tri == 0u) {
+            continue;
+        }
+        // Each distinct triangle once, with its share of the samples.
+        var seen = false;
+        var count = 0u;
+        for (var o = 0u; o < batch.samples; o++) {
+            let other = visible_occluder(textureLoad(visibility, xy, i32(o)).x);
+            if (other == tri) {
+                seen = seen || o < s;
+                count = count + 1u;
+            }
+        }
+        if (seen) {
+            continue;
+        }
+        sum = sum + f32(count) / f32(batch.samples) * shade_occluder(occluder_surface(tri - 1u, ray));
+    }
+    occluder[pixel] = occluder[pixel] + vec4<f32>(sum, 0.0);
+}

@@ -1,0 +1,269 @@
+//! The head in the picture (issue 16, part 3): drawn opaque in front of the hair behind it, shaded as a
+//! diffuse surface under the SRBF lights with the hair's shadows, and held in the fiber-density
+//! volume as a solid so it shadows the hair. On lavapipe: the occluder pass and the volume's solid
+//! against their CPU twins, the AOVs adding up to the beauty, and the head's shadow under a narrow
+//! light behind it against a CPU ray cast of every visible hair point towards the light.
+
+use glam::Vec3;
+use strandlight::envmap::{SrbfLight, SrbfSet};
+use strandlight::gpu::{GpuContext, GpuOptions};
+use strandlight::hair::Hair;
+use strandlight::hair::procedural::{Head, Style};
+use strandlight::render::occluder::{
+    Occluder, SKIN_ALBEDO, occluder_triangle, shade_occluder_frame,
+};
+use strandlight::render::scene::generated_hair;
+use strandlight::render::shade::{ShadingHair, is_hair};
+use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
+use strandlight::scattering::Preset;
+use strandlight::scattering::lut::Luts;
+use strandlight::shadow::grid::{GridSources, GridValues};
+use strandlight::shadow::solid::solid_fraction;
+use strandlight::shadow::{DensityPyramid, FiberDensity};
+
+fn context() -> GpuContext {
+    GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)")
+}
+
+struct Scene {
+    hair: Hair,
+    sigma_a: Vec<[f32; 3]>,
+    look: HairLook,
+    camera: Camera,
+    settings: RenderSettings,
+    occluder: Occluder,
+}
+
+/// A bob of `strands` strands on the generated head (with its neck), seen from (yaw, pitch).
+fn scene(strands: usize, width: u32, height: u32, yaw: f32, pitch: f32) -> Scene {
+    let hair = generated_hair(Style::Bob, strands, 12, 3);
+    let look = HairLook::new(Preset::Brown.params());
+    let (lo, hi) = hair.bounds();
+    Scene {
+        sigma_a: vec![look.fast.sigma_a_rgb(); hair.point_count()],
+        camera: Camera::framing(lo, hi, yaw, pitch, width as f32 / height as f32, 0.95),
+        hair,
+        look,
+        settings: RenderSettings {
+            width,
+            height,
+            multiple_scattering: false,
+            volume_resolution: 64,
+            shadow_grid_resolution: 40,
+            ..Default::default()
+        },
+        occluder: Occluder::new(Head::default().mesh(32, true), SKIN_ALBEDO),
+    }
+}
+
+fn render(ctx: &GpuContext, s: &Scene, lights: &[SrbfLight], occluder: bool) -> (Renderer, Frame) {
+    let luts = Luts::default_tables();
+    let mut r = Renderer::new(
+        ctx,
+        s.settings.clone(),
+        &luts,
+        &s.hair,
+        &s.sigma_a,
+        &s.look,
+        lights,
+        &s.camera,
+    )
+    .expect("renderer");
+    if occluder {
+        r.set_occluder(ctx, Some(&s.occluder));
+    }
+    r.render_frame(ctx);
+    let f = r.read_frame(ctx).expect("read back");
+    (r, f)
+}
+
+#[test]
+fn the_occluder_and_its_solid_equal_their_cpu_twins() {
+    let ctx = context();
+    let lights = SrbfSet::read(
+        &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"),
+    )
+    .expect("the sunny fit");
+    let s = scene(800, 96, 72, 35.0, 10.0);
+    let (renderer, frame) = render(&ctx, &s, &lights.lights, true);
+    let (solid, offset) = renderer.occluder_solid().expect("an occluder");
+    // The head fills part of the volume.
+    let grid = s.settings.volume_grid(&s.hair);
+    assert_eq!(solid, solid_fraction(&grid, &s.occluder.mesh).as_slice());
+    let filled = solid.iter().filter(|&&f| f > 0.0).count();
+    assert!(filled > 100, "{filled} solid voxels");
+    // The shadow grid, swept through the volume with the solid, against the CPU twin.
+    let mut volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
+    volume.add_solid(solid);
+    let pyramid = DensityPyramid::build(&volume);
+    let sources = GridSources {
+        pyramid: &pyramid,
+        occluder: Some(&volume),
+        forward: None,
+        skip: s.settings.shadow_skip(&s.hair),
+    };
+    let shadow_grid = s.settings.shadow_grid(&s.hair);
+    let dirs: Vec<(Vec3, f32)> = lights
+        .lights
+        .iter()
+        .map(|l| (l.dir().normalize().as_vec3(), l.lambda as f32))
+        .collect();
+    let cpu = GridValues::build(shadow_grid, &sources, &dirs);
+    let gpu = renderer.read_shadow_grid(&ctx).expect("the grid");
+    let n = shadow_grid.point_count();
+    let (mut worst, mut inside) = (0f32, 0usize);
+    for (l, values) in cpu.lights.iter().enumerate() {
+        for (i, c) in values.iter().enumerate() {
+            let g = gpu[l * n + i];
+            // Transmittances, not their logarithms: behind the head they reach the floor (1e-8), where
+            // the logarithms differ by rounding of a vanishing light.
+            worst = worst.max((g.transmittance.exp() - c.transmittance.exp()).abs());
+            assert_eq!(
+                g.depth_behind < 0.0,
+                c.depth_behind < 0.0,
+                "inside flags differ at {i}"
+            );
+            inside += (c.depth_behind < 0.0) as usize;
+        }
+    }
+    println!(
+        "shadow grid with the head's solid: GPU against CPU twin, worst {worst:.2e} (transmittance); \
+         {inside} (point, light) entries inside the head"
+    );
+    assert!(worst < 1e-3 && inside > 0, "{worst} {inside}");
+    // The occluder's radiance: GPU against shade_occluder_frame over the same samples, reading the
+    // GPU's grid.
+    let values = GridValues {
+        grid: shadow_grid,
+        lights: gpu.chunks(n).map(<[_]>::to_vec).collect(),
+    };
+    let camera = s.camera.uniform(96, 72, s.settings.min_width_px);
+    let want = shade_occluder_frame(
+        &frame,
+        &camera,
+        &s.occluder,
+        &lights.lights,
+        Some(&values),
+        offset,
+    );
+    let peak = want.iter().flatten().fold(1e-6f32, |a, &b| a.max(b));
+    let mut head_pixels = 0;
+    let mut worst = 0f32;
+    for (i, (g, c)) in frame.occluder.iter().zip(&want).enumerate() {
+        for k in 0..3 {
+            worst = worst.max((g[k] - c[k]).abs() / peak);
+        }
+        head_pixels += frame.sample_ids[i]
+            .iter()
+            .any(|&id| occluder_triangle(id).is_some()) as usize;
+    }
+    println!(
+        "occluder pass against its CPU twin: {head_pixels} head pixels, worst {worst:.2e} of the peak"
+    );
+    assert!(head_pixels > 200 && worst < 2e-3, "{head_pixels} {worst}");
+    // The beauty is the components plus the occluder, and the head is opaque.
+    let mut sum_worst = 0f32;
+    for i in 0..frame.pixel_count() {
+        for k in 0..3 {
+            let sum: f32 =
+                frame.components.iter().map(|c| c[i][k]).sum::<f32>() + frame.occluder[i][k];
+            sum_worst = sum_worst
+                .max((sum - frame.beauty[i][k]).abs() / frame.beauty[i][k].abs().max(1e-4));
+        }
+        let all_head = frame.sample_ids[i]
+            .iter()
+            .all(|&id| occluder_triangle(id).is_some());
+        if all_head {
+            assert_eq!(frame.beauty[i][3], 1.0);
+        }
+    }
+    println!("AOVs with the occluder against the beauty: worst {sum_worst:.2e}");
+    assert!(sum_worst < 1e-4, "{sum_worst}");
+}
+
+#[test]
+fn the_head_shadows_the_hair_behind_it_from_a_narrow_light() {
+    let ctx = context();
+    // Sparse hair (little self-shadowing), seen from the front three-quarter; one narrow light behind
+    // and a little above the head.
+    let s = scene(300, 160, 120, 35.0, 5.0);
+    let centre = Vec3::new(0.25, 0.3, -1.0).normalize();
+    let lambda = 0.05f64;
+    let light = SrbfLight {
+        direction: centre.as_dvec3().to_array(),
+        lambda,
+        rgb: [100.0; 3],
+    };
+    let (_, lit) = render(&ctx, &s, &[light], true);
+    let mut unshadowed = s.settings.clone();
+    unshadowed.shadows = false;
+    let free = Scene {
+        settings: unshadowed,
+        ..scene(300, 160, 120, 35.0, 5.0)
+    };
+    let (_, open) = render(&ctx, &free, &[light], true);
+    // The lobe's angular standard deviation is lambda / sqrt(2); its width here is three of them.
+    let width = 3.0 * lambda as f32 / std::f32::consts::SQRT_2;
+    let (u, v) = {
+        let a = if centre.x.abs() < 0.9 {
+            Vec3::X
+        } else {
+            Vec3::Y
+        };
+        let u = centre.cross(a).normalize();
+        (u, centre.cross(u))
+    };
+    let probes: Vec<Vec3> = std::iter::once(centre)
+        .chain((0..8).map(|k| {
+            let a = std::f32::consts::TAU * k as f32 / 8.0;
+            (centre * width.cos() + (u * a.cos() + v * a.sin()) * width.sin()).normalize()
+        }))
+        .collect();
+    let hair = ShadingHair::new(&s.hair, &s.sigma_a);
+    let camera = s.camera.uniform(160, 120, s.settings.min_width_px);
+    let (mut shadowed, mut clear) = (Vec::new(), Vec::new());
+    for i in 0..lit.pixel_count() {
+        let ids = &lit.sample_ids[i][..lit.samples as usize];
+        let Some(&id) = ids.iter().find(|&&id| id != 0) else {
+            continue;
+        };
+        // One hair segment alone in the pixel, lit at all without shadows.
+        if !is_hair(id) || ids.iter().any(|&o| o != 0 && o != id) || open.beauty[i][1] <= 1e-6 {
+            continue;
+        }
+        let (x, y) = ((i % 160) as f32 + 0.5, (i / 160) as f32 + 0.5);
+        let (origin, dir) = strandlight::render::camera::pixel_ray(&camera, x, y);
+        let p = hair.shading_point(id - 1, origin, dir).position;
+        let hits = probes
+            .iter()
+            .filter(|&&d| s.occluder.mesh.intersect(p, d, 1e-3).is_some())
+            .count();
+        // The fraction of the light arriving: the shadowed render over the unshadowed one.
+        let t = lit.beauty[i][1] / open.beauty[i][1];
+        if hits == probes.len() {
+            shadowed.push(t);
+        } else if hits == 0 {
+            clear.push(t);
+        }
+    }
+    let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64;
+    let clear_mean = mean(&clear);
+    let worst = shadowed.iter().copied().fold(0f32, f32::max) as f64;
+    println!(
+        "narrow light behind the head: {} hair points in its shadow (deeper than the light's width, \
+         {:.1} deg), {} clear of it; transmittance in the shadow mean {:.4}, worst {worst:.4}, clear \
+         mean {clear_mean:.3}: worst {:.2} % of the clear mean",
+        shadowed.len(),
+        width.to_degrees(),
+        clear.len(),
+        mean(&shadowed),
+        100.0 * worst / clear_mean
+    );
+    assert!(
+        shadowed.len() > 50 && clear.len() > 50,
+        "{} {}",
+        shadowed.len(),
+        clear.len()
+    );
+    assert!(worst <= 0.02 * clear_mean, "{worst} {clear_mean}");
+}
