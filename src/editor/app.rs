@@ -65,6 +65,8 @@ pub enum Loaded {
     },
     /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
     Hair { source: HairSource },
+    /// An occluder mesh that loaded: it becomes the session's head (an edit; the scene reloads).
+    Occluder { path: PathBuf },
     /// A new environment; applied as an edit when it arrives.
     Environment {
         environment: Box<Environment>,
@@ -573,6 +575,30 @@ impl EditorApp {
         ));
     }
 
+    /// Loads an occluder mesh (.obj, .gltf, .glb) on a worker, in the hair's space; when it loads it
+    /// becomes the session's head (an edit), when it fails the error names the file and nothing changes.
+    pub fn open_occluder(&mut self, path: PathBuf) {
+        let ctx = self.ctx.clone();
+        let normalization = self
+            .live
+            .as_ref()
+            .map_or(crate::session::assemble::GENERATOR_SPACE, |l| {
+                l.normalization
+            });
+        self.source_job = Some(Job::spawn(
+            format!("loading {}", path.display()),
+            move || ctx.request_repaint(),
+            move |_| {
+                let mesh = crate::hair::load::load_mesh(&path, &normalization)
+                    .map_err(|e| e.to_string())?;
+                if mesh.triangles.is_empty() {
+                    return Err(format!("{}: the mesh has no triangles", path.display()));
+                }
+                Ok(Loaded::Occluder { path })
+            },
+        ));
+    }
+
     /// Files dropped on the window: hair, environments and sessions, by extension.
     fn dropped_files(&mut self, ctx: &egui::Context) {
         let files: Vec<PathBuf> = ctx.input(|i| {
@@ -744,6 +770,14 @@ impl EditorApp {
         if let Some(result) = self.source_job.as_mut().and_then(|j| j.poll()) {
             self.source_job = None;
             match result.and_then(|r| r) {
+                Ok(Loaded::Occluder { path }) => {
+                    let occluder = crate::session::OccluderOptions {
+                        show: true,
+                        mesh: Some(path),
+                        ..self.session.occluder.clone()
+                    };
+                    self.perform(Edit::Occluder(Box::new(occluder)), false);
+                }
                 Ok(Loaded::Hair { source }) => {
                     self.perform(Edit::Hair(source), false);
                     self.session.camera.target = None;

@@ -24,8 +24,7 @@ use crate::scattering::HairParams;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{
-    LoadedHairSource, base_absorption, mean_absorption, renderer_look, scene_occluder,
-    turned_lights,
+    LoadedHairSource, base_absorption, mean_absorption, occluder_mesh, renderer_look, turned_lights,
 };
 use crate::session::{
     AssembleError, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions, Session,
@@ -196,6 +195,9 @@ pub struct LiveScene {
     /// session is brought into it too), and the occluder shown.
     pub hair_mesh: Option<TriangleMesh>,
     pub normalization: Normalization,
+    /// The occluder's mesh (the session's file, or the hair's own), shown or not, and the occluder
+    /// shown.
+    occluder_mesh: Option<TriangleMesh>,
     pub occluder: Option<Occluder>,
     /// The environment with its lights unturned.
     pub environment: Environment,
@@ -293,8 +295,25 @@ impl LiveScene {
             renderer.set_thickness_scale(&ctx, &hair.hair, session.look.thickness_scale)?;
         }
         let display = DisplayPass::new(&ctx.device, width, height);
-        let occluder = scene_occluder(&session.occluder, hair.mesh.as_ref(), &hair.normalization)?;
+        // A mesh file that no longer loads: the hair's own, reported with the paint's warnings.
+        let (occluder_mesh, occluder_warning) =
+            match occluder_mesh(&session.occluder, hair.mesh.as_ref(), &hair.normalization) {
+                Ok(m) => (m, None),
+                Err(e) => (
+                    hair.mesh.clone(),
+                    Some(format!("{e}; showing the hair's own head instead")),
+                ),
+            };
+        session.occluder.validate().map_err(AssembleError::Look)?;
+        let occluder = occluder_mesh
+            .clone()
+            .filter(|_| session.occluder.show)
+            .map(|m| Occluder::new(m, session.occluder.albedo));
         renderer.set_occluder(&ctx, occluder.as_ref());
+        let warning = match (warning, occluder_warning) {
+            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+            (a, b) => a.or(b),
+        };
         let mut live = Self {
             bounds: hair.hair.bounds(),
             hair: Arc::new(hair.hair),
@@ -302,6 +321,7 @@ impl LiveScene {
             hair_source: session.hair.clone(),
             hair_mesh: hair.mesh,
             normalization: hair.normalization,
+            occluder_mesh,
             occluder,
             environment_pictures: Arc::new(env_preview::pictures(&environment)),
             environment,
@@ -440,11 +460,12 @@ impl LiveScene {
                     self.renderer.set_occluder_albedo(&self.ctx, albedo);
                 }
                 _ => {
-                    self.occluder = scene_occluder(
-                        &session.occluder,
-                        self.hair_mesh.as_ref(),
-                        &self.normalization,
-                    )?;
+                    session.occluder.validate().map_err(AssembleError::Look)?;
+                    self.occluder = self
+                        .occluder_mesh
+                        .clone()
+                        .filter(|_| session.occluder.show)
+                        .map(|m| Occluder::new(m, albedo));
                     self.renderer
                         .set_occluder(&self.ctx, self.occluder.as_ref());
                 }

@@ -136,6 +136,14 @@ impl StandardScene {
             .find(|s| s.name.eq_ignore_ascii_case(name))
     }
 
+    /// The generated head under every scene's hair (as under the default render's).
+    pub fn occluder(&self) -> super::occluder::Occluder {
+        super::occluder::Occluder::new(
+            crate::hair::procedural::Head::default().occluder_mesh(),
+            super::occluder::SKIN_ALBEDO,
+        )
+    }
+
     /// S0 and S1 are wavy (Xu's animated character), S2 and S3 straight (Xu's "straight").
     pub fn hair(&self) -> Hair {
         let style = if matches!(self.name, "S0" | "S1") {

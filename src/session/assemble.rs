@@ -52,9 +52,6 @@ pub const GENERATOR_SPACE: Normalization = Normalization {
     scale: 1.0,
 };
 
-/// Latitude rings of the generated head's mesh (64 vertices a ring: ~3k triangles).
-pub const HEAD_RINGS: usize = 32;
-
 /// BLAKE3 of a file's bytes, hex.
 pub fn file_blake3(path: &Path) -> std::io::Result<String> {
     Ok(blake3::hash(&std::fs::read(path)?).to_hex().to_string())
@@ -88,7 +85,7 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 hair: generate(&params).map_err(|e| AssembleError::Generator(name.clone(), e))?,
                 name,
                 warning: None,
-                mesh: Some(params.head.mesh(HEAD_RINGS, true)),
+                mesh: Some(params.head.occluder_mesh()),
                 normalization: GENERATOR_SPACE,
             }
         }
@@ -227,8 +224,7 @@ pub fn renderer_look(look: &Look, mean_sigma_a: [f64; 3]) -> HairLook {
 }
 
 /// The occluder of options `o` for a hair with its own mesh `own` (in world space) that came into
-/// world space by `normalization`: none when hidden, else the options' mesh file (brought into the
-/// hair's space) or the hair's own, with the options' albedo.
+/// world space by `normalization`: none when hidden, else [`occluder_mesh`] with the options' albedo.
 pub fn scene_occluder(
     o: &OccluderOptions,
     own: Option<&TriangleMesh>,
@@ -238,13 +234,21 @@ pub fn scene_occluder(
         return Ok(None);
     }
     o.validate().map_err(AssembleError::Look)?;
+    Ok(occluder_mesh(o, own, normalization)?.map(|m| Occluder::new(m, o.albedo)))
+}
+
+/// The options' mesh file (brought into the hair's space) or the hair's own mesh; none without
+/// triangles.
+pub fn occluder_mesh(
+    o: &OccluderOptions,
+    own: Option<&TriangleMesh>,
+    normalization: &Normalization,
+) -> Result<Option<TriangleMesh>, AssembleError> {
     let mesh = match &o.mesh {
         Some(path) => Some(load_mesh(path, normalization)?),
         None => own.cloned(),
     };
-    Ok(mesh
-        .filter(|m| !m.triangles.is_empty())
-        .map(|m| Occluder::new(m, o.albedo)))
+    Ok(mesh.filter(|m| !m.triangles.is_empty()))
 }
 
 /// Everything the renderer is built from.

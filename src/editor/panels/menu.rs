@@ -128,6 +128,15 @@ pub fn hair_dialog(app: &mut EditorApp) {
     }
 }
 
+pub fn occluder_dialog(app: &mut EditorApp) {
+    if let Some(p) = rfd::FileDialog::new()
+        .add_filter("mesh", &["obj", "gltf", "glb"])
+        .pick_file()
+    {
+        app.open_occluder(p);
+    }
+}
+
 pub fn environment_dialog(app: &mut EditorApp) {
     if let Some(p) = rfd::FileDialog::new()
         .add_filter("environment", &["hdr", "exr", "json"])

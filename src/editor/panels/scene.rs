@@ -7,6 +7,7 @@ use crate::editor::panels::menu;
 use crate::hair::procedural::{Style, StyleParams};
 use crate::render::background::Background;
 use crate::render::display::{Solo, ViewTransform};
+use crate::render::frame::{srgb_decode, srgb_encode};
 use crate::render::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
 
@@ -45,6 +46,7 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
         menu::hair_dialog(app);
     }
     generator(app, ui);
+    head(app, ui);
     if let Some(live) = &app.live {
         let (lo, hi) = live.hair.bounds();
         let size = hi - lo;
@@ -56,6 +58,62 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
             size.y,
             size.z
         ));
+    }
+}
+
+/// The head the hair sits on: shown or not, its skin colour, and its mesh (the hair's own: the
+/// generated head, or the mesh a glTF hair carries; or a mesh file).
+fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
+    let mut o = app.session.occluder.clone();
+    let mut gesture = false;
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut o.show, "Head").on_hover_text(
+            "Draw the head: it hides the hair behind it, shadows the hair and takes the hair's shadows",
+        );
+        let encode = |v: f32| (255.0 * srgb_encode(v.clamp(0.0, 1.0)) + 0.5) as u8;
+        let mut rgb = o.albedo.map(encode);
+        if ui
+            .color_edit_button_srgb(&mut rgb)
+            .on_hover_text("Skin colour (its diffuse albedo)")
+            .changed()
+        {
+            o.albedo = rgb.map(|v| srgb_decode(v as f64 / 255.0) as f32);
+            gesture |= ui.input(|i| i.pointer.any_down());
+        }
+    });
+    ui.horizontal(|ui| {
+        let own = match (
+            &app.session.hair,
+            app.live.as_ref().map(|l| l.hair_mesh.is_some()),
+        ) {
+            (HairSource::Generated { .. }, _) => "the generated head",
+            (_, Some(true)) => "the hair file's mesh",
+            _ => "none (the hair file has no mesh)",
+        };
+        let what = o
+            .mesh
+            .as_ref()
+            .and_then(|p| p.file_name())
+            .map_or(own.to_string(), |n| n.to_string_lossy().into_owned());
+        ui.weak(what);
+        if ui
+            .button("Mesh…")
+            .on_hover_text("An OBJ or glTF mesh, in the hair file's units and axes")
+            .clicked()
+        {
+            menu::occluder_dialog(app);
+        }
+        if o.mesh.is_some()
+            && ui
+                .button("Own")
+                .on_hover_text(format!("Back to {own}"))
+                .clicked()
+        {
+            o.mesh = None;
+        }
+    });
+    if o != app.session.occluder {
+        app.perform(Edit::Occluder(Box::new(o)), gesture);
     }
 }
 

@@ -21,7 +21,15 @@ impl Default for Head {
     }
 }
 
+/// Latitude rings of the generated head's mesh (64 vertices a ring: ~4k triangles with the neck).
+pub const HEAD_MESH_RINGS: usize = 32;
+
 impl Head {
+    /// The head as the renderer draws it: [`Head::mesh`] with [`HEAD_MESH_RINGS`] and the neck.
+    pub fn occluder_mesh(&self) -> TriangleMesh {
+        self.mesh(HEAD_MESH_RINGS, true)
+    }
+
     /// Implicit value: < 1 inside, 1 on the surface.
     pub fn implicit(&self, p: Vec3) -> f32 {
         ((p - self.centre) / self.radii).length_squared()
