@@ -119,12 +119,21 @@ fn image(h: &Harness<'static, EditorApp>) -> Frame {
     live.renderer.read_frame(&live.ctx).expect("read back")
 }
 
-/// Mean luminance of the hair pixels (coverage-weighted beauty over coverage).
+/// Mean luminance of the hair: the beauty less the head's radiance, over the hair's share of the
+/// visibility samples.
 fn mean_luminance(f: &Frame) -> f64 {
     let (mut sum, mut cover) = (0.0, 0.0);
-    for p in &f.beauty {
-        sum += 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-        cover += p[3] as f64;
+    let samples = (f.samples as usize).min(4);
+    for (i, p) in f.beauty.iter().enumerate() {
+        let head = f.occluder.get(i).copied().unwrap_or([0.0; 3]);
+        let hair: [f64; 3] = std::array::from_fn(|c| (p[c] - head[c]) as f64);
+        sum += 0.2126 * hair[0] + 0.7152 * hair[1] + 0.0722 * hair[2];
+        let ids = &f.sample_ids[i][..samples];
+        cover += ids
+            .iter()
+            .filter(|&&id| strandlight::render::shade::is_hair(id))
+            .count() as f64
+            / f.samples as f64;
     }
     sum / cover.max(1e-9)
 }
@@ -437,6 +446,81 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
         thin,
         "undo restores the fibres' diameters"
     );
+}
+
+/// Pixels of `f` showing the head (any of their samples).
+fn head_pixels(f: &Frame) -> usize {
+    f.sample_ids
+        .iter()
+        .filter(|ids| {
+            ids.iter()
+                .any(|&id| strandlight::render::occluder::occluder_triangle(id).is_some())
+        })
+        .count()
+}
+
+#[test]
+fn the_head_and_the_environment_show_and_the_panel_changes_them() {
+    let dir = tmp("head");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    // By default: the generated head under the bob, the environment behind both.
+    let with_head = image(&h);
+    let shown = head_pixels(&with_head);
+    let behind = with_head
+        .background
+        .iter()
+        .filter(|b| b.iter().any(|&v| v > 0.0))
+        .count();
+    println!(
+        "{shown} of {} pixels show the head, {behind} have the environment behind",
+        with_head.pixel_count()
+    );
+    assert!(shown > 50 && behind == with_head.pixel_count());
+    // The head hidden: no head pixels, and the hair it hid shows.
+    click(&mut h, "Head");
+    assert!(!h.state().session.occluder.show);
+    converge(&mut h);
+    let without = image(&h);
+    assert_eq!(head_pixels(&without), 0);
+    let hair = |f: &Frame| {
+        f.sample_ids
+            .iter()
+            .filter(|ids| {
+                ids.iter()
+                    .any(|&id| strandlight::render::shade::is_hair(id))
+            })
+            .count()
+    };
+    println!(
+        "hair pixels: {} with the head, {} without",
+        hair(&with_head),
+        hair(&without)
+    );
+    assert!(
+        hair(&without) > hair(&with_head),
+        "the head hid hair behind it"
+    );
+    // Undo brings it back as it was.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert!(h.state().session.occluder.show);
+    converge(&mut h);
+    assert_eq!(
+        image(&h).beauty,
+        with_head.beauty,
+        "undo restores the head exactly"
+    );
+    // A transparent background: the renderer looks nothing up behind the hair.
+    // The render settings lie below the fold of the scene panel: clicked through accesskit.
+    h.get_by_label("transparent").click_accesskit();
+    h.step();
+    assert_eq!(
+        h.state().session.render.background,
+        strandlight::render::background::Background::Transparent
+    );
+    converge(&mut h);
+    assert!(image(&h).background.is_empty());
 }
 
 #[test]

@@ -337,7 +337,8 @@ fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
         }
         [r.width, r.height] = size;
     });
-    ui.horizontal(|ui| {
+    // Wrapped: on a narrow panel the choices go on to the next line rather than out of reach.
+    ui.horizontal_wrapped(|ui| {
         ui.label("background");
         let now = r.background;
         let colour = match now {
