@@ -169,11 +169,15 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
     let phase = std::f32::consts::TAU * uniform(&mut r);
     let curl_pitch = 2.0 + 1.5 * uniform(&mut r); // cm per turn
     let wave_length = 5.0 + 2.0 * uniform(&mut r); // cm
-    // Start outwards and down (no loops above the crown); roots over the forehead are combed back
-    // so the face stays clear.
+    // Start outwards and down (no loops above the crown); roots over the forehead are combed up,
+    // back and aside, away from a parting, so the face stays clear (combed only back, they slid down
+    // over the forehead and fell over the face).
     let outward = (root - head.centre).with_y(0.0).normalize_or(normal);
     let front = ((root.z - head.centre.z) / head.radii.z).max(0.0);
-    let mut base = (0.5 * normal + outward + 0.5 * down - Vec3::Z * 1.5 * front).normalize_or(down);
+    let aside = Vec3::X * (root.x - head.centre.x).signum();
+    let mut base =
+        (0.5 * normal + outward + 0.5 * down + (Vec3::Y * 1.5 - Vec3::Z * 2.5 + aside) * front)
+            .normalize_or(down);
     let mut side = orthogonal(base);
     let mut frizz_tilt = Vec3::ZERO;
     let mut pts = Vec::with_capacity(n);
@@ -194,7 +198,12 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                 let column = tie + tail_offset - Vec3::Y * (tie.y - p.y);
                 (down + 0.3 * (column - p)).normalize_or(down)
             }
-            _ => (base + 0.35 * ds * down).normalize_or(down),
+            _ => {
+                // Combed back while in front of the ears, above the chin: the face stays clear.
+                let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0)
+                    * (p.y > head.centre.y - 0.6 * head.radii.y) as u8 as f32;
+                (base + 0.35 * ds * down - Vec3::Z * (0.6 * ds * ahead)).normalize_or(down)
+            }
         };
         // Parallel transport of the side vector keeps curls from twisting.
         side = (side - base * side.dot(base)).normalize_or(orthogonal(base));
