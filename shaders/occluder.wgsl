@@ -2,28 +2,15 @@
 // samples, each shaded at the pixel ray's hit on the triangle's plane with the interpolated vertex
 // normal, as a diffuse surface under one batch of SRBF lights: albedo / pi times each light's
 // irradiance (Hill's fitted SG-cosine convolution, `sg_irradiance`) times its transmittance through
-// the hair, read from the shadow grid a little off the surface (outside the grid: 1). Weighted by the
+// the hair, read from the shadow grid a little off the surface (clamped at the grid's faces). Weighted by the
 // samples' coverage and added to the occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
-// Prepended: circular_gaussian (PI), shadow_grid, camera.
-
-struct ShadeBatch {
-    first: u32,
-    count: u32,
-    flags: u32,
-    samples: u32,
-    slot: u32,
-    row0: u32,
-    rows: u32,
-    _p2: u32,
-}
+// Prepended: circular_gaussian (PI), shadow_grid (GpuLight, ShadeBatch, FLAG_SHADOWS), camera.
 
 struct OccluderInfo {
     albedo: vec3<f32>,
     // How far off the surface, along its normal, the shadow grid is read (cm).
     normal_offset: f32,
 }
-
-const FLAG_SHADOWS: u32 = 1u;
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> batch: ShadeBatch;
@@ -54,7 +41,7 @@ fn sg_irradiance(mu: f32, lambda: f32) -> f32 {
     let x1 = c1 * x;
     let n = x0 + x1;
     var y = clamp(mu, 0.0, 1.0);
-    if (abs(x0) <= x1) {
+    if (abs(x0) <= x1 && x > 0.0) {
         y = n * n / x;
     }
     // Hill normalises by the approximate integral 2 pi / s.
@@ -99,11 +86,6 @@ fn occluder_surface(tri: u32, ray: Ray) -> Surface {
     return Surface(p, n);
 }
 
-fn inside_grid(g: ShadowGridInfo, p: vec3<f32>) -> bool {
-    let q = (p - g.origin) / g.spacing;
-    return all(q >= vec3<f32>(0.0)) && all(q <= vec3<f32>(g.dims));
-}
-
 // Radiance of the occluder's surface towards the camera under the batch's lights.
 fn shade_occluder(s: Surface) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
@@ -113,7 +95,7 @@ fn shade_occluder(s: Surface) -> vec3<f32> {
         let j = batch.first + k;
         let l = lights[j];
         var t = 1.0;
-        if (shadowed && inside_grid(shadow_grid, q)) {
+        if (shadowed) {
             t = grid_shadow(shadow_grid, q, j).transmittance;
         }
         sum = sum + t * sg_irradiance(dot(s.normal, l.direction), l.lambda) * l.rgb;

@@ -9,23 +9,10 @@
 // Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response,
 // dual_response, shadow_grid, camera.
 
-const FLAG_SHADOWS: u32 = 1u;
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 // `ShadeBatch.slot` of the preview's dispatches: every pixel shades one segment, not each distinct one.
 const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 
-struct ShadeBatch {
-    first: u32,
-    count: u32,
-    flags: u32,
-    samples: u32,
-    slot: u32,
-    // Rows [row0, row0 + rows) of the image (all of them for a whole frame, a band per unit of
-    // progressive refinement).
-    row0: u32,
-    rows: u32,
-    _p2: u32,
-}
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<uniform> params: FastHairParams;

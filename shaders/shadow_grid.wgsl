@@ -11,6 +11,23 @@ struct GpuLight {
     _pad: f32,
 }
 
+// One shading dispatch's batch of lights over rows of the image (twin of ShadeBatch in
+// src/render/shading.rs); read by the shading and occluder passes.
+struct ShadeBatch {
+    first: u32,
+    count: u32,
+    flags: u32,
+    samples: u32,
+    slot: u32,
+    // Rows [row0, row0 + rows) of the image (all of them for a whole frame, a band per unit of
+    // progressive refinement).
+    row0: u32,
+    rows: u32,
+    _p2: u32,
+}
+
+const FLAG_SHADOWS: u32 = 1u;
+
 struct ShadowGridInfo {
     origin: vec3<f32>,
     spacing: f32,

@@ -316,6 +316,12 @@ fn build_shadow_grid(
                 var f = path_zero();
                 if (forward) {
                     f = forward_integrand(x, d.omega, lod);
+                    // The depth behind counts hair only: the head's solid is not fibres that
+                    // scatter light back (`sweep` in sweep.rs, `behind`).
+                    let v = forward_voxel_at(x);
+                    if (d.behind && v >= 0) {
+                        f.tau = f.tau * (1.0 - volume[3u * u32(v) + 2u].w);
+                    }
                 } else if (forward_voxel_at(x) >= 0) {
                     // Zero outside the volume, as forward_integrand.
                     f.tau = crossings_at(x, d.omega, lod);

@@ -81,18 +81,11 @@ fn the_resolve_looks_the_environment_up_as_its_cpu_twin_does() {
 }
 
 fn strandlight() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_strandlight"));
-    c.env(
-        "STRANDLIGHT_CACHE",
-        std::env::temp_dir().join("strandlight-test-cache"),
-    );
-    c
+    common::strandlight_command()
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("strandlight-background-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d.join(name)
+    common::temp_file("background", name)
 }
 
 /// `render` of a small bob with extra arguments (outputs included).

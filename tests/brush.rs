@@ -154,7 +154,7 @@ fn setup() -> Setup {
         .collect();
     let mean_x = covered.iter().map(|c| c.0).sum::<f32>() / covered.len() as f32;
     let mean_y = covered.iter().map(|c| c.1).sum::<f32>() / covered.len() as f32;
-    let centre = [mean_x + 18.0, mean_y];
+    let centre = [mean_x + 28.0, mean_y];
     Setup {
         picker: Picker::new(&scene.hair, view, mirror_x),
         hair: scene.hair,

@@ -5,18 +5,11 @@ mod common;
 use std::process::Command;
 
 fn strandlight() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_strandlight"));
-    c.env(
-        "STRANDLIGHT_CACHE",
-        std::env::temp_dir().join("strandlight-test-cache"),
-    );
-    c
+    common::strandlight_command()
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("strandlight-cli-render-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d.join(name)
+    common::temp_file("cli-render", name)
 }
 
 #[test]

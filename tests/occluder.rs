@@ -12,11 +12,13 @@ use strandlight::hair::procedural::{Head, Style};
 use strandlight::render::occluder::{
     Occluder, SKIN_ALBEDO, occluder_triangle, shade_occluder_frame,
 };
+use strandlight::render::reference::REFERENCE_VARIANT;
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{ShadingHair, is_hair};
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
+use strandlight::shadow::forward::ForwardTable;
 use strandlight::shadow::grid::{GridSources, GridValues};
 use strandlight::shadow::solid::solid_fraction;
 use strandlight::shadow::{DensityPyramid, FiberDensity};
@@ -84,7 +86,9 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
         &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"),
     )
     .expect("the sunny fit");
-    let s = scene(800, 96, 72, 35.0, 10.0);
+    // With multiple scattering: the grid's forward terms and the depth behind (hair only) too.
+    let mut s = scene(800, 96, 72, 35.0, 10.0);
+    s.settings.multiple_scattering = true;
     let (renderer, frame) = render(&ctx, &s, &lights.lights, true);
     let (solid, offset) = renderer.occluder_solid().expect("an occluder");
     // The head fills part of the volume.
@@ -96,10 +100,11 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
     let mut volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
     volume.add_solid(solid);
     let pyramid = DensityPyramid::build(&volume);
+    let forward = ForwardTable::build(&s.look.params, REFERENCE_VARIANT);
     let sources = GridSources {
         pyramid: &pyramid,
         occluder: Some(&volume),
-        forward: None,
+        forward: Some((&volume, &forward)),
         skip: s.settings.shadow_skip(&s.hair),
     };
     let shadow_grid = s.settings.shadow_grid(&s.hair);
@@ -111,13 +116,21 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
     let cpu = GridValues::build(shadow_grid, &sources, &dirs);
     let gpu = renderer.read_shadow_grid(&ctx).expect("the grid");
     let n = shadow_grid.point_count();
-    let (mut worst, mut inside) = (0f32, 0usize);
+    let (mut worst, mut worst_behind, mut inside) = (0f32, 0f32, 0usize);
     for (l, values) in cpu.lights.iter().enumerate() {
         for (i, c) in values.iter().enumerate() {
             let g = gpu[l * n + i];
             // Transmittances, not their logarithms: behind the head they reach the floor (1e-8), where
             // the logarithms differ by rounding of a vanishing light.
             worst = worst.max((g.transmittance.exp() - c.transmittance.exp()).abs());
+            for ch in 0..3 {
+                worst =
+                    worst.max((g.transmittance_f[ch].exp() - c.transmittance_f[ch].exp()).abs());
+            }
+            if c.depth_behind >= 0.0 {
+                worst_behind = worst_behind
+                    .max((g.depth_behind - c.depth_behind).abs() / c.depth_behind.max(1.0));
+            }
             assert_eq!(
                 g.depth_behind < 0.0,
                 c.depth_behind < 0.0,
@@ -127,10 +140,14 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
         }
     }
     println!(
-        "shadow grid with the head's solid: GPU against CPU twin, worst {worst:.2e} (transmittance); \
-         {inside} (point, light) entries inside the head"
+        "shadow grid with the head's solid: GPU against CPU twin, worst {worst:.2e} (transmittance, \
+         T_f), {worst_behind:.2e} (depth behind, hair only); {inside} (point, light) entries inside \
+         the head"
     );
-    assert!(worst < 1e-3 && inside > 0, "{worst} {inside}");
+    assert!(
+        worst < 1e-3 && worst_behind < 1e-3 && inside > 0,
+        "{worst} {worst_behind} {inside}"
+    );
     // The occluder's radiance: GPU against shade_occluder_frame over the same samples, reading the
     // GPU's grid.
     let values = GridValues {
@@ -184,10 +201,10 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
 #[test]
 fn the_head_shadows_the_hair_behind_it_from_a_narrow_light() {
     let ctx = context();
-    // Sparse hair (little self-shadowing), seen from the front three-quarter; one narrow light behind
-    // and a little above the head.
-    let s = scene(300, 160, 120, 35.0, 5.0);
-    let centre = Vec3::new(0.25, 0.3, -1.0).normalize();
+    // Sparse hair (little self-shadowing) seen from the right (+x); one narrow light behind the head
+    // as the camera sees it (from the left, a little above and behind).
+    let s = scene(300, 160, 120, 90.0, 5.0);
+    let centre = Vec3::new(-1.0, 0.3, -0.35).normalize();
     let lambda = 0.05f64;
     let light = SrbfLight {
         direction: centre.as_dvec3().to_array(),
@@ -199,7 +216,7 @@ fn the_head_shadows_the_hair_behind_it_from_a_narrow_light() {
     unshadowed.shadows = false;
     let free = Scene {
         settings: unshadowed,
-        ..scene(300, 160, 120, 35.0, 5.0)
+        ..scene(300, 160, 120, 90.0, 5.0)
     };
     let (_, open) = render(&ctx, &free, &[light], true);
     // The lobe's angular standard deviation is lambda / sqrt(2); its width here is three of them.

@@ -353,7 +353,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         &env.lights.lights,
         &camera,
     )?;
-    renderer.set_occluder(&ctx, occluder.as_ref());
+    // The reference modes trace hair alone (their shadow rays know no mesh): their image has no head.
+    if args.reference.is_some() && occluder.is_some() {
+        eprintln!("warning: the reference modes draw no head; rendering without it");
+    } else {
+        renderer.set_occluder(&ctx, occluder.as_ref());
+    }
     // The PNG shows the session's background unless told otherwise; the EXR only a background asked
     // for.
     let png_background = args.background.unwrap_or(session.render.background);

@@ -450,10 +450,14 @@ impl LiveScene {
         if session.occluder != self.applied.occluder {
             // Shown or hidden, or another albedo (another mesh file reloads the scene). Applied
             // before anything can fail, so a failure is reported once.
-            let only_albedo = session.occluder.show == self.applied.occluder.show;
+            let (was, now) = (self.applied.occluder.show, session.occluder.show);
             self.applied.occluder = session.occluder.clone();
             let albedo = session.occluder.albedo;
-            match (&mut self.occluder, only_albedo) {
+            match (&mut self.occluder, was == now) {
+                // Hidden before and after (its colour edited): nothing to draw.
+                (None, true) if !now => {
+                    session.occluder.validate().map_err(AssembleError::Look)?;
+                }
                 (Some(o), true) => {
                     session.occluder.validate().map_err(AssembleError::Look)?;
                     o.albedo = albedo;

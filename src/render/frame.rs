@@ -85,7 +85,8 @@ impl Frame {
     }
 
     /// The same coverage and depth with other shading: `radiance[k]` (the components, before exposure)
-    /// for pixel `pixels[k]`, every other pixel zero.
+    /// for pixel `pixels[k]`, every other pixel zero; the occluder's radiance is kept (it is part of
+    /// the beauty).
     pub fn with_components(
         &self,
         pixels: &[usize],
@@ -95,10 +96,11 @@ impl Frame {
         let n = self.pixel_count();
         let mut out = self.clone();
         out.components = vec![vec![[0.0; 3]; n]; COMPONENTS.len()];
-        for px in out.beauty.iter_mut() {
-            px[0] = 0.0;
-            px[1] = 0.0;
-            px[2] = 0.0;
+        for (i, px) in out.beauty.iter_mut().enumerate() {
+            let head = self.occluder.get(i).copied().unwrap_or([0.0; 3]);
+            px[0] = head[0];
+            px[1] = head[1];
+            px[2] = head[2];
         }
         for (&i, l) in pixels.iter().zip(radiance) {
             for t in 0..COMPONENTS.len() {

@@ -93,7 +93,7 @@ pub fn sg_irradiance(mu: f32, lambda: f32) -> f32 {
     let x = (1.0 - scale).max(0.0).sqrt();
     let (x0, x1) = (c0 * mu, c1 * x);
     let n = x0 + x1;
-    let y = if x0.abs() <= x1 {
+    let y = if x0.abs() <= x1 && x > 0.0 {
         n * n / x
     } else {
         mu.clamp(0.0, 1.0)
@@ -104,7 +104,8 @@ pub fn sg_irradiance(mu: f32, lambda: f32) -> f32 {
 
 /// Radiance of the occluder's surface point `p` with normal `n` towards the camera under `lights`
 /// (the grid's light k is lights' k), each light scaled by its transmittance read `offset` cm off the
-/// surface when shadows are given and that point lies in the grid. Twin of `shade_occluder` in
+/// surface when shadows are given (clamped at the grid's faces, as the hair reads it). Twin of
+/// `shade_occluder` in
 /// `shaders/occluder.wgsl`.
 pub fn shade_occluder(
     albedo: [f32; 3],
@@ -118,13 +119,7 @@ pub fn shade_occluder(
     let q = p + offset * n;
     let mut sum = [0f32; 3];
     for (k, l) in lights.iter().enumerate() {
-        let t = shadows
-            .filter(|g| {
-                let g = &g.grid;
-                let r = (q - g.origin) / g.spacing;
-                r.min_element() >= 0.0 && (0..3).all(|a| r[a] <= g.dims[a] as f32)
-            })
-            .map_or(1.0, |g| g.shadow(q, first + k).transmittance);
+        let t = shadows.map_or(1.0, |g| g.shadow(q, first + k).transmittance);
         let e = sg_irradiance(n.dot(l.dir().normalize().as_vec3()), l.lambda as f32);
         for c in 0..3 {
             sum[c] += t * e * l.rgb[c] as f32;

@@ -233,12 +233,18 @@ impl FiberDensity {
         }
     }
 
+    /// The occluder's fraction of the voxel containing p (0 outside the volume or without one).
+    pub fn solid_at(&self, p: Vec3) -> f32 {
+        self.voxel_at(p)
+            .and_then(|v| self.solid.get(v))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
     /// Whether p lies in a voxel more than half inside the occluder (the shadow grid's points there are
     /// left out of its interpolation: their transmittance is the solid's, not the hair's).
     pub fn inside_solid(&self, p: Vec3) -> bool {
-        self.voxel_at(p)
-            .and_then(|v| self.solid.get(v))
-            .is_some_and(|&s| s > 0.5)
+        self.solid_at(p) > 0.5
     }
 
     /// The voxel containing p.

@@ -144,12 +144,15 @@ fn slice_bilinear(slice: &[PathIntegrals], nb: u32, nc: u32, u: f32, v: f32) -> 
 /// One sweep along omega: `visit(point, integrals)` for every grid point, the integrals of its path
 /// out of the grid with the first `skip` cm left out (the point's own fiber). Only the optical depth
 /// without `forward`.
+/// `behind`: the reversed sweep of the depth behind the point, which counts hair only (an occluder's
+/// solid is not fibres that scatter light back).
 pub fn sweep(
     grid: &ShadowGrid,
     pyramid: &DensityPyramid,
     forward: Option<(&FiberDensity, &ForwardTable)>,
     omega: Vec3,
     skip: f32,
+    behind: bool,
     mut visit: impl FnMut(usize, &PathIntegrals),
 ) {
     let ax = SweepAxes::new(grid, omega);
@@ -176,7 +179,11 @@ pub fn sweep(
                 let x = grid.point(ax.point_index(grid, k, ib, ic)) + omega * (0.5 * ax.step);
                 let f = match forward {
                     Some((volume, table)) => {
-                        forward_integrand(pyramid, volume, table, x, omega, lod)
+                        let mut f = forward_integrand(pyramid, volume, table, x, omega, lod);
+                        if behind {
+                            f.tau *= 1.0 - volume.solid_at(x);
+                        }
+                        f
                     }
                     // Zero outside the volume, as forward_integrand: with and without multiple
                     // scattering the direct fraction sums the same samples.
@@ -254,9 +261,17 @@ pub fn sweep_light(
     let forward = src.forward.is_some();
     let mut acc = vec![[0f32; 8]; grid.point_count()];
     for d in sweep_directions(centre, lambda, forward) {
-        sweep(grid, src.pyramid, src.forward, d.omega, src.skip, |i, f| {
-            accumulate(&mut acc[i], &d, f, forward);
-        });
+        sweep(
+            grid,
+            src.pyramid,
+            src.forward,
+            d.omega,
+            src.skip,
+            d.behind,
+            |i, f| {
+                accumulate(&mut acc[i], &d, f, forward);
+            },
+        );
     }
     acc.iter()
         .enumerate()

@@ -363,3 +363,20 @@ pub fn read_exr_channels(path: &std::path::Path, names: &[&str]) -> Vec<Vec<f32>
         })
         .collect()
 }
+
+/// The `strandlight` binary, with its fit cache in the temporary folder.
+pub fn strandlight_command() -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_strandlight"));
+    c.env(
+        "STRANDLIGHT_CACHE",
+        std::env::temp_dir().join("strandlight-test-cache"),
+    );
+    c
+}
+
+/// File `name` in this process's temporary folder for the tests of `what`.
+pub fn temp_file(what: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("strandlight-{what}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d.join(name)
+}

@@ -58,7 +58,7 @@ impl Head {
 
     /// The skull as a closed triangle mesh (outward winding, counter-clockwise seen from outside):
     /// latitude rings from the crown down, `2 rings` vertices each. With a neck, the rings stop at the
-    /// first one below the equator narrower than the neck (radius 0.45 of the head's narrower half
+    /// first one below the equator inside the neck's circle (radius 0.45 of the head's narrower half
     /// axis), a flat annulus joins it to a cylinder that runs down to two half-heights below the
     /// centre, and a disc closes it.
     pub fn mesh(&self, rings: usize, neck: bool) -> TriangleMesh {
@@ -66,11 +66,13 @@ impl Head {
         let rings = rings.max(3);
         let n = 2 * rings;
         let narrow = self.radii.x.min(self.radii.z);
+        let wide = self.radii.x.max(self.radii.z);
         let neck_r = 0.45 * narrow;
         let polar = |i: usize| PI * i as f32 / rings as f32;
+        // The last skull ring lies wholly inside the neck's circle (the annulus does not fold).
         let count = if neck {
             (rings / 2 + 1..=rings)
-                .find(|&i| polar(i).sin() * narrow < neck_r)
+                .find(|&i| polar(i).sin() * wide < neck_r)
                 .unwrap_or(rings)
                 + 1
         } else {
