@@ -18,8 +18,10 @@ pub struct BrushReport {
     /// Brush radius, render pixels.
     pub radius_px: f32,
     /// Reading the view depth back and projecting every point (once per view, on a worker in the
-    /// editor).
+    /// editor): their sum, and each.
     pub picker_ms: f64,
+    pub depth_read_ms: f64,
+    pub projection_ms: f64,
     /// CPU milliseconds per dab: finding the points, the layer, their absorption and its upload.
     pub cpu_ms_median: f64,
     pub cpu_ms_max: f64,
@@ -43,33 +45,42 @@ pub fn brush_run(
     base: &[[f32; 3]],
     dabs: usize,
 ) -> anyhow::Result<BrushReport> {
+    // The view depth alone, read back as the editor reads it (the whole frame is ten times the bytes).
     let t = Instant::now();
-    let frame = renderer.read_frame(ctx)?;
-    let camera = renderer.view_camera();
+    let (pending, camera) = renderer.start_read_view_depth(ctx);
+    let bytes = loop {
+        if let Some(r) = pending.poll(&ctx.device) {
+            break r.map_err(anyhow::Error::msg)?;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    };
+    let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes[0]);
+    let depth_read_ms = t.elapsed().as_secs_f64() * 1e3;
     let (lo, hi) = hair.bounds();
     let view = ViewDepth {
-        width: frame.width,
-        height: frame.height,
-        depth: frame.depth.clone(),
+        width: camera.size[0],
+        height: camera.size[1],
+        depth: depth.clone(),
         camera,
     };
+    let t = Instant::now();
     let picker = Picker::new(hair, view, 0.5 * (lo.x + hi.x));
-    let picker_ms = t.elapsed().as_secs_f64() * 1e3;
+    let projection_ms = t.elapsed().as_secs_f64() * 1e3;
+    let picker_ms = depth_read_ms + projection_ms;
     // A horizontal stroke through the middle of the hair on screen, half the image wide.
-    let covered: Vec<usize> = (0..frame.depth.len())
-        .filter(|&i| frame.depth[i] < 1e9)
-        .collect();
+    let width = camera.size[0];
+    let covered: Vec<usize> = (0..depth.len()).filter(|&i| depth[i] < 1e9).collect();
     anyhow::ensure!(!covered.is_empty(), "no hair on screen to paint");
-    let w = frame.width as usize;
+    let w = width as usize;
     let n = covered.len() as f32;
     let cx = covered.iter().map(|&i| (i % w) as f32 + 0.5).sum::<f32>() / n;
     let cy = covered.iter().map(|&i| (i / w) as f32 + 0.5).sum::<f32>() / n;
-    let radius = 0.04 * frame.width as f32;
+    let radius = 0.04 * width as f32;
     let brush = Brush {
         radius_px: radius,
         ..Default::default()
     };
-    let length = 0.5 * frame.width as f32;
+    let length = 0.5 * width as f32;
     let mut layer = PaintLayer::empty(hair.point_count(), hair.strand_count());
     let mut sigma: Vec<[f32; 3]> = base.to_vec();
     let mut stroke = Stroke::new();
@@ -111,6 +122,8 @@ pub fn brush_run(
         dabs,
         radius_px: radius,
         picker_ms,
+        depth_read_ms,
+        projection_ms,
         cpu_ms_max: cpu.iter().copied().fold(0.0, f64::max),
         cpu_ms_median: median(cpu),
         points_per_dab_mean: points as f64 / dabs.max(1) as f64,
