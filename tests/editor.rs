@@ -744,6 +744,8 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
     let mut session = small_session();
     session.render.width = 96;
     session.render.height = 64;
+    // A finer shadow grid than the other tests' (the screenshot shows the hair's shadow on the face).
+    session.render.shadow_grid_resolution = 32;
     let mut h = harness(session, &dir, false);
     converge(&mut h);
     let exr = dir.join("export.exr");

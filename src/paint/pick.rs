@@ -116,7 +116,8 @@ impl Buckets {
             .into_iter()
             .filter(|(_, q)| q.x >= 0.0 && q.y >= 0.0 && q.x < width as f32 && q.y < height as f32)
             .collect();
-        items.sort_by_key(|(i, q)| (cell(q), *i));
+        // The keys are unique (a point once per buckets): unstable and parallel, the same order.
+        items.par_sort_unstable_by_key(|(i, q)| (cell(q), *i));
         let mut starts = vec![0u32; cols * rows + 1];
         for (_, q) in &items {
             starts[cell(q) + 1] += 1;
@@ -180,10 +181,19 @@ impl Picker {
                 .collect()
         };
         let (w, h) = (view.width, view.height);
+        let ((direct, mirrored), t) = rayon::join(
+            || {
+                rayon::join(
+                    || Buckets::new(w, h, project_all(false)),
+                    || Buckets::new(w, h, project_all(true)),
+                )
+            },
+            || hair.root_to_tip(),
+        );
         Self {
-            direct: Buckets::new(w, h, project_all(false)),
-            mirrored: Buckets::new(w, h, project_all(true)),
-            t: hair.root_to_tip(),
+            direct,
+            mirrored,
+            t,
             view,
         }
     }
