@@ -94,11 +94,16 @@ fn shade_occluder(s: Surface) -> vec3<f32> {
     for (var k = 0u; k < batch.count; k++) {
         let j = batch.first + k;
         let l = lights[j];
+        let e = sg_irradiance(dot(s.normal, l.direction), l.lambda);
+        // A light that does not reach the surface costs no grid lookup.
+        if (e <= 0.0) {
+            continue;
+        }
         var t = 1.0;
         if (shadowed) {
             t = grid_shadow(shadow_grid, q, j).transmittance;
         }
-        sum = sum + t * sg_irradiance(dot(s.normal, l.direction), l.lambda) * l.rgb;
+        sum = sum + t * e * l.rgb;
     }
     return info.albedo / PI * sum;
 }

@@ -119,8 +119,11 @@ pub fn shade_occluder(
     let q = p + offset * n;
     let mut sum = [0f32; 3];
     for (k, l) in lights.iter().enumerate() {
-        let t = shadows.map_or(1.0, |g| g.shadow(q, first + k).transmittance);
         let e = sg_irradiance(n.dot(l.dir().normalize().as_vec3()), l.lambda as f32);
+        if e <= 0.0 {
+            continue;
+        }
+        let t = shadows.map_or(1.0, |g| g.shadow(q, first + k).transmittance);
         for c in 0..3 {
             sum[c] += t * e * l.rgb[c] as f32;
         }
