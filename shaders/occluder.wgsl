@@ -2,7 +2,8 @@
 // samples, each shaded at the pixel ray's hit on the triangle's plane with the interpolated vertex
 // normal, as a diffuse surface under one batch of SRBF lights: albedo / pi times each light's
 // irradiance (Hill's fitted SG-cosine convolution, `sg_irradiance`) times its transmittance through
-// the hair, read from the shadow grid a little off the surface (clamped at the grid's faces). Weighted by the
+// the hair, read from the shadow grid a little off the surface (clamped at the grid's faces, fading to 1
+// within a grid spacing outside it). Weighted by the
 // samples' coverage and added to the occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
 // Prepended: circular_gaussian (PI), shadow_grid (GpuLight, ShadeBatch, FLAG_SHADOWS), camera.
 
@@ -86,11 +87,21 @@ fn occluder_surface(tri: u32, ray: Ray) -> Surface {
     return Surface(p, n);
 }
 
+// How far p lies outside the grid's box, in grid spacings, clamped to [0, 1]: the grid's reading
+// (clamped at its faces) fades to unshadowed over one spacing outside it (a bust's shoulders lie far
+// outside the hair's grid, where the nearest face's values mean nothing).
+fn grid_outside(g: ShadowGridInfo, p: vec3<f32>) -> f32 {
+    let q = (p - g.origin) / g.spacing;
+    let d = max(max(-q, q - vec3<f32>(g.dims)), vec3<f32>(0.0));
+    return clamp(length(d), 0.0, 1.0);
+}
+
 // Radiance of the occluder's surface towards the camera under the batch's lights.
 fn shade_occluder(s: Surface) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let shadowed = (batch.flags & FLAG_SHADOWS) != 0u;
     let q = s.position + info.normal_offset * s.normal;
+    let outside = grid_outside(shadow_grid, q);
     for (var k = 0u; k < batch.count; k++) {
         let j = batch.first + k;
         let l = lights[j];
@@ -101,7 +112,7 @@ fn shade_occluder(s: Surface) -> vec3<f32> {
         }
         var t = 1.0;
         if (shadowed) {
-            t = grid_shadow(shadow_grid, q, j).transmittance;
+            t = mix(grid_shadow(shadow_grid, q, j).transmittance, 1.0, outside);
         }
         sum = sum + t * e * l.rgb;
     }

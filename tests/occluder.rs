@@ -4,6 +4,8 @@
 //! against their CPU twins, the AOVs adding up to the beauty, and the head's shadow under a narrow
 //! light behind it against a CPU ray cast of every visible hair point towards the light.
 
+mod common;
+
 use glam::Vec3;
 use strandlight::envmap::{SrbfLight, SrbfSet};
 use strandlight::gpu::{GpuContext, GpuOptions};
@@ -283,4 +285,71 @@ fn the_head_shadows_the_hair_behind_it_from_a_narrow_light() {
         clear.len()
     );
     assert!(worst <= 0.02 * clear_mean, "{worst} {clear_mean}");
+}
+
+#[test]
+fn a_mesh_file_is_drawn_shaded_and_held_as_a_solid_under_its_hair() {
+    // The TressFX ponytail on its bust (OBJ: head, eyes, teeth, jacket; open at the bottom).
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    use strandlight::hair::load::{LoadOptions, load_hair, load_mesh};
+    let loaded = load_hair(
+        &data.join("hair/tressfx_ponytail.hair"),
+        &LoadOptions::default(),
+    )
+    .expect("the ponytail");
+    let mesh = load_mesh(
+        &data.join("meshes/tressfx_ponytail_head.obj"),
+        &loaded.normalization,
+    )
+    .expect("its bust");
+    let hair = loaded.file.hair;
+    let look = HairLook::new(Preset::Auburn.params());
+    let (lo, hi) = hair.bounds();
+    let s = Scene {
+        sigma_a: vec![look.fast.sigma_a_rgb(); hair.point_count()],
+        camera: Camera::framing(lo, hi, 200.0, 5.0, 96.0 / 72.0, 0.95),
+        hair,
+        look,
+        settings: RenderSettings {
+            width: 96,
+            height: 72,
+            multiple_scattering: false,
+            volume_resolution: 48,
+            shadow_grid_resolution: 24,
+            ..Default::default()
+        },
+        occluder: Occluder::new(mesh, SKIN_ALBEDO),
+    };
+    let lights = SrbfSet::read(
+        &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps/sunny.srbf.json"),
+    )
+    .expect("the sunny fit")
+    .lights;
+    let (renderer, frame) = render(&context(), &s, &lights, true);
+    let (solid, _) = renderer.occluder_solid().expect("an occluder");
+    let filled = solid.iter().filter(|&&f| f > 0.5).count() as f64 / solid.len() as f64;
+    let head = frame
+        .sample_ids
+        .iter()
+        .filter(|ids| ids.iter().any(|&id| occluder_triangle(id).is_some()))
+        .count();
+    let hair_px = frame
+        .sample_ids
+        .iter()
+        .filter(|ids| ids.iter().any(|&id| is_hair(id)))
+        .count();
+    let lit = frame.occluder.iter().filter(|c| c[1] > 0.0).count();
+    println!(
+        "the bust: {:.1} % of the hair's volume inside it, {head} pixels show it ({lit} lit), {hair_px} show hair",
+        100.0 * filled
+    );
+    // The head fills part of the hair's volume (not all of it: the open jacket adds no interior),
+    // shows, is lit, and hides part of the hair.
+    assert!(filled > 0.02 && filled < 0.6, "{filled}");
+    assert!(
+        head > 500 && lit > head / 2 && hair_px > 200,
+        "{head} {lit} {hair_px}"
+    );
 }

@@ -104,7 +104,8 @@ pub fn sg_irradiance(mu: f32, lambda: f32) -> f32 {
 
 /// Radiance of the occluder's surface point `p` with normal `n` towards the camera under `lights`
 /// (the grid's light k is lights' k), each light scaled by its transmittance read `offset` cm off the
-/// surface when shadows are given (clamped at the grid's faces, as the hair reads it). Twin of
+/// surface when shadows are given (clamped at the grid's faces, as the hair reads it, and fading to
+/// unshadowed within a grid spacing outside them: [`grid_outside`]). Twin of
 /// `shade_occluder` in
 /// `shaders/occluder.wgsl`.
 pub fn shade_occluder(
@@ -117,18 +118,31 @@ pub fn shade_occluder(
     offset: f32,
 ) -> [f32; 3] {
     let q = p + offset * n;
+    let outside = shadows.map_or(1.0, |g| grid_outside(&g.grid, q));
     let mut sum = [0f32; 3];
     for (k, l) in lights.iter().enumerate() {
         let e = sg_irradiance(n.dot(l.dir().normalize().as_vec3()), l.lambda as f32);
         if e <= 0.0 {
             continue;
         }
-        let t = shadows.map_or(1.0, |g| g.shadow(q, first + k).transmittance);
+        let t = shadows.map_or(1.0, |g| {
+            let t = g.shadow(q, first + k).transmittance;
+            t + (1.0 - t) * outside
+        });
         for c in 0..3 {
             sum[c] += t * e * l.rgb[c] as f32;
         }
     }
     std::array::from_fn(|c| albedo[c] / std::f32::consts::PI * sum[c])
+}
+
+/// How far `p` lies outside the grid's box, in grid spacings, clamped to [0, 1]: the grid's reading
+/// (clamped at its faces) fades to unshadowed over one spacing outside it. Twin of `grid_outside` in
+/// `shaders/occluder.wgsl`.
+pub fn grid_outside(g: &crate::shadow::grid::ShadowGrid, p: Vec3) -> f32 {
+    let q = (p - g.origin) / g.spacing;
+    let dims = Vec3::from(g.dims.map(|d| d as f32));
+    (-q).max(q - dims).max(Vec3::ZERO).length().clamp(0.0, 1.0)
 }
 
 /// The occluder's radiance in every pixel of a frame (coverage-weighted: each distinct triangle among
