@@ -34,7 +34,8 @@ struct ResolveInfo {
 struct ResolveRows {
     row0: u32,
     rows: u32,
-    _p0: u32,
+    // 1: also look the background up (it depends on the camera alone: a shading band's resolve skips it).
+    background: u32,
     _p1: u32,
 }
 @group(0) @binding(12) var<storage, read> band: ResolveRows;
@@ -110,6 +111,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     beauty[pixel] = vec4<f32>(info.exposure_scale * sum, alpha);
     view_depth[pixel] = select(1e10, linear_depth(nearest), covered > 0u);
     sample_ids[pixel] = ids;
-    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
-    background[pixel] = vec4<f32>(info.exposure_scale * background_radiance(ray.dir), 1.0);
+    if (band.background != 0u) {
+        let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);
+        background[pixel] = vec4<f32>(info.exposure_scale * background_radiance(ray.dir), 1.0);
+    }
 }

@@ -24,7 +24,8 @@ use crate::scattering::HairParams;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{
-    LoadedHairSource, base_absorption, mean_absorption, occluder_mesh, renderer_look, turned_lights,
+    LoadedHairSource, base_absorption, mean_absorption, occluder_mesh, renderer_look,
+    shown_occluder, turned_lights,
 };
 use crate::session::{
     AssembleError, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions, Session,
@@ -304,11 +305,7 @@ impl LiveScene {
                     Some(format!("{e}; showing the hair's own head instead")),
                 ),
             };
-        session.occluder.validate().map_err(AssembleError::Look)?;
-        let occluder = occluder_mesh
-            .clone()
-            .filter(|_| session.occluder.show)
-            .map(|m| Occluder::new(m, session.occluder.albedo));
+        let occluder = shown_occluder(&session.occluder, occluder_mesh.clone())?;
         renderer.set_occluder(&ctx, occluder.as_ref());
         let warning = match (warning, occluder_warning) {
             (Some(a), Some(b)) => Some(format!("{a}; {b}")),
@@ -464,12 +461,7 @@ impl LiveScene {
                     self.renderer.set_occluder_albedo(&self.ctx, albedo);
                 }
                 _ => {
-                    session.occluder.validate().map_err(AssembleError::Look)?;
-                    self.occluder = self
-                        .occluder_mesh
-                        .clone()
-                        .filter(|_| session.occluder.show)
-                        .map(|m| Occluder::new(m, albedo));
+                    self.occluder = shown_occluder(&session.occluder, self.occluder_mesh.clone())?;
                     self.renderer
                         .set_occluder(&self.ctx, self.occluder.as_ref());
                 }

@@ -241,6 +241,7 @@ impl Renderer {
             &self.background_map,
             &p.targets,
             row0..row0 + rows,
+            true,
             None,
         );
     }

@@ -1064,7 +1064,7 @@ impl Renderer {
                 // The last part: the image's visibility is whole; the components restart.
                 self.visibility_valid = true;
                 ShadingPass::clear(enc, &self.targets);
-                self.encode_resolve(device, enc, 0..self.settings.height);
+                self.encode_resolve(device, enc, 0..self.settings.height, true);
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
@@ -1074,7 +1074,7 @@ impl Renderer {
                 let inputs = self.shading_inputs();
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
-                self.encode_resolve(device, enc, row0..row0 + rows);
+                self.encode_resolve(device, enc, row0..row0 + rows, false);
             }
         }
     }
@@ -1084,6 +1084,7 @@ impl Renderer {
         device: &wgpu::Device,
         enc: &mut wgpu::CommandEncoder,
         rows: std::ops::Range<u32>,
+        background: bool,
     ) {
         self.resolve_pass.encode(
             device,
@@ -1093,6 +1094,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             rows,
+            background,
             None,
         );
     }

@@ -410,7 +410,7 @@ impl Renderer {
             })
         };
         let camera_u = camera.uniform(settings.width, settings.height, settings.min_width_px);
-        let resolve_info = ResolveInfo::new(settings.exposure, settings.samples, None);
+        let resolve_info = ResolveInfo::new(settings.exposure, settings.samples);
         let skip = settings.shadow_skip(hair);
         let shadow_grid = GpuShadowGrid::new(
             device,
@@ -994,12 +994,10 @@ impl Renderer {
     /// by `yaw` radians about +Y (world = rotate_yaw(map direction, yaw); a map made for turned lights
     /// gives its own `yaw`). The resolve writes it with every image; here once more for the current one.
     pub fn set_background(&mut self, ctx: &GpuContext, map: Option<&BackgroundMap>, yaw: f32) {
-        let samples = self.resolve_params.samples;
-        self.resolve_params = ResolveInfo {
-            exposure_scale: self.resolve_params.exposure_scale,
-            env_yaw: yaw,
-            ..ResolveInfo::new(0.0, samples, map)
-        };
+        let r = &mut self.resolve_params;
+        r.env_width = map.map_or(0, |m| m.width);
+        r.env_height = map.map_or(0, |m| m.height);
+        r.env_yaw = yaw;
         self.background_map = environment_buffer(&ctx.device, map);
         self.resolve_again(ctx, "background");
     }
@@ -1031,6 +1029,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             0..self.settings.height,
+            true,
             None,
         );
         if let Some(p) = &self.preview {
@@ -1042,6 +1041,7 @@ impl Renderer {
                 &self.background_map,
                 &p.targets,
                 0..p.targets.height,
+                true,
                 None,
             );
         }
@@ -1172,6 +1172,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             0..self.settings.height,
+            true,
             timer.and_then(|t| t.compute_writes("resolve")),
         );
         self.visibility_valid = true;

@@ -22,17 +22,14 @@ pub struct ResolveInfo {
 const _: () = assert!(std::mem::size_of::<ResolveInfo>() == 32);
 
 impl ResolveInfo {
-    pub fn new(
-        exposure: f32,
-        samples: u32,
-        map: Option<&super::background::BackgroundMap>,
-    ) -> Self {
+    /// No background map yet ([`super::renderer::Renderer::set_background`] gives one).
+    pub fn new(exposure: f32, samples: u32) -> Self {
         Self {
             exposure_scale: exposure.exp2(),
             samples,
-            env_width: map.map_or(0, |m| m.width),
-            env_height: map.map_or(0, |m| m.height),
-            env_yaw: map.map_or(0.0, |m| m.yaw),
+            env_width: 0,
+            env_height: 0,
+            env_yaw: 0.0,
             _pad: [0; 3],
         }
     }
@@ -55,7 +52,9 @@ impl ResolvePass {
 
     /// Encodes the resolve of image rows `rows` (all of them after visibility or an exposure change;
     /// a band's after progressive refinement shaded it: at 720x480 on lavapipe a whole-image resolve
-    /// costs ~18 ms, which after every band was most of the refinement's time).
+    /// costs ~18 ms, which after every band was most of the refinement's time). With `background`,
+    /// the rows' background is looked up too (after visibility, a new camera or map; a shading band
+    /// leaves it as it is).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -66,6 +65,7 @@ impl ResolvePass {
         environment: &wgpu::Buffer,
         targets: &FrameTargets,
         rows: std::ops::Range<u32>,
+        background: bool,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let row0 = rows.start.min(targets.height);
@@ -75,7 +75,7 @@ impl ResolvePass {
         let band = buffer_init(
             device,
             "resolve rows",
-            bytemuck::cast_slice(&[row0, count, 0, 0]),
+            bytemuck::cast_slice(&[row0, count, background as u32, 0]),
             wgpu::BufferUsages::STORAGE,
         );
         let mut entries = vec![

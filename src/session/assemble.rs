@@ -233,8 +233,16 @@ pub fn scene_occluder(
     if !o.show {
         return Ok(None);
     }
+    shown_occluder(o, occluder_mesh(o, own, normalization)?)
+}
+
+/// The occluder the options show with `mesh` (their mesh, already resolved): none when hidden.
+pub fn shown_occluder(
+    o: &OccluderOptions,
+    mesh: Option<TriangleMesh>,
+) -> Result<Option<Occluder>, AssembleError> {
     o.validate().map_err(AssembleError::Look)?;
-    Ok(occluder_mesh(o, own, normalization)?.map(|m| Occluder::new(m, o.albedo)))
+    Ok(mesh.filter(|_| o.show).map(|m| Occluder::new(m, o.albedo)))
 }
 
 /// The options' mesh file (brought into the hair's space) or the hair's own mesh; none without
