@@ -13,18 +13,19 @@ struct Camera {
     far: f32,
 }
 
-// A visibility sample's value: segment + 1 for hair, -(triangle + 1) for the occluder, 0 for nothing
-// (twin of render/occluder.rs: VisibleSample).
-fn visible_hair(v: f32) -> u32 {
-    return select(0u, u32(v + 0.5), v > 0.5);
-}
-
+// A visibility sample's value: -(triangle + 1) for the occluder, 0 for nothing (twin of
+// render/occluder.rs: occluder_triangle; the hair is in the K-buffer).
 fn visible_occluder(v: f32) -> u32 {
     return select(0u, u32(-v + 0.5), v < -0.5);
 }
 
 // The occluder's samples in the resolved sample ids: triangle + 1 with the top bit set.
 const OCCLUDER_ID_BIT: u32 = 0x80000000u;
+
+// Distance along the view axis of a [0, 1] depth (directx-style right-handed projection).
+fn linear_depth(c: Camera, d: f32) -> f32 {
+    return c.near * c.far / (c.far - d * (c.far - c.near));
+}
 
 struct Ray {
     origin: vec3<f32>,

@@ -4,7 +4,8 @@
 // irradiance (Hill's fitted SG-cosine convolution, `sg_irradiance`) times its transmittance through
 // the hair, read from the shadow grid a little off the surface (clamped at the grid's faces, fading to 1
 // within a grid spacing outside it). Weighted by the
-// samples' coverage and added to the occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
+// samples' coverage and the transmittance of the hair in front (the K-buffer's), and added to the
+// occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
 // Prepended: circular_gaussian (PI), shadow_grid (GpuLight, ShadeBatch, FLAG_SHADOWS), camera.
 
 struct OccluderInfo {
@@ -24,6 +25,8 @@ struct OccluderInfo {
 @group(0) @binding(8) var<storage, read> info: OccluderInfo;
 @group(0) @binding(9) var visibility: texture_multisampled_2d<f32>;
 @group(0) @binding(10) var<storage, read_write> occluder: array<vec4<f32>>;
+// The K-buffer's per-pixel summary: .y is the transmittance of the hair in front of the occluder.
+@group(0) @binding(11) var<storage, read> pixel_info: array<vec4<f32>>;
 
 // Irradiance of an SRBF of unit amplitude, G(w) = exp(2 (w.xi - 1) / lambda^2), on a surface whose
 // normal makes cosine `mu` with its centre: Hill 2016's fitted convolution with the clamped cosine
@@ -129,7 +132,8 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = y * camera.size.x + id.x;
     let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(y) + 0.5);
     var sum = vec3<f32>(0.0);
-    for (var s = 0u; s < batch.samples; s++) {
+    let samples = textureNumSamples(visibility);
+    for (var s = 0u; s < samples; s++) {
         let tri = visible_occluder(textureLoad(visibility, xy, i32(s)).x);
         if (tri == 0u) {
             continue;
@@ -137,7 +141,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         // Each distinct triangle once, with its share of the samples.
         var seen = false;
         var count = 0u;
-        for (var o = 0u; o < batch.samples; o++) {
+        for (var o = 0u; o < samples; o++) {
             let other = visible_occluder(textureLoad(visibility, xy, i32(o)).x);
             if (other == tri) {
                 seen = seen || o < s;
@@ -147,7 +151,8 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         if (seen) {
             continue;
         }
-        sum = sum + f32(count) / f32(batch.samples) * shade_occluder(occluder_surface(tri - 1u, ray));
+        sum = sum + f32(count) / f32(samples) * shade_occluder(occluder_surface(tri - 1u, ray));
     }
-    occluder[pixel] = occluder[pixel] + vec4<f32>(sum, 0.0);
+    // Seen through the hair in front of it.
+    occluder[pixel] = occluder[pixel] + vec4<f32>(pixel_info[pixel].y * sum, 0.0);
 }

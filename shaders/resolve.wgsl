@@ -1,6 +1,6 @@
-// Resolve pass: per pixel, coverage (alpha) from the visibility samples (hair and occluder), the nearest
-// sample's view depth, the sample ids under the pixel (segment + 1, or the occluder's triangle + 1 with
-// the top bit set; for picking and the CPU twins), and the beauty = sum of the accumulated components
+// Resolve pass: per pixel, coverage (alpha: the hair's composited K-buffer coverage, plus the occluder's
+// samples' share behind the hair in front of them), the nearest view depth (hair or occluder), the
+// occluder's sample ids (its triangle + 1 with the top bit set; for the CPU twins), and the beauty = sum of the accumulated components
 // and the occluder's radiance times the exposure scale 2^EV. Linear, premultiplied by coverage; no tonemap.
 // Also the background behind each pixel: the environment map along the pixel's centre ray, exposed
 // (zero without a map); the composite is the picture's business (render/background.rs).
@@ -36,13 +36,18 @@ struct ResolveRows {
     rows: u32,
     // 1: also look the background up (it depends on the camera alone: a shading band's resolve skips it).
     background: u32,
-    _p1: u32,
+    // 1: progressive refinement has shaded part of the fragments: the hair's radiance is scaled by its
+    // alpha over the weight shaded so far (the unshaded fragments take the shaded ones' mean).
+    normalise: u32,
 }
 @group(0) @binding(12) var<storage, read> band: ResolveRows;
 @group(0) @binding(13) var<storage, read> environment: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> background: array<vec4<f32>>;
 // The occluder's radiance (coverage-weighted, like the components); zero without one.
 @group(0) @binding(15) var<storage, read> occluder: array<vec4<f32>>;
+// The K-buffer's per-pixel summary (hair alpha, transmittance of the hair in front of the occluder,
+// nearest hair depth, fragment count).
+@group(0) @binding(16) var<storage, read> pixel_info: array<vec4<f32>>;
 
 // Radiance of the environment along the unit world direction d: the map turned back by the yaw
 // (envmap/direction.rs: rotate_yaw, uv_from_direction), bilinear between texel centres, wrapping in
@@ -78,11 +83,6 @@ fn background_radiance(d: vec3<f32>) -> vec3<f32> {
     return top + (bottom - top) * f.y;
 }
 
-// Distance along the view axis of a [0, 1] depth (directx-style right-handed projection).
-fn linear_depth(d: f32) -> f32 {
-    return camera.near * camera.far / (camera.far - d * (camera.far - camera.near));
-}
-
 @compute @workgroup_size(8, 8)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.y >= band.rows) {
@@ -93,23 +93,29 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = id.y * camera.size.x + id.x;
+    // The occluder's samples (the hair is in the K-buffer: render/kbuffer.rs).
     var ids = vec4<u32>(0u);
     var covered = 0u;
     var nearest = 1.0;
     for (var s = 0u; s < info.samples; s++) {
-        let f = textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x;
-        let tri = visible_occluder(f);
-        let v = select(visible_hair(f), OCCLUDER_ID_BIT | tri, tri != 0u);
-        ids[s] = v;
-        if (v != 0u) {
+        let tri = visible_occluder(textureLoad(visibility, vec2<i32>(id.xy), i32(s)).x);
+        if (tri != 0u) {
+            ids[s] = OCCLUDER_ID_BIT | tri;
             covered = covered + 1u;
             nearest = min(nearest, textureLoad(depth, vec2<i32>(id.xy), i32(s)));
         }
     }
-    let alpha = f32(covered) / f32(info.samples);
-    let sum = aov_r[pixel].xyz + aov_tt[pixel].xyz + aov_trt[pixel].xyz + aov_ms_global[pixel].xyz + aov_ms_local[pixel].xyz + occluder[pixel].xyz;
+    // The hair's composited coverage, and the occluder's behind the hair in front of it.
+    let hair = pixel_info[pixel];
+    let alpha = min(hair.x + f32(covered) / f32(info.samples) * hair.y, 1.0);
+    var hair_sum = aov_r[pixel].xyz + aov_tt[pixel].xyz + aov_trt[pixel].xyz + aov_ms_global[pixel].xyz + aov_ms_local[pixel].xyz;
+    let shaded = aov_r[pixel].w;
+    if (band.normalise != 0u && shaded > 0.0) {
+        hair_sum = hair_sum * (hair.x / shaded);
+    }
+    let sum = hair_sum + occluder[pixel].xyz;
     beauty[pixel] = vec4<f32>(info.exposure_scale * sum, alpha);
-    view_depth[pixel] = select(1e10, linear_depth(nearest), covered > 0u);
+    view_depth[pixel] = min(hair.z, select(1e10, linear_depth(camera, nearest), covered > 0u));
     sample_ids[pixel] = ids;
     if (band.background != 0u) {
         let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(id.y) + 0.5);

@@ -1,5 +1,4 @@
-// Shading pass (Xu 2011 Sec. 5): for every pixel, the distinct hair segments among its visibility
-// samples are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
+// Shading pass (Xu 2011 Sec. 5): for every pixel, the hair fragments of its K-buffer are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
 // each light scaled by its transmittance (swept through the fiber-density pyramid at the points of the
 // shadow grid, read trilinearly), and accumulated per lobe
 // weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
@@ -10,7 +9,7 @@
 // dual_response, shadow_grid, camera.
 
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
-// `ShadeBatch.slot` of the preview's dispatches: every pixel shades one segment, not each distinct one.
+// `ShadeBatch.slot` of the preview's dispatches: every pixel shades one fragment for all of them.
 const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 
 
@@ -32,8 +31,9 @@ const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 @group(0) @binding(15) var<storage, read_write> aov_trt: array<vec4<f32>>;
 @group(0) @binding(16) var<storage, read_write> aov_ms_global: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
-@group(0) @binding(18) var visibility: texture_multisampled_2d<f32>;
+@group(0) @binding(18) var<storage, read> fragments: array<vec2<u32>>;
 @group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
+@group(0) @binding(20) var<storage, read> pixel_info: array<vec4<f32>>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -115,47 +115,41 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let xy = vec2<u32>(id.x, y);
     let pixel = y * camera.size.x + id.x;
-    // This dispatch handles visibility sample `batch.slot` of every pixel: its segment is shaded if no
-    // earlier sample of the pixel holds the same segment, weighted by the fraction of samples it
-    // covers (or, for the preview, the pixel's representative sample). (One shading call per invocation: looping over a pixel's segments inside one invocation
-    // gave wrong sums on lavapipe.)
-    var v = 0u;
-    var count = 0u;
-    if (batch.slot == SLOT_REPRESENTATIVE) {
-        // The preview: one shading per pixel, the first covered sample's segment standing for every
-        // covered sample (representative_sample in shade.rs).
-        for (var s = 0u; s < batch.samples; s++) {
-            let other = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
-            if (other != 0u) {
-                if (v == 0u) {
-                    v = other;
-                }
-                count = count + 1u;
-            }
-        }
-        if (v == 0u) {
-            return;
-        }
+    // This dispatch shades K-buffer slot `batch.slot` of every pixel with its weight, or for the
+    // preview one fragment with the pixel's whole hair alpha (representative_fragment in shade.rs). (One shading call per invocation: looping over a pixel's fragments inside one
+    // invocation gave wrong sums on lavapipe.)
+    let base = pixel * batch.slots;
+    var f = fragments[base];
+    var w = pixel_info[pixel].x;
+    if (batch.slot != SLOT_REPRESENTATIVE) {
+        f = fragments[base + batch.slot];
+        w = bitcast<f32>(f.y);
     } else {
-        v = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(batch.slot)).x);
-        if (v == 0u) {
-            return;
-        }
-        for (var s = 0u; s < batch.samples; s++) {
-            let other = visible_hair(textureLoad(visibility, vec2<i32>(xy), i32(s)).x);
-            if (other == v) {
-                if (s < batch.slot) {
-                    return;
-                }
-                count = count + 1u;
+        // The fragment at which the weights reach half the hair's alpha (the front one is the most
+        // lit: standing for all, it brightened the preview).
+        var reached = 0.0;
+        for (var i = 0u; i < batch.slots; i++) {
+            let g = fragments[base + i];
+            if (g.x == 0u) {
+                break;
+            }
+            f = g;
+            reached = reached + bitcast<f32>(g.y);
+            if (reached >= 0.5 * w) {
+                break;
             }
         }
     }
+    if (f.x == 0u || w <= 0.0) {
+        return;
+    }
+    let v = f.x;
     let ray = pixel_ray(camera, f32(xy.x) + 0.5, f32(xy.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
     let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
-    let w = f32(count) / f32(batch.samples);
-    aov_r[pixel] = aov_r[pixel] + vec4<f32>(w * l.r, 0.0);
+    // .w of R: the weight shaded so far, counted at each fragment's first light batch (the resolve
+    // scales a partly shaded image by the pixel's hair alpha over it while refinement runs).
+    aov_r[pixel] = aov_r[pixel] + vec4<f32>(w * l.r, select(0.0, w, batch.first == 0u));
     aov_tt[pixel] = aov_tt[pixel] + vec4<f32>(w * l.tt, 0.0);
     aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(w * l.trt, 0.0);
     aov_ms_global[pixel] = aov_ms_global[pixel] + vec4<f32>(w * l.ms_global, 0.0);

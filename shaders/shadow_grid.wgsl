@@ -17,7 +17,8 @@ struct ShadeBatch {
     first: u32,
     count: u32,
     flags: u32,
-    samples: u32,
+    // Fragments per pixel in the K-buffer.
+    slots: u32,
     slot: u32,
     // Rows [row0, row0 + rows) of the image (all of them for a whole frame, a band per unit of
     // progressive refinement).

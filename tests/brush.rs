@@ -1,11 +1,11 @@
 //! The brush's picking against brute force: the points a dab touches (found from the frame's view
-//! depth, read back from the GPU) against the same footprint computed on the CPU by casting each
-//! pixel's sample rays at every segment's ribbon; paint-through, the root-to-tip mask and the mirror.
+//! depth, read back from the GPU) against the same footprint computed on the CPU from every segment's
+//! fragments in every pixel (brute force); paint-through, the root-to-tip mask and the mirror.
 
 mod common;
 
 use glam::Vec3;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::paint::brush::{Brush, FRONT_DEPTH, Falloff};
 use strandlight::paint::pick::{Picker, Projected, ViewDepth, project};
@@ -17,95 +17,37 @@ fn context() -> GpuContext {
     GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)")
 }
 
-/// The standard 4x multisample positions (Vulkan, D3D).
-const SAMPLES_4: [[f32; 2]; 4] = [
-    [0.375, 0.125],
-    [0.875, 0.375],
-    [0.125, 0.625],
-    [0.625, 0.875],
-];
+/// The front depth of every pixel by brute force on the CPU: the nearest of the fragments every
+/// segment's ribbon (the fibre's true width) leaves in the pixels it touches (the K-buffer's CPU twin,
+/// [`strandlight::render::kbuffer::abuffer`]), None where no fibre touches the pixel.
+struct CpuDepth {
+    c: CameraUniform,
+    front: Vec<Option<f32>>,
+}
 
-/// The CPU twin of the visibility pass's geometry: each segment's camera-facing ribbon (the fibre's
-/// width, at least `min_width_px` pixels) as two triangles, exactly as `vs_ribbon` builds them.
-fn ribbons(hair: &strandlight::hair::Hair, c: &CameraUniform) -> Vec<[Vec3; 4]> {
-    let eye = Vec3::from(c.eye);
-    let forward = Vec3::from(c.forward);
-    let mut out = Vec::new();
-    for s in 0..hair.strand_count() {
-        let r = hair.strand_range(s);
-        for i in r.start..r.end - 1 {
-            let (a, b) = (hair.positions[i], hair.positions[i + 1]);
-            let corner = |p: Vec3, w: f32, side: f32| {
-                let to_eye = eye - p;
-                let sv = (b - a).cross(to_eye);
-                let len = sv.length().max(1e-20);
-                let depth = (-to_eye).dot(forward).max(1e-6);
-                let hw = (0.5 * w).max(0.5 * c.min_width_px * c.pixel_angle * depth);
-                p + (side * hw / len) * sv
-            };
-            let (wa, wb) = (hair.thickness_at(s, i), hair.thickness_at(s, i + 1));
-            out.push([
-                corner(a, wa, -1.0),
-                corner(b, wb, -1.0),
-                corner(a, wa, 1.0),
-                corner(b, wb, 1.0),
-            ]);
+impl CpuDepth {
+    fn new(hair: &strandlight::hair::Hair, c: CameraUniform) -> Self {
+        let points = strandlight::gpu::fiber_density::GpuHair::point_data(hair, 1.0);
+        let segments = strandlight::render::shade::segment_starts(hair);
+        let ab = strandlight::render::kbuffer::abuffer(&c, &points, &segments);
+        Self {
+            c,
+            front: ab
+                .pixels
+                .iter()
+                .map(|l| l.first().map(|f| f.depth))
+                .collect(),
         }
     }
-    out
-}
 
-/// Ray-triangle distance (Moller-Trumbore), None when it misses.
-fn hit(o: Vec3, d: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Option<f32> {
-    let (e1, e2) = (b - a, c - a);
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let t0 = o - a;
-    let u = t0.dot(p) / det;
-    let q = t0.cross(e1);
-    let v = d.dot(q) / det;
-    let t = e2.dot(q) / det;
-    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
-}
-
-/// The nearest hair depth (along the view axis) of a pixel's samples, by brute force.
-struct CpuDepth<'a> {
-    c: CameraUniform,
-    ribbons: &'a [[Vec3; 4]],
-    cache: HashMap<(i64, i64), Option<f32>>,
-}
-
-impl CpuDepth<'_> {
-    fn pixel(&mut self, x: i64, y: i64) -> Option<f32> {
+    fn pixel(&self, x: i64, y: i64) -> Option<f32> {
         if x < 0 || y < 0 || x >= self.c.size[0] as i64 || y >= self.c.size[1] as i64 {
             return None;
         }
-        if let Some(d) = self.cache.get(&(x, y)) {
-            return *d;
-        }
-        let forward = Vec3::from(self.c.forward);
-        let mut best: Option<f32> = None;
-        for s in SAMPLES_4 {
-            let (o, d) =
-                strandlight::render::camera::pixel_ray(&self.c, x as f32 + s[0], y as f32 + s[1]);
-            for q in self.ribbons {
-                for t in [hit(o, d, q[0], q[1], q[2]), hit(o, d, q[2], q[1], q[3])]
-                    .into_iter()
-                    .flatten()
-                {
-                    let z = (t * d).dot(forward);
-                    best = Some(best.map_or(z, |b| b.min(z)));
-                }
-            }
-        }
-        self.cache.insert((x, y), best);
-        best
+        self.front[(y * self.c.size[0] as i64 + x) as usize]
     }
 
-    fn around(&mut self, q: Projected) -> Option<f32> {
+    fn around(&self, q: Projected) -> Option<f32> {
         let (px, py) = (q.x.floor() as i64, q.y.floor() as i64);
         let mut best: Option<f32> = None;
         for dy in -1..=1 {
@@ -174,7 +116,7 @@ fn cpu_region(
     radius: f32,
     reach: f32,
     band: f32,
-    cpu: &mut CpuDepth,
+    cpu: &CpuDepth,
 ) -> Vec<(u32, Option<bool>)> {
     let mut out = Vec::new();
     for (i, p) in positions.iter().enumerate() {
@@ -218,12 +160,7 @@ fn compare(selected: &BTreeSet<u32>, region: &[(u32, Option<bool>)]) -> (usize, 
 #[test]
 fn a_dab_touches_the_footprint_a_cpu_ray_cast_finds_front_through_masked_and_mirrored() {
     let s = setup();
-    let ribbons = ribbons(&s.hair, &s.camera);
-    let mut cpu = CpuDepth {
-        c: s.camera,
-        ribbons: &ribbons,
-        cache: HashMap::new(),
-    };
+    let cpu = CpuDepth::new(&s.hair, s.camera);
     let radius = 12.0;
     // Depth differences between the GPU's samples and the CPU's rays are well under a millimetre.
     let band = 0.05;
@@ -248,7 +185,7 @@ fn a_dab_touches_the_footprint_a_cpu_ray_cast_finds_front_through_masked_and_mir
         radius,
         FRONT_DEPTH,
         band,
-        &mut cpu,
+        &cpu,
     );
     let (n, wrong) = compare(&front, &region);
     println!(
@@ -263,7 +200,7 @@ fn a_dab_touches_the_footprint_a_cpu_ray_cast_finds_front_through_masked_and_mir
         ..brush
     };
     let through = run(&deep);
-    let region = cpu_region(&s, &s.hair.positions, s.centre, radius, 4.0, band, &mut cpu);
+    let region = cpu_region(&s, &s.hair.positions, s.centre, radius, 4.0, band, &cpu);
     let (n, wrong) = compare(&through, &region);
     println!(
         "paint-through 4 cm: {} points, {n} compared, {wrong} differ",
@@ -305,7 +242,7 @@ fn a_dab_touches_the_footprint_a_cpu_ray_cast_finds_front_through_masked_and_mir
         .iter()
         .map(|p| Vec3::new(2.0 * s.mirror_x - p.x, p.y, p.z))
         .collect();
-    let region_m = cpu_region(&s, &mirror, s.centre, radius, FRONT_DEPTH, band, &mut cpu);
+    let region_m = cpu_region(&s, &mirror, s.centre, radius, FRONT_DEPTH, band, &cpu);
     let only_mirror: BTreeSet<u32> = both.difference(&front).copied().collect();
     let near: BTreeSet<u32> = region_m.iter().map(|r| r.0).collect();
     let mut n = 0;

@@ -14,7 +14,7 @@ use strandlight::render::targets::FrameTargets;
 fn the_display_pass_matches_its_cpu_twin() {
     let ctx = GpuContext::new_headless(&GpuOptions::from_env()).expect("a GPU adapter (lavapipe)");
     let (w, h) = (37u32, 11u32);
-    let targets = FrameTargets::new(&ctx.device, w, h, 4);
+    let targets = FrameTargets::new(&ctx.device, w, h, 4, (1, Default::default()));
     let n = (w * h) as usize;
     // Radiance from 0 to ~8 (past the filmic shoulder), coverage from 0 to 1.
     let beauty: Vec<[f32; 4]> = (0..n)
@@ -43,7 +43,7 @@ fn the_display_pass_matches_its_cpu_twin() {
         .write_buffer(&targets.background, 0, bytemuck::cast_slice(&background));
     // A preview: a third of the size, other values.
     let (pw, ph) = (w.div_ceil(3), h.div_ceil(3));
-    let preview = FrameTargets::new(&ctx.device, pw, ph, 4);
+    let preview = FrameTargets::new(&ctx.device, pw, ph, 4, (1, Default::default()));
     let pn = (pw * ph) as usize;
     let preview_beauty: Vec<[f32; 4]> = (0..pn)
         .map(|i| {

@@ -306,9 +306,10 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     fresh.render_frame(&ctx);
     let want = fresh.read_frame(&ctx).expect("read");
     let d = difference(&want, &got);
+    // The hair's mean radiance (not premultiplied: thicker fibres also cover more).
     let mean = |f: &strandlight::render::Frame| {
-        let n = f.covered().count().max(1) as f64;
-        f.covered().map(|i| f.beauty[i][1] as f64).sum::<f64>() / n
+        let alpha: f64 = f.covered().map(|i| f.beauty[i][3] as f64).sum();
+        f.covered().map(|i| f.beauty[i][1] as f64).sum::<f64>() / alpha.max(1e-12)
     };
     println!(
         "thickness x3 against a renderer made with the scaled hair: {d:.1e}; mean G of hair pixels {:.4} -> {:.4}, hair pixels {} -> {}",

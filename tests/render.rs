@@ -18,7 +18,7 @@ use strandlight::render::reference::{
 };
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{
-    DISTINCT, REPRESENTATIVE, SampleChoice, ShadingHair, shade_pixels, shade_point,
+    EVERY_FRAGMENT, FragmentChoice, REPRESENTATIVE, ShadingHair, shade_pixels, shade_point,
 };
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
@@ -120,7 +120,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .collect();
         let values = GridValues::build(s.settings.shadow_grid(&s.hair), &sources, &light_dirs);
         let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
-        let twin = |frame: &Frame, cam: &CameraUniform, choose: SampleChoice, what: &str| {
+        let twin = |frame: &Frame, cam: &CameraUniform, choose: FragmentChoice, what: &str| {
             let covered: Vec<usize> = frame.covered().collect();
             assert!(
                 covered.len() > 100,
@@ -145,6 +145,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                 )
             });
             let mut errors = Vec::new();
+            let mut worst = (0.0f32, 0usize, 0usize, 0.0f32, 0.0f32);
             let scale = pixels
                 .iter()
                 .map(|&i| frame.beauty[i][0] + frame.beauty[i][1] + frame.beauty[i][2])
@@ -156,7 +157,11 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                     for c in 0..3 {
                         let (g, r) = (frame.components[t][i][c], cpu[k][t][c]);
                         // Relative, with a floor of 1e-3 of the brightest pixel (dark TT pixels).
-                        errors.push((g - r).abs() / r.abs().max(1e-3 * scale));
+                        let e = (g - r).abs() / r.abs().max(1e-3 * scale);
+                        if e > worst.0 {
+                            worst = (e, i, t, g, r);
+                        }
+                        errors.push(e);
                     }
                 }
             }
@@ -171,14 +176,25 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                 pixels.len(),
                 ms_share / pixels.len() as f32
             );
+            println!(
+                "  worst: pixel {} component {} GPU {:.4e} CPU {:.4e} ({} fragments)",
+                worst.1,
+                worst.2,
+                worst.3,
+                worst.4,
+                frame.kept_fragments(worst.1).len()
+            );
+            // The pixels shade ~10 fragments each, deep ones in the volume's shadow included: a
+            // rounding that tips the dual scattering's branch (forward light above the direct) at one
+            // of them moves a dark MS component by ~2 % (p99 stays below 0.1 %).
             assert!(
-                max <= 0.01,
-                "{what}: GPU and CPU twin differ by {max} (> 1%)"
+                max <= 0.025 && p99 <= 1e-3,
+                "{what}: GPU and CPU twin differ by {max} (> 2.5%), p99 {p99}"
             );
         };
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
-        twin(&frame, &cam, DISTINCT, "frame");
-        // The preview (half resolution, each pixel's representative sample), after a change.
+        twin(&frame, &cam, EVERY_FRAGMENT, "frame");
+        // The preview (half resolution, each pixel's front fragment for all its hair), after a change.
         renderer.set_preview(PreviewMode::Fixed(2));
         renderer.set_camera(&ctx, &s.camera);
         loop {

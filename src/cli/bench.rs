@@ -13,7 +13,6 @@ use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
 use strandlight::render::renderer::build_tables;
 use strandlight::render::scene::{StandardScene, default_environment};
-use strandlight::render::shade::is_hair;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
@@ -356,16 +355,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 per_pass.entry(name).or_default().push(ms);
             }
         }
-        // The points the shading pass shades: each pixel's distinct segments among its samples.
+        // The points the shading pass shades: each pixel's kept fragments.
         let frame = renderer.read_frame(&ctx)?;
-        let samples = (frame.samples as usize).min(4);
-        let shaded_points: usize = frame
-            .sample_ids
-            .iter()
-            .map(|ids| {
-                let ids = &ids[..samples];
-                (0..samples)
-                    .filter(|&k| is_hair(ids[k]) && !ids[..k].contains(&ids[k]))
+        let shaded_points: usize = (0..frame.pixel_count())
+            .map(|i| {
+                frame
+                    .kept_fragments(i)
+                    .iter()
+                    .filter(|f| f.weight > 0.0)
                     .count()
             })
             .sum();

@@ -1,4 +1,4 @@
-//! `strandlight gpu-info`: which adapter the renderer would use.
+//! `strandlight gpu-info`: which adapter the renderer would use, and the optional features it has.
 
 use strandlight::gpu::{GpuContext, GpuOptions};
 
@@ -6,6 +6,8 @@ pub fn run(software: bool) -> anyhow::Result<()> {
     let mut options = GpuOptions::from_env();
     options.force_software |= software;
     let ctx = GpuContext::new_headless(&options)?;
-    println!("{}", serde_json::to_string_pretty(&ctx.summary)?);
+    let mut summary = serde_json::to_value(&ctx.summary)?;
+    summary["features"] = format!("{:?}", ctx.adapter.features()).into();
+    println!("{}", serde_json::to_string_pretty(&summary)?);
     Ok(())
 }

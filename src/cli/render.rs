@@ -15,7 +15,7 @@ use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
-use strandlight::render::tiled::{DEFAULT_TILE, needs_tiles, render_tiled};
+use strandlight::render::tiled::{needs_tiles, render_tiled, tile_side};
 use strandlight::render::{Camera, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::session::assemble::{StillHeader, still_attributes};
@@ -105,9 +105,16 @@ pub struct RenderArgs {
     pub width: u32,
     #[arg(long, default_value_t = 480)]
     pub height: u32,
-    /// Visibility samples per pixel (MSAA: 2 or 4).
+    /// The head's samples per pixel (MSAA: 2 or 4).
     #[arg(long, default_value_t = 4)]
     pub samples: u32,
+    /// Hair fragments kept per pixel by the K-buffer (1 to 32; each is shaded).
+    #[arg(long, default_value_t = strandlight::render::kbuffer::DEFAULT_FRAGMENTS)]
+    pub fragments: u32,
+    /// The fragments behind the kept ones: drop (Yu 2012), fold (into the last kept) or spread (over
+    /// the kept ones).
+    #[arg(long, default_value = "spread")]
+    pub tail: strandlight::render::kbuffer::Tail,
     /// Exposure in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -266,6 +273,8 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
             width: args.width,
             height: args.height,
             samples: args.samples,
+            fragments: args.fragments,
+            tail: args.tail,
             exposure: args.exposure,
             shadows: !args.no_shadows,
             multiple_scattering: !args.single_scattering,
@@ -335,7 +344,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let tile = match args.tile {
         Some(t) if t < 16 => bail!("--tile must be at least 16 pixels, got {t}"),
         Some(t) => t,
-        None if needs_tiles(&ctx, settings.width, settings.height) => DEFAULT_TILE,
+        None if needs_tiles(&ctx, settings.width, settings.height, settings.fragments) => {
+            tile_side(&ctx, settings.fragments)
+        }
         None => 0,
     };
     let mut first = settings.clone();

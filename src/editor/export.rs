@@ -11,7 +11,7 @@ use crate::render::background::Background;
 use crate::render::camera::Tile;
 use crate::render::frame::Frame;
 use crate::render::renderer::FrameReadBack;
-use crate::render::tiled::{DEFAULT_TILE, empty_frame, paste};
+use crate::render::tiled::{empty_frame, paste};
 use crate::session::Session;
 use crate::session::assemble::{LoadedHairSource, Scene, StillHeader, still_attributes};
 use std::path::PathBuf;
@@ -89,8 +89,9 @@ impl ExportJob {
         tile: Option<u32>,
     ) -> Result<Self, String> {
         let (w, h) = (scene.settings.width, scene.settings.height);
-        let tile = tile.unwrap_or(if crate::render::tiled::needs_tiles(&live.ctx, w, h) {
-            DEFAULT_TILE
+        let k = scene.settings.fragments;
+        let tile = tile.unwrap_or(if crate::render::tiled::needs_tiles(&live.ctx, w, h, k) {
+            crate::render::tiled::tile_side(&live.ctx, k)
         } else {
             w.max(h)
         });

@@ -388,6 +388,8 @@ impl LiveScene {
             || self.applied.occluder.mesh != session.occluder.mesh
             || self.environment_source != session.environment
             || a.samples != b.samples
+            || a.fragments != b.fragments
+            || a.tail != b.tail
             || a.volume_resolution != b.volume_resolution
             || a.shadow_grid_resolution != b.shadow_grid_resolution
     }

@@ -55,6 +55,13 @@ impl AdapterSummary {
     }
 }
 
+/// What the renderer cannot do without: 64-bit integers and their atomics (the K-buffer's keys,
+/// `shaders/kbuffer.wgsl`). Vulkan has them with VK_KHR_shader_atomic_int64 (NVIDIA, AMD, Intel,
+/// lavapipe), DX12 with shader model 6.6.
+pub const REQUIRED_FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX)
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
+
 /// A device and queue, with the adapter they came from.
 #[derive(Clone)]
 pub struct GpuContext {
@@ -120,7 +127,8 @@ impl GpuContext {
             | wgpu::Features::FLOAT32_FILTERABLE;
         wgpu::DeviceDescriptor {
             label: Some("strandlight device"),
-            required_features: adapter.features() & wanted,
+            // The K-buffer's 64-bit atomics are required: without them device creation names them.
+            required_features: (adapter.features() & wanted) | REQUIRED_FEATURES,
             required_limits: adapter.limits(),
             ..Default::default()
         }

@@ -14,6 +14,7 @@ pub const FORWARD_SCATTERING: &str = include_str!("../../shaders/forward_scatter
 pub const FORWARD_EVAL: &str = include_str!("../../shaders/forward_eval.wgsl");
 pub const CAMERA: &str = include_str!("../../shaders/camera.wgsl");
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
+pub const KBUFFER: &str = include_str!("../../shaders/kbuffer.wgsl");
 pub const SHADING: &str = include_str!("../../shaders/shading.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
 pub const OCCLUDER: &str = include_str!("../../shaders/occluder.wgsl");
@@ -40,14 +41,19 @@ pub fn shadow_grid_build_module() -> String {
     .join("\n")
 }
 
-/// The visibility pass (ribbons into the multisampled id target).
 /// The occluder's shading: PI, the shadow-grid lookup, camera, and the kernel.
 pub fn occluder_module() -> String {
     [CIRCULAR_GAUSSIAN, SHADOW_GRID, CAMERA, OCCLUDER].join("\n")
 }
 
+/// The visibility pass (the occluder into the multisampled id target).
 pub fn visibility_module() -> String {
     [CIRCULAR_GAUSSIAN, CAMERA, VISIBILITY].join("\n")
+}
+
+/// The K-buffer's raster and composite passes.
+pub fn kbuffer_module() -> String {
+    [CIRCULAR_GAUSSIAN, CAMERA, KBUFFER].join("\n")
 }
 
 /// The shading pass: the fast model, dual scattering, the shadow-grid lookup, camera, and the kernel.

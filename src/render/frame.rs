@@ -3,6 +3,7 @@
 //! parameters as header attributes; a tonemapped PNG preview (ACES filmic, sRGB), never used for the EXR.
 
 use super::background::Background;
+use super::kbuffer::{Fragment, PixelFragments};
 use super::targets::COMPONENTS;
 use std::path::Path;
 
@@ -10,13 +11,23 @@ use std::path::Path;
 pub struct Frame {
     pub width: u32,
     pub height: u32,
+    /// The occluder's samples per pixel.
     pub samples: u32,
-    /// Linear RGB times 2^EV, premultiplied by coverage; alpha = covered samples / samples.
+    /// Linear RGB times 2^EV, premultiplied by coverage; alpha = the composited coverage of the hair
+    /// (the K-buffer's) and of the occluder's samples behind it.
     pub beauty: Vec<[f32; 4]>,
-    /// Distance along the view axis of the nearest hair sample (1e10 where there is none).
+    /// Distance along the view axis of the nearest fragment or occluder sample (1e10 where there is
+    /// none).
     pub depth: Vec<f32>,
-    /// Segment index + 1 per visibility sample (0 = no hair); only the first four samples.
+    /// The occluder's id per sample (its triangle + 1 with the top bit set; 0 = none); only the first
+    /// four samples.
     pub sample_ids: Vec<[u32; 4]>,
+    /// The K-buffer's kept fragments, `fragments_per_pixel` per pixel (segment + 1 and weight; empty
+    /// for a still rendered in tiles).
+    pub fragments: Vec<Fragment>,
+    pub fragments_per_pixel: u32,
+    /// The K-buffer's summary per pixel (empty for a still rendered in tiles).
+    pub pixel_fragments: Vec<PixelFragments>,
     /// R, TT, TRT, MS.global, MS.local, with the same exposure as the beauty; they add up to it.
     pub components: Vec<Vec<[f32; 3]>>,
     /// The environment behind every pixel, exposed like the beauty (empty: the render had no
@@ -80,6 +91,20 @@ impl Frame {
     }
 
     /// Pixels with any coverage.
+    /// Pixel `i`'s kept hair fragments (segment + 1 and weight), front to back.
+    pub fn kept_fragments(&self, i: usize) -> &[Fragment] {
+        let k = self.fragments_per_pixel as usize;
+        match self.fragments.get(i * k..(i + 1) * k) {
+            Some(s) => &s[..s.iter().take_while(|f| f.id != 0).count()],
+            None => &[],
+        }
+    }
+
+    /// The hair's composited coverage of pixel `i` (0 for a frame without its K-buffer).
+    pub fn hair_alpha(&self, i: usize) -> f32 {
+        self.pixel_fragments.get(i).map_or(0.0, |p| p.alpha)
+    }
+
     pub fn covered(&self) -> impl Iterator<Item = usize> + '_ {
         (0..self.pixel_count()).filter(|&i| self.beauty[i][3] > 0.0)
     }

@@ -5,6 +5,7 @@ pub mod background;
 pub mod camera;
 pub mod display;
 pub mod frame;
+pub mod kbuffer;
 pub mod occluder;
 pub mod path_trace;
 pub mod preview;

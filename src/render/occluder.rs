@@ -182,7 +182,9 @@ pub fn shade_occluder_frame(
                     out[c] += count as f32 / frame.samples as f32 * l[c];
                 }
             }
-            out
+            // Seen through the hair in front of it.
+            let t = frame.pixel_fragments[i].occluder_transmittance;
+            out.map(|v| t * v)
         })
         .collect()
 }
@@ -314,6 +316,10 @@ impl OccluderPass {
                 wgpu::BindGroupEntry {
                     binding: 10,
                     resource: targets.occluder.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 11,
+                    resource: targets.kbuffer.pixel_info.as_entire_binding(),
                 },
             ],
         );

@@ -1,6 +1,7 @@
 //! The preview that progressive refinement shows right after a change: the same view at a fraction of
-//! the resolution, every light, one shading per pixel (the first covered visibility sample's segment
-//! standing for all the covered samples: [`super::shade::representative_sample`]), shadows from the
+//! the resolution, every light, one shading per pixel (a K-buffer of four fragments, the one where
+//! the weights reach half the pixel's alpha standing for all of its hair:
+//! [`super::shade::representative_fragment`]), shadows from the
 //! grid as it stands (a light group whose entries are part-way through a rebuild is shaded
 //! unshadowed). Its own small frame targets and camera; the frame's are untouched, so the converged
 //! image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
@@ -8,6 +9,7 @@
 
 use super::camera::CameraUniform;
 use super::frame::Frame;
+use super::kbuffer::Tail;
 use super::renderer::{RenderError, Renderer};
 use super::shading::{
     FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, SLOT_REPRESENTATIVE, ShadeBatch, ShadingInputs,
@@ -16,6 +18,10 @@ use super::shading::{
 use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
 use std::time::Duration;
+
+/// The preview's K-buffer: four fragments, one of them shaded for all
+/// ([`super::shade::representative_fragment`]).
+const PREVIEW_FRAGMENTS: u32 = 4;
 
 /// Whether, and at what resolution, refinement previews a change.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -119,7 +125,13 @@ impl Renderer {
             let camera = self.preview_camera(factor);
             self.preview = Some(Preview {
                 factor,
-                targets: FrameTargets::new(device, w, h, self.settings.samples),
+                targets: FrameTargets::new(
+                    device,
+                    w,
+                    h,
+                    self.settings.samples,
+                    (PREVIEW_FRAGMENTS, Tail::Spread),
+                ),
                 camera: crate::gpu::context::buffer_init(
                     device,
                     "preview camera",
@@ -224,7 +236,7 @@ impl Renderer {
                 first,
                 count,
                 flags,
-                samples: self.settings.samples,
+                slots: PREVIEW_FRAGMENTS,
                 slot: SLOT_REPRESENTATIVE,
                 row0,
                 rows,
@@ -241,7 +253,7 @@ impl Renderer {
             &self.background_map,
             &p.targets,
             row0..row0 + rows,
-            true,
+            (true, false),
             None,
         );
     }

@@ -10,12 +10,14 @@
 //! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed: its
 //! deposit in ranges of segments, whose fixed-point sums add up exactly, then its resolve), the
 //! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
-//! lights or the forward table changed), visibility in ranges of segments, then every shading batch (a light batch at one
-//! visibility sample, every light batch at the first sample before any at the second) in bands of
+//! lights or the forward table changed), visibility in ranges of segments (the K-buffer's atomic
+//! insertion does not depend on their order; the last part composites it), then every shading batch
+//! (a light batch at one K-buffer slot, every light batch at the front slot before any at the
+//! second) in bands of
 //! rows, each band followed by a resolve of its rows; the grid's entries for a light batch are built
 //! just before the first shading batch that reads them. [`Progress::ready`] says when a finished unit
 //! left an image worth showing: the complete preview, then the full image once every light has shaded
-//! the first visibility sample (the "first pass"), updated unit by unit until converged. Every pixel
+//! the front K-buffer slot (the "first pass"), updated unit by unit until converged. Every pixel
 //! takes its batches in `render_frame`'s order, so the converged image is `render_frame`'s bit for
 //! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
 //! the shadow grid has built.
@@ -45,10 +47,10 @@ const GUESS_VISIBILITY_SEGMENT_S: f64 = 1e-6;
 /// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
 const GUESS_ROW_LIGHTS: f64 = 16.0;
-/// Visibility samples with their own shading bands (at most 4 samples per pixel).
+/// K-buffer slots with their own shading bands (the slots behind the fourth share the last).
 const MAX_SLOTS: usize = 4;
 
-/// The bands of visibility sample `slot`.
+/// The bands of K-buffer slot `slot`.
 fn slot_bands(slot: u32) -> usize {
     (slot as usize).min(MAX_SLOTS - 1)
 }
@@ -66,7 +68,7 @@ pub enum WorkUnit {
     /// count 0 when the camera, size and fibres are those it last drew); the last part clears the
     /// components and resolves the image.
     Visibility { first: u32, count: u32 },
-    /// Frame batch `batch` (its lights at its visibility sample) over rows [row0, row0 + rows).
+    /// Frame batch `batch` (its lights at its K-buffer slot) over rows [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
     /// The preview's visibility pass over segments [first, first + count) (after a camera move; a
     /// parameter change reuses the last).
@@ -88,7 +90,7 @@ pub struct DisplayImage<'a> {
 pub enum ImageReady {
     /// The preview of the latest change is complete.
     Preview,
-    /// The full-resolution image: every light has shaded the first visibility sample (or more).
+    /// The full-resolution image: every light has shaded the front K-buffer slot (or more).
     Full,
 }
 
@@ -232,7 +234,7 @@ pub struct Refinement {
     volume_cost: Option<f64>,
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
-    /// The frame's shading bands per visibility sample (costs per light: the first sample shades
+    /// The frame's shading bands per K-buffer slot (costs per light: the first sample shades
     /// every covered pixel, the others only where a new segment appears, a few times cheaper), and
     /// the preview's (costs per row of all lights).
     bands: [Bands; MAX_SLOTS],
@@ -312,7 +314,7 @@ impl Refinement {
             .min(remaining.max(1))
     }
 
-    /// Seconds per row and light of a shading batch at visibility sample `slot` (measured or guessed).
+    /// Seconds per row and light of a shading batch at K-buffer slot `slot` (measured or guessed).
     fn light_row_cost(&self, slot: u32) -> f64 {
         self.bands[slot_bands(slot)]
             .cost
@@ -722,7 +724,7 @@ impl Renderer {
         self.refinement.sharp_rows
     }
 
-    /// Frame batch `batch`'s visibility sample and light count.
+    /// Frame batch `batch`'s K-buffer slot and light count.
     fn batch_shape(&self, batch: u32) -> Option<(u32, u32)> {
         self.shading_pass
             .frame_batches()
@@ -730,7 +732,7 @@ impl Renderer {
             .map(|b| (b.slot, b.count))
     }
 
-    /// Shading batches of the first pass: every light batch at the first visibility sample.
+    /// Shading batches of the first pass: every light batch at the front K-buffer slot.
     fn first_pass_batches(&self) -> u32 {
         self.shading_pass
             .frame_batches()
@@ -1064,6 +1066,7 @@ impl Renderer {
                 // The last part: the image's visibility is whole; the components restart.
                 self.visibility_valid = true;
                 ShadingPass::clear(enc, &self.targets);
+                self.shading_partial = true;
                 self.encode_resolve(device, enc, 0..self.settings.height, true);
             }
             WorkUnit::Shade { batch, row0, rows } => {
@@ -1074,7 +1077,22 @@ impl Renderer {
                 let inputs = self.shading_inputs();
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
-                self.encode_resolve(device, enc, row0..row0 + rows, false);
+                // The last batch leaves its rows converged: resolved as render_frame resolves them.
+                let last = batch + 1 >= self.shading_pass.frame_batches().count() as u32;
+                if last && row0 + rows >= self.settings.height {
+                    self.shading_partial = false;
+                }
+                self.resolve_pass.encode(
+                    device,
+                    enc,
+                    &self.camera,
+                    &self.resolve_info,
+                    &self.background_map,
+                    &self.targets,
+                    row0..row0 + rows,
+                    (false, !last),
+                    None,
+                );
             }
         }
     }
@@ -1094,7 +1112,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             rows,
-            background,
+            (background, self.shading_partial),
             None,
         );
     }

@@ -237,7 +237,7 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             &cam,
             &hair,
             &pixels,
-            super::shade::DISTINCT,
+            super::shade::EVERY_FRAGMENT,
             |sp, wo| reference_shade(params, variant, sp, wo, &lights, shadows),
         )
     };

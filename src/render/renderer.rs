@@ -6,6 +6,7 @@
 use super::background::BackgroundMap;
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
+use super::kbuffer::{DEFAULT_FRAGMENTS, MAX_FRAGMENTS, Tail};
 use super::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
 use super::preview::{Preview, PreviewMode};
 use super::progressive::Refinement;
@@ -52,6 +53,8 @@ pub const PASSES: [&str; 6] = [
 pub enum RenderError {
     #[error("image size {0}x{1} is out of range (1..={2} per side)")]
     Size(u32, u32, u32),
+    #[error("{0} fragments per pixel are not supported (use 1 to 32)")]
+    Fragments(u32),
     #[error("{0} samples per pixel are not supported (use 2 or 4)")]
     Samples(u32),
     #[error("{points} points in the hair but {absorption} absorption values")]
@@ -151,14 +154,19 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
-    /// Multisampling of the visibility pass (2 or 4).
+    /// Multisampling of the occluder in the visibility pass (2 or 4).
     pub samples: u32,
+    /// Hair fragments kept per pixel by the K-buffer (1 to [`MAX_FRAGMENTS`]).
+    pub fragments: u32,
+    /// What becomes of the fragments behind the kept ones.
+    pub tail: Tail,
     /// Exposure in stops applied by the resolve pass.
     pub exposure: f32,
     pub shadows: bool,
     /// Dual scattering (MS.global, MS.local) on top of single scattering.
     pub multiple_scattering: bool,
-    /// Ribbons are at least this many pixels wide.
+    /// Fibers cover at least this many pixels across (0: their true width; 1 draws the old opaque
+    /// one-pixel ribbons).
     pub min_width_px: f32,
     /// SRBF lights per shading pass (at most 16).
     pub lights_per_pass: u32,
@@ -177,10 +185,12 @@ impl Default for RenderSettings {
             width: 720,
             height: 480,
             samples: 4,
+            fragments: DEFAULT_FRAGMENTS,
+            tail: Tail::Spread,
             exposure: 0.0,
             shadows: true,
             multiple_scattering: true,
-            min_width_px: 1.0,
+            min_width_px: 0.0,
             lights_per_pass: 16,
             volume_resolution: 128,
             shadow_skip_voxels: 0.5,
@@ -190,6 +200,11 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// The K-buffer's fragments per pixel and tail.
+    pub fn kbuffer(&self) -> (u32, Tail) {
+        (self.fragments, self.tail)
+    }
+
     /// The fiber-density grid this renderer builds for `hair` (the CPU twin uses the same).
     pub fn volume_grid(&self, hair: &Hair) -> VolumeGrid {
         VolumeGrid::around(hair, self.voxel_size(hair))
@@ -254,6 +269,8 @@ pub struct Renderer {
     pub(super) shading_pass: ShadingPass,
     pub(super) resolve_pass: ResolvePass,
     pub(super) volume_dirty: bool,
+    /// Progressive refinement has shaded part of the K-buffer's fragments (resolves normalise).
+    pub(super) shading_partial: bool,
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
     pub(super) volume_stale: bool,
@@ -354,6 +371,9 @@ impl Renderer {
         }
         if !matches!(settings.samples, 2 | 4) {
             return Err(RenderError::Samples(settings.samples));
+        }
+        if !(1..=MAX_FRAGMENTS).contains(&settings.fragments) {
+            return Err(RenderError::Fragments(settings.fragments));
         }
         if sigma_a.len() != hair.point_count() {
             return Err(RenderError::AbsorptionCount {
@@ -470,7 +490,13 @@ impl Renderer {
             resolve_params: resolve_info,
             background_map: environment_buffer(device, None),
             occluder: None,
-            targets: FrameTargets::new(device, settings.width, settings.height, settings.samples),
+            targets: FrameTargets::new(
+                device,
+                settings.width,
+                settings.height,
+                settings.samples,
+                settings.kbuffer(),
+            ),
             density_pass: FiberDensityPass::new(device),
             pyramid_pass: DensityPyramidPass::new(device),
             shadow_grid_pass: ShadowGridPass::new(device),
@@ -478,6 +504,7 @@ impl Renderer {
             shading_pass: ShadingPass::new(device),
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
+            shading_partial: false,
             volume_stale: false,
             volume_absorption_old: false,
             shadow_grid_dirty: true,
@@ -502,18 +529,18 @@ impl Renderer {
         if self.settings.multiple_scattering {
             flags |= FLAG_MULTIPLE_SCATTERING;
         }
-        let samples = self.settings.samples;
+        let slots = self.settings.fragments;
         let height = self.settings.height;
-        // Sample-major: every light batch at the first visibility sample (most of every pixel), then
-        // at the others (the pixels where fibres cross), so a refining image has all its lights early.
+        // Slot-major: every light batch at the front fragment (most of every pixel), then at the
+        // ones behind it, so a refining image has all its lights early.
         let light_batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
-        let batches: Vec<ShadeBatch> = (0..samples)
+        let batches: Vec<ShadeBatch> = (0..slots)
             .flat_map(|slot| {
                 light_batches.iter().map(move |&(first, count)| ShadeBatch {
                     first,
                     count,
                     flags,
-                    samples,
+                    slots,
                     slot,
                     row0: 0,
                     rows: height,
@@ -943,7 +970,13 @@ impl Renderer {
         self.resized_preview(width, height);
         self.settings.width = width;
         self.settings.height = height;
-        self.targets = FrameTargets::new(&ctx.device, width, height, self.settings.samples);
+        self.targets = FrameTargets::new(
+            &ctx.device,
+            width,
+            height,
+            self.settings.samples,
+            self.settings.kbuffer(),
+        );
         // The camera uniform holds the image size (projection aspect, pixel rays); a tile's is written
         // by set_camera_tile after this.
         let camera = self.camera_view;
@@ -1029,7 +1062,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             0..self.settings.height,
-            true,
+            (true, self.shading_partial),
             None,
         );
         if let Some(p) = &self.preview {
@@ -1041,7 +1074,7 @@ impl Renderer {
                 &self.background_map,
                 &p.targets,
                 0..p.targets.height,
-                true,
+                (true, false),
                 None,
             );
         }
@@ -1172,10 +1205,11 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             0..self.settings.height,
-            true,
+            (true, false),
             timer.and_then(|t| t.compute_writes("resolve")),
         );
         self.visibility_valid = true;
+        self.shading_partial = false;
         self.last_ran.extend(["visibility", "shading", "resolve"]);
         if let Some(t) = timer {
             t.resolve(&mut enc);
@@ -1247,7 +1281,7 @@ impl Renderer {
             .collect::<Result<Vec<_>, _>>()
             .map_err(RenderError::Gpu)?;
         Ok(frame_from_bytes(
-            (t.width, t.height, t.samples),
+            shape(t),
             self.settings.exposure,
             self.extras(),
             &bytes,
@@ -1259,7 +1293,7 @@ impl Renderer {
         let t = &self.targets;
         FrameReadBack {
             pending: ctx.start_read(&frame_buffers(t, self.extras())),
-            shape: (t.width, t.height, t.samples),
+            shape: shape(t),
             exposure: self.settings.exposure,
             extras: self.extras(),
         }
@@ -1295,7 +1329,13 @@ struct Extras {
 /// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them (the background
 /// and the occluder last, when there are some).
 fn frame_buffers(t: &FrameTargets, extras: Extras) -> Vec<&wgpu::Buffer> {
-    let mut v = vec![&t.beauty, &t.view_depth, &t.sample_ids];
+    let mut v = vec![
+        &t.beauty,
+        &t.view_depth,
+        &t.sample_ids,
+        &t.kbuffer.fragments,
+        &t.kbuffer.pixel_info,
+    ];
     v.extend(t.components.iter());
     if extras.background {
         v.push(&t.background);
@@ -1306,10 +1346,10 @@ fn frame_buffers(t: &FrameTargets, extras: Extras) -> Vec<&wgpu::Buffer> {
     v
 }
 
-/// A frame (width, height, samples) from its buffers' bytes; the components take the exposure the
-/// beauty has.
+/// A frame (width, height, samples, fragments per pixel) from its buffers' bytes; the components take
+/// the exposure the beauty has.
 fn frame_from_bytes(
-    (width, height, samples): (u32, u32, u32),
+    (width, height, samples, k): Shape,
     exposure: f32,
     extras: Extras,
     bytes: &[Vec<u8>],
@@ -1328,26 +1368,36 @@ fn frame_from_bytes(
         beauty: bytemuck::pod_collect_to_vec(&bytes[0]),
         depth: bytemuck::pod_collect_to_vec(&bytes[1]),
         sample_ids: bytemuck::pod_collect_to_vec(&bytes[2]),
-        components: bytes[3..3 + COMPONENTS.len()].iter().map(rgb).collect(),
+        fragments: bytemuck::pod_collect_to_vec(&bytes[3]),
+        fragments_per_pixel: k,
+        pixel_fragments: bytemuck::pod_collect_to_vec(&bytes[4]),
+        components: bytes[5..5 + COMPONENTS.len()].iter().map(rgb).collect(),
         // Exposed by the resolve already.
         background: match extras.background {
-            true => bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes[3 + COMPONENTS.len()])
+            true => bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes[5 + COMPONENTS.len()])
                 .into_iter()
                 .map(|p| [p[0], p[1], p[2]])
                 .collect(),
             false => Vec::new(),
         },
         occluder: match extras.occluder {
-            true => rgb(&bytes[3 + COMPONENTS.len() + extras.background as usize]),
+            true => rgb(&bytes[5 + COMPONENTS.len() + extras.background as usize]),
             false => Vec::new(),
         },
     }
 }
 
+/// (width, height, occluder samples, K-buffer slots) of a frame's targets.
+type Shape = (u32, u32, u32, u32);
+
+fn shape(t: &FrameTargets) -> Shape {
+    (t.width, t.height, t.samples, t.kbuffer.k)
+}
+
 /// A frame on its way back from the GPU ([`Renderer::start_read_frame`]).
 pub struct FrameReadBack {
     pending: crate::gpu::context::PendingRead,
-    shape: (u32, u32, u32),
+    shape: Shape,
     exposure: f32,
     extras: Extras,
 }

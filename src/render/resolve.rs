@@ -54,7 +54,8 @@ impl ResolvePass {
     /// a band's after progressive refinement shaded it: at 720x480 on lavapipe a whole-image resolve
     /// costs ~18 ms, which after every band was most of the refinement's time). With `background`,
     /// the rows' background is looked up too (after visibility, a new camera or map; a shading band
-    /// leaves it as it is).
+    /// leaves it as it is). With `normalise` (refinement under way), the hair's radiance is scaled by
+    /// its alpha over the weight shaded so far, so a partly shaded image shows its final brightness.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -65,7 +66,7 @@ impl ResolvePass {
         environment: &wgpu::Buffer,
         targets: &FrameTargets,
         rows: std::ops::Range<u32>,
-        background: bool,
+        (background, normalise): (bool, bool),
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let row0 = rows.start.min(targets.height);
@@ -75,7 +76,7 @@ impl ResolvePass {
         let band = buffer_init(
             device,
             "resolve rows",
-            bytemuck::cast_slice(&[row0, count, background as u32, 0]),
+            bytemuck::cast_slice(&[row0, count, background as u32, normalise as u32]),
             wgpu::BufferUsages::STORAGE,
         );
         let mut entries = vec![
@@ -112,6 +113,7 @@ impl ResolvePass {
             (13, environment),
             (14, &targets.background),
             (15, &targets.occluder),
+            (16, &targets.kbuffer.pixel_info),
         ] {
             entries.push(wgpu::BindGroupEntry {
                 binding,

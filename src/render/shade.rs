@@ -4,6 +4,7 @@
 
 use super::camera::{CameraUniform, closest_on_segment, pixel_ray};
 use super::frame::Frame;
+use super::kbuffer::{Fragment, PixelFragments};
 use crate::envmap::SrbfLight;
 use crate::envmap::srbf::srbf_integral;
 use crate::hair::Hair;
@@ -180,38 +181,45 @@ pub fn is_hair(id: u32) -> bool {
     id != 0 && id & super::occluder::OCCLUDER_ID_BIT == 0
 }
 
-/// The distinct segments among a pixel's sample ids with their counts (ids are segment + 1).
-pub fn distinct_samples(ids: &[u32]) -> Vec<(u32, u32)> {
-    let mut out: Vec<(u32, u32)> = Vec::new();
-    for &v in ids.iter().filter(|&&v| is_hair(v)) {
-        match out.iter_mut().find(|(id, _)| *id == v) {
-            Some(e) => e.1 += 1,
-            None => out.push((v, 1)),
+/// Which of a pixel's K-buffer fragments are shaded, as (segment + 1, weight): every kept fragment
+/// with its weight (the frame), or the front one for all of the hair (the preview).
+pub type FragmentChoice = fn(&[Fragment], &PixelFragments) -> Vec<(u32, f64)>;
+
+/// The frame's choice: every kept fragment with its composite weight (twin of a slot's dispatch).
+pub const EVERY_FRAGMENT: FragmentChoice = |slots, _| {
+    slots
+        .iter()
+        .filter(|f| f.id != 0 && f.weight > 0.0)
+        .map(|f| (f.id, f.weight as f64))
+        .collect()
+};
+
+/// The preview's choice (twin of the WGSL's `SLOT_REPRESENTATIVE` branch): the fragment at which the
+/// weights reach half the pixel's hair alpha, with all of that alpha.
+pub fn representative_fragment(slots: &[Fragment], pixel: &PixelFragments) -> Vec<(u32, f64)> {
+    let w = pixel.alpha;
+    let mut chosen = slots.first().copied().unwrap_or_default();
+    let mut reached = 0.0f32;
+    for g in slots.iter().take_while(|g| g.id != 0) {
+        chosen = *g;
+        reached += g.weight;
+        if reached >= 0.5 * w {
+            break;
         }
     }
-    out
+    match chosen.id {
+        0 => Vec::new(),
+        _ if w > 0.0 => vec![(chosen.id, w as f64)],
+        _ => Vec::new(),
+    }
 }
 
-/// The preview's one segment per pixel (twin of the WGSL's `SLOT_REPRESENTATIVE` branch): the first
-/// covered sample's segment id, standing for all the covered samples (their count).
-pub fn representative_sample(ids: &[u32]) -> Option<(u32, u32)> {
-    let first = *ids.iter().find(|&&v| is_hair(v))?;
-    Some((first, ids.iter().filter(|&&v| is_hair(v)).count() as u32))
-}
-
-/// Which of a pixel's samples are shaded: each distinct segment with its count (the frame), or one
-/// representative (the preview).
-pub type SampleChoice = fn(&[u32]) -> Vec<(u32, u32)>;
-
-/// The frame's choice: every distinct segment ([`distinct_samples`]).
-pub const DISTINCT: SampleChoice = distinct_samples;
-
-/// The preview's choice: [`representative_sample`].
-pub const REPRESENTATIVE: SampleChoice = |ids| representative_sample(ids).into_iter().collect();
+/// The preview's choice: [`representative_fragment`].
+pub const REPRESENTATIVE: FragmentChoice = representative_fragment;
 
 /// The pixel loop of the CPU shading passes (rayon over the given pixels): for each pixel, `fold` is
-/// called on a fresh `init()` for every distinct segment among its visibility samples, with the pixel
-/// index, the shading point, omega_o and the segment's coverage weight (its share of the samples).
+/// called on a fresh `init()` for every kept fragment of its K-buffer, with the pixel index, the
+/// shading point, omega_o and the fragment's composite weight.
 pub fn fold_visible_points<T: Send>(
     frame: &Frame,
     camera: &CameraUniform,
@@ -220,48 +228,53 @@ pub fn fold_visible_points<T: Send>(
     init: impl Fn() -> T + Sync,
     fold: impl Fn(&mut T, usize, &ShadingPoint, Vec3, f64) + Sync,
 ) -> Vec<T> {
-    fold_chosen_points(frame, camera, hair, pixels, DISTINCT, init, fold)
+    fold_chosen_points(frame, camera, hair, pixels, EVERY_FRAGMENT, init, fold)
 }
 
-/// [`fold_visible_points`] over the samples `choose` picks.
+/// [`fold_visible_points`] over the fragments `choose` picks.
 pub fn fold_chosen_points<T: Send>(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
-    choose: SampleChoice,
+    choose: FragmentChoice,
     init: impl Fn() -> T + Sync,
     fold: impl Fn(&mut T, usize, &ShadingPoint, Vec3, f64) + Sync,
 ) -> Vec<T> {
+    let k = frame.fragments_per_pixel as usize;
     pixels
         .par_iter()
         .map(|&i| {
-            let samples = frame.samples.min(4) as usize;
-            let ids = &frame.sample_ids[i][..samples];
+            let mut acc = init();
+            let (Some(slots), Some(info)) = (
+                frame.fragments.get(i * k..(i + 1) * k),
+                frame.pixel_fragments.get(i),
+            ) else {
+                return acc;
+            };
             let (x, y) = (
                 (i % frame.width as usize) as f32,
                 (i / frame.width as usize) as f32,
             );
             let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
-            let mut acc = init();
-            for (id, count) in choose(ids) {
+            for (id, weight) in choose(slots, info) {
                 let sp = hair.shading_point(id - 1, origin, dir);
-                fold(&mut acc, i, &sp, -dir, count as f64 / frame.samples as f64);
+                fold(&mut acc, i, &sp, -dir, weight);
             }
             acc
         })
         .collect()
 }
 
-/// The pixel loop of the shading pass on the CPU: for each pixel of `pixels`, the coverage-weighted
-/// sum of `shade` over the samples `choose` picks ([`DISTINCT`] for the frame, [`REPRESENTATIVE`] for
-/// the preview), the radiance per lobe (before exposure).
+/// The pixel loop of the shading pass on the CPU: for each pixel of `pixels`, the weighted sum of
+/// `shade` over the fragments `choose` picks ([`EVERY_FRAGMENT`] for the frame, [`REPRESENTATIVE`]
+/// for the preview), the radiance per lobe (before exposure).
 pub fn shade_pixels(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
-    choose: SampleChoice,
+    choose: FragmentChoice,
     shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
 ) -> Vec<LobeRadiance> {
     fold_chosen_points(

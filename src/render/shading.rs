@@ -1,7 +1,7 @@
 //! The shading passes (`shaders/shading.wgsl`): one dispatch per batch of at most
 //! [`MAX_LIGHTS_PER_PASS`] SRBF lights (Xu 2011's multi-pass scheme), each adding its lights' R, TT and
 //! TRT radiance (and with multiple scattering MS.global and MS.local) to the component buffers; one
-//! dispatch per visibility sample within a batch.
+//! dispatch per K-buffer slot within a batch.
 
 use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
 use super::targets::FrameTargets;
@@ -12,8 +12,8 @@ use bytemuck::{Pod, Zeroable};
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
-/// [`ShadeBatch::slot`] of the preview's dispatches: each pixel shades its representative sample
-/// ([`super::shade::representative_sample`]) instead of each distinct segment at one slot.
+/// [`ShadeBatch::slot`] of the preview's dispatches: each pixel shades its front fragment for all of
+/// its hair ([`super::shade::representative_fragment`]) instead of one K-buffer slot.
 pub const SLOT_REPRESENTATIVE: u32 = u32::MAX;
 
 /// One SRBF light as the shaders read it.
@@ -33,8 +33,9 @@ pub struct ShadeBatch {
     pub first: u32,
     pub count: u32,
     pub flags: u32,
-    pub samples: u32,
-    /// The visibility sample this dispatch shades (one dispatch per sample and batch), or
+    /// Fragments per pixel in the K-buffer.
+    pub slots: u32,
+    /// The K-buffer slot this dispatch shades (one dispatch per slot and batch), or
     /// [`SLOT_REPRESENTATIVE`].
     pub slot: u32,
     /// Rows [row0, row0 + rows) of the image.
@@ -59,7 +60,7 @@ pub struct ShadingInputs<'a> {
     pub shadow_values: &'a wgpu::Buffer,
     pub dual_tables: &'a wgpu::Buffer,
     pub azimuthal_table: &'a wgpu::Buffer,
-    /// The occluder, shaded with the first visibility sample's batches (and the preview's).
+    /// The occluder, shaded with the first slot's batches (and the preview's).
     pub occluder: Option<&'a GpuOccluder>,
 }
 
@@ -142,21 +143,20 @@ impl ShadingPass {
             inputs.dual_tables,
         ];
         let buffers: Vec<&wgpu::Buffer> = buffers.into_iter().chain(&targets.components).collect();
-        let visibility = wgpu::BindGroupEntry {
-            binding: buffers.len() as u32,
-            resource: wgpu::BindingResource::TextureView(&targets.visibility),
-        };
-        let azimuthal = wgpu::BindGroupEntry {
-            binding: buffers.len() as u32 + 1,
-            resource: inputs.azimuthal_table.as_entire_binding(),
-        };
-        bind_buffers(
-            device,
-            &self.pipeline,
-            "shading",
-            &buffers,
-            vec![visibility, azimuthal],
-        )
+        let more = [
+            &targets.kbuffer.fragments,
+            inputs.azimuthal_table,
+            &targets.kbuffer.pixel_info,
+        ];
+        let extra = more
+            .iter()
+            .enumerate()
+            .map(|(k, b)| wgpu::BindGroupEntry {
+                binding: buffers.len() as u32 + k as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        bind_buffers(device, &self.pipeline, "shading", &buffers, extra)
     }
 
     fn dispatch(

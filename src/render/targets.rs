@@ -1,13 +1,16 @@
-//! Per-frame GPU targets sized by the image: the multisampled visibility (segment ids) and depth
-//! textures, the per-component accumulation buffers and the resolved outputs.
+//! Per-frame GPU targets sized by the image: the multisampled visibility (the occluder's ids) and
+//! depth textures, the hair's K-buffer, the per-component accumulation buffers and the resolved
+//! outputs.
+
+use super::kbuffer::{KBufferTargets, Tail};
 
 /// Component buffers, in order: R, TT, TRT, MS.global, MS.local (linear radiance, coverage-weighted).
 pub const COMPONENTS: [&str; 5] = ["R", "TT", "TRT", "MS.global", "MS.local"];
 
-/// Segment index + 1 as an exact float (R32Uint cannot be multisampled without adapter-specific
-/// features; every integer up to 2^24 is exact in f32).
+/// The occluder's -(triangle + 1) as an exact float (R32Uint cannot be multisampled without
+/// adapter-specific features; every integer up to 2^24 is exact in f32).
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-/// The most segments the visibility target can name.
+/// The most segments the K-buffer's keys and the shading can name.
 pub const MAX_SEGMENTS: u32 = 1 << 24;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -25,10 +28,20 @@ pub struct FrameTargets {
     pub background: wgpu::Buffer,
     /// The occluder's radiance, coverage-weighted like the components (zero without one).
     pub occluder: wgpu::Buffer,
+    /// The hair's fragments.
+    pub kbuffer: KBufferTargets,
 }
 
 impl FrameTargets {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
+    /// Targets for a width x height image, `samples` occluder samples per pixel and `fragments` hair
+    /// fragments kept per pixel.
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        samples: u32,
+        (fragments, tail): (u32, Tail),
+    ) -> Self {
         let texture = |label: &str, format| {
             device
                 .create_texture(&wgpu::TextureDescriptor {
@@ -71,6 +84,7 @@ impl FrameTargets {
             sample_ids: buffer("sample ids", 16),
             background: buffer("background", 16),
             occluder: buffer("occluder", 16),
+            kbuffer: KBufferTargets::new(device, width, height, fragments, tail),
         }
     }
 }

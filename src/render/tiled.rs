@@ -5,18 +5,31 @@
 
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
+use super::kbuffer::KBufferTargets;
 use super::renderer::{RenderError, Renderer};
 use crate::gpu::GpuContext;
 
 /// Tiles of at most this many pixels a side by default (16 MiB per RGBA float buffer).
 pub const DEFAULT_TILE: u32 = 1024;
 
-/// Whether a width x height image exceeds what the device binds or rasterises at once (then it is
+/// Whether a width x height image with `fragments` K-buffer slots exceeds what the device binds or rasterises at once (then it is
 /// rendered in tiles).
-pub fn needs_tiles(ctx: &GpuContext, width: u32, height: u32) -> bool {
+pub fn needs_tiles(ctx: &GpuContext, width: u32, height: u32, fragments: u32) -> bool {
     let l = ctx.device.limits();
     let bytes = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
-    width as u64 * height as u64 * 16 > bytes || width.max(height) > l.max_texture_dimension_2d
+    let per_pixel = KBufferTargets::bytes_per_pixel(fragments).max(16);
+    width as u64 * height as u64 * per_pixel > bytes
+        || width.max(height) > l.max_texture_dimension_2d
+}
+
+/// The side of the tiles a still with `fragments` K-buffer slots is rendered in: [`DEFAULT_TILE`], or
+/// less where a tile's K-buffer would not fit one binding.
+pub fn tile_side(ctx: &GpuContext, fragments: u32) -> u32 {
+    let l = ctx.device.limits();
+    let bytes = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+    let per_pixel = KBufferTargets::bytes_per_pixel(fragments).max(16);
+    let side = ((bytes / per_pixel) as f64).sqrt() as u32;
+    DEFAULT_TILE.min(side / 16 * 16).max(16)
 }
 
 /// An empty full-size frame the tiles are pasted into (96 bytes a pixel: an 8K still needs ~3.2 GB
@@ -30,13 +43,17 @@ pub fn empty_frame(width: u32, height: u32, samples: u32, components: usize) -> 
         beauty: vec![[0.0; 4]; n],
         depth: vec![1e10; n],
         sample_ids: vec![[0; 4]; n],
+        fragments: Vec::new(),
+        fragments_per_pixel: 0,
+        pixel_fragments: Vec::new(),
         components: vec![vec![[0.0; 3]; n]; components],
         background: Vec::new(),
         occluder: Vec::new(),
     }
 }
 
-/// Copies a tile's frame into the full frame at the tile's origin.
+/// Copies a tile's frame into the full frame at the tile's origin (not its K-buffer: an 8K still's
+/// would take gigabytes).
 pub fn paste(full: &mut Frame, tile: &Tile, part: &Frame) {
     let [x0, y0] = tile.origin.map(|v| v as usize);
     let (tw, fw) = (part.width as usize, full.width as usize);

@@ -1,14 +1,16 @@
-//! The visibility pass: hair segments as camera-facing ribbons into the multisampled id and depth
-//! targets (`shaders/visibility.wgsl`).
+//! The visibility pass: the occluder (the head) into the multisampled id and depth targets
+//! (`shaders/visibility.wgsl`), then the hair's fragments into the K-buffer, which reads that depth
+//! ([`super::kbuffer`]), and after the last segment the K-buffer's composite.
 
+use super::kbuffer::KBufferPass;
 use super::occluder::GpuOccluder;
 use super::targets::{DEPTH_FORMAT, FrameTargets, VISIBILITY_FORMAT};
 use crate::gpu::fiber_density::GpuHair;
 use crate::gpu::shaders;
 
 pub struct VisibilityPass {
-    pipeline: wgpu::RenderPipeline,
     occluder: wgpu::RenderPipeline,
+    kbuffer: KBufferPass,
 }
 
 impl VisibilityPass {
@@ -18,8 +20,8 @@ impl VisibilityPass {
             source: wgpu::ShaderSource::Wgsl(shaders::visibility_module().into()),
         });
         Self {
-            pipeline: Self::pipeline(device, &module, samples, "ribbon"),
             occluder: Self::pipeline(device, &module, samples, "occluder"),
+            kbuffer: KBufferPass::new(device),
         }
     }
 
@@ -74,8 +76,9 @@ impl VisibilityPass {
     }
 
     /// Draws segments `range` (all of them for a whole frame; progressive refinement's bounded units
-    /// draw parts): the range starting at 0 clears the targets and draws the occluder first, later
-    /// ones draw over them (in order, so the depth test's ties resolve as in one draw).
+    /// draw parts): the range starting at 0 clears the targets and draws the occluder first; the range
+    /// reaching the last segment ends with the K-buffer's composite. The K-buffer does not depend on
+    /// the order the segments are drawn in.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -89,24 +92,42 @@ impl VisibilityPass {
         timestamps: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let clear = range.start == 0;
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("visibility"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: hair.points.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: hair.segments.as_entire_binding(),
-                },
-            ],
-        });
+        if clear {
+            self.encode_occluder(device, encoder, camera, occluder, targets);
+        }
+        self.kbuffer.encode_raster(
+            device,
+            encoder,
+            camera,
+            hair,
+            &targets.depth,
+            &targets.kbuffer,
+            range.clone(),
+            clear,
+            timestamps,
+        );
+        if range.end >= hair.segment_count {
+            self.kbuffer.encode_composite(
+                device,
+                encoder,
+                camera,
+                hair,
+                &targets.depth,
+                &targets.kbuffer,
+                (targets.width, targets.height),
+            );
+        }
+    }
+
+    /// Clears the id and depth targets and draws the occluder's triangles (when there is one).
+    fn encode_occluder(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &wgpu::Buffer,
+        occluder: Option<&GpuOccluder>,
+        targets: &FrameTargets,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("visibility"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -114,31 +135,23 @@ impl VisibilityPass {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: if clear {
-                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                    } else {
-                        wgpu::LoadOp::Load
-                    },
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &targets.depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: if clear {
-                        wgpu::LoadOp::Clear(1.0)
-                    } else {
-                        wgpu::LoadOp::Load
-                    },
+                    load: wgpu::LoadOp::Clear(1.0),
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: timestamps,
+            timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some(o) = occluder.filter(|_| clear) {
+        if let Some(o) = occluder {
             let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("visibility occluder"),
                 layout: &self.occluder.get_bind_group_layout(0),
@@ -160,12 +173,6 @@ impl VisibilityPass {
             pass.set_pipeline(&self.occluder);
             pass.set_bind_group(0, &bind, &[]);
             pass.draw(0..3 * o.triangle_count, 0..1);
-        }
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        let end = range.end.min(hair.segment_count);
-        if end > range.start {
-            pass.draw(6 * range.start..6 * end, 0..1);
         }
     }
 }

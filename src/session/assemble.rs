@@ -374,6 +374,10 @@ pub fn still_attributes(session: &Session, h: &StillHeader) -> Vec<(String, Stri
         ("camera".into(), json(h.camera)),
         ("exposure_ev".into(), s.exposure.to_string()),
         ("samples".into(), s.samples.to_string()),
+        (
+            "fragments".into(),
+            format!("{} per pixel, tail {:?}", s.fragments, s.tail),
+        ),
         ("shadows".into(), s.shadows.to_string()),
         (
             "multiple_scattering".into(),

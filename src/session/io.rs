@@ -158,6 +158,13 @@ impl Session {
         if !matches!(r.samples, 2 | 4) {
             return Err(format!("render samples must be 2 or 4, got {}", r.samples));
         }
+        let most = crate::render::kbuffer::MAX_FRAGMENTS;
+        if !(1..=most).contains(&r.fragments) {
+            return Err(format!(
+                "render fragments must be 1 to {most}, got {}",
+                r.fragments
+            ));
+        }
         if r.width == 0 || r.height == 0 || r.width > 16384 || r.height > 16384 {
             return Err(format!(
                 "render size {}x{} is out of range",

@@ -286,7 +286,13 @@ impl ViewCamera {
 pub struct RenderOptions {
     pub width: u32,
     pub height: u32,
+    /// The occluder's (the head's) samples per pixel (2 or 4).
     pub samples: u32,
+    /// Hair fragments kept per pixel by the K-buffer (1 to 32) and what becomes of the rest.
+    #[serde(default = "default_fragments")]
+    pub fragments: u32,
+    #[serde(default)]
+    pub tail: crate::render::kbuffer::Tail,
     /// Exposure in stops (applied to the EXR as `render --exposure` does).
     pub exposure: f32,
     pub shadows: bool,
@@ -299,6 +305,10 @@ pub struct RenderOptions {
     pub background: crate::render::background::Background,
 }
 
+fn default_fragments() -> u32 {
+    crate::render::kbuffer::DEFAULT_FRAGMENTS
+}
+
 impl Default for RenderOptions {
     fn default() -> Self {
         let s = RenderSettings::default();
@@ -306,6 +316,8 @@ impl Default for RenderOptions {
             width: s.width,
             height: s.height,
             samples: s.samples,
+            fragments: s.fragments,
+            tail: s.tail,
             exposure: s.exposure,
             shadows: s.shadows,
             multiple_scattering: s.multiple_scattering,
@@ -323,6 +335,8 @@ impl RenderOptions {
             width,
             height,
             samples: self.samples,
+            fragments: self.fragments,
+            tail: self.tail,
             exposure: self.exposure,
             shadows: self.shadows,
             multiple_scattering: self.multiple_scattering,

@@ -383,8 +383,30 @@ fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         ui.label("samples");
         for s in [2u32, 4] {
-            if ui.selectable_label(r.samples == s, s.to_string()).clicked() && r.samples != s {
+            if ui
+                .selectable_label(r.samples == s, s.to_string())
+                .on_hover_text("The head's samples per pixel")
+                .clicked()
+                && r.samples != s
+            {
                 r.samples = s;
+                c.changed = true;
+            }
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        ui.label("fragments");
+        for k in [4u32, 8, 12, 20, 32] {
+            if ui
+                .selectable_label(r.fragments == k, k.to_string())
+                .on_hover_text(
+                    "Hair fragments kept and shaded per pixel (translucency and anti-aliasing): \
+                     more is closer to all of them and slower",
+                )
+                .clicked()
+                && r.fragments != k
+            {
+                r.fragments = k;
                 c.changed = true;
             }
         }
