@@ -16,9 +16,10 @@
 struct KBufferInfo {
     // Fragments kept per pixel.
     k: u32,
-    // TAIL_DROP or TAIL_FOLD.
+    // TAIL_DROP, TAIL_FOLD or TAIL_SPREAD.
     tail: u32,
-    _p0: u32,
+    // 1: an occluder was drawn into the depth (else its samples are not read).
+    occluder: u32,
     _p1: u32,
 }
 
@@ -26,8 +27,8 @@ const TAIL_DROP: u32 = 0u;
 const TAIL_FOLD: u32 = 1u;
 const TAIL_SPREAD: u32 = 2u;
 // Pixels the drawn ribbon is grown by on every side (a pixel the true ribbon touches has its centre
-// within sqrt(2) / 2 of it).
-const EXPAND_PX: f32 = 1.0;
+// within sqrt(2) / 2 of it; the margin covers the slant of a tapering ribbon's sides).
+const EXPAND_PX: f32 = 0.75;
 // Fixed-point units of optical depth in the pixel sums.
 const OPTICAL_DEPTH_SCALE: f32 = 16384.0;
 // A fragment's opacity is at most this (its optical depth stays finite).
@@ -149,6 +150,9 @@ fn fragment_depth(seg: u32, pixel: vec2<u32>) -> f32 {
 // The share of the pixel's occluder samples that do not hide a fragment at view depth `depth`, and the
 // view depth of the nearest occluder sample (1e10 without one).
 fn occluder_cover(pixel: vec2<u32>, depth: f32) -> vec2<f32> {
+    if (kinfo.occluder == 0u) {
+        return vec2<f32>(1.0, 1e10);
+    }
     let n = textureNumSamples(occluder_depth);
     var open = 0u;
     var nearest = 1e10;
@@ -177,9 +181,12 @@ fn optical_depth(a: f32) -> u32 {
 @group(0) @binding(5) var<storage, read_write> keys: array<atomic<u64>>;
 @group(0) @binding(6) var<storage, read_write> sums: array<atomic<u32>>;
 
+// The ribbon travels with its fragments (flat), not recomputed per fragment.
 struct FragmentIn {
     @builtin(position) position: vec4<f32>,
     @location(0) @interpolate(flat) segment: u32,
+    @location(1) @interpolate(flat) ends: vec4<f32>,
+    @location(2) @interpolate(flat) dir_width: vec4<f32>,
 }
 
 @vertex
@@ -192,6 +199,8 @@ fn vs_fragments(@builtin(vertex_index) vi: u32) -> FragmentIn {
     let q = ribbon_quad(seg);
     var out: FragmentIn;
     out.segment = seg;
+    out.ends = vec4<f32>(q.p0, q.p1);
+    out.dir_width = vec4<f32>(q.dir, q.half_width);
     if (!q.valid) {
         out.position = vec4<f32>(2.0, 2.0, 0.5, 1.0);
         return out;
@@ -210,7 +219,14 @@ fn fs_fragments(in: FragmentIn) {
     if (pixel.x >= camera.size.x || pixel.y >= camera.size.y) {
         return;
     }
-    let c = pixel_coverage(ribbon_quad(in.segment), pixel);
+    var ribbon: RibbonQuad;
+    ribbon.p0 = in.ends.xy;
+    ribbon.p1 = in.ends.zw;
+    ribbon.dir = in.dir_width.xy;
+    ribbon.normal = vec2<f32>(-ribbon.dir.y, ribbon.dir.x);
+    ribbon.half_width = in.dir_width.zw;
+    ribbon.valid = true;
+    let c = pixel_coverage(ribbon, pixel);
     if (c <= 0.0) {
         return;
     }

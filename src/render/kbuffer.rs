@@ -20,8 +20,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
-/// Pixels the drawn ribbon is grown by on every side.
-pub const EXPAND_PX: f32 = 1.0;
+/// Pixels the drawn ribbon is grown by on every side (a pixel the true ribbon touches has its centre
+/// within √2 / 2 of it).
+pub const EXPAND_PX: f32 = 0.75;
 /// Fixed-point units of optical depth in the pixel sums.
 pub const OPTICAL_DEPTH_SCALE: f32 = 16384.0;
 /// A fragment's opacity is at most this (its optical depth stays finite).
@@ -65,18 +66,19 @@ impl std::str::FromStr for Tail {
 pub struct KBufferInfo {
     pub k: u32,
     pub tail: u32,
-    pub _p0: u32,
+    /// 1: an occluder was drawn into the depth the passes read.
+    pub occluder: u32,
     pub _p1: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<KBufferInfo>() == 16);
 
 impl KBufferInfo {
-    pub fn new(k: u32, tail: Tail) -> Self {
+    pub fn new(k: u32, tail: Tail, occluder: bool) -> Self {
         Self {
             k,
             tail: tail as u32,
-            _p0: 0,
+            occluder: occluder as u32,
             _p1: 0,
         }
     }
@@ -366,7 +368,7 @@ pub struct KBufferTargets {
     pub pixel_info: wgpu::Buffer,
     /// The raster pass's attachment (nothing is written to it).
     pub raster_target: wgpu::TextureView,
-    pub info: wgpu::Buffer,
+    pub tail: Tail,
 }
 
 impl KBufferTargets {
@@ -406,13 +408,18 @@ impl KBufferTargets {
             fragments: buffer("k-buffer fragments", 8 * k as u64),
             pixel_info: buffer("k-buffer pixels", 16),
             raster_target,
-            info: crate::gpu::context::buffer_init(
-                device,
-                "k-buffer info",
-                bytemuck::bytes_of(&KBufferInfo::new(k, tail)),
-                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            ),
+            tail,
         }
+    }
+
+    /// The passes' parameters, with or without an occluder in the depth.
+    fn info(&self, device: &wgpu::Device, occluder: bool) -> wgpu::Buffer {
+        crate::gpu::context::buffer_init(
+            device,
+            "k-buffer info",
+            bytemuck::bytes_of(&KBufferInfo::new(self.k, self.tail, occluder)),
+            wgpu::BufferUsages::STORAGE,
+        )
     }
 
     /// Bytes per pixel of the K-buffer with `k` slots (the largest per-pixel buffer: tiling).
@@ -469,7 +476,7 @@ impl KBufferPass {
     }
 
     /// Draws segments `range` into the K-buffer (clearing it first when `clear`); `occluder_depth` is
-    /// the occluder's multisampled depth (cleared to 1 without one).
+    /// the occluder's multisampled depth and whether an occluder was drawn into it.
     #[allow(clippy::too_many_arguments)]
     pub fn encode_raster(
         &self,
@@ -477,7 +484,7 @@ impl KBufferPass {
         encoder: &mut wgpu::CommandEncoder,
         camera: &wgpu::Buffer,
         hair: &GpuHair,
-        occluder_depth: &wgpu::TextureView,
+        (occluder_depth, occluder): (&wgpu::TextureView, bool),
         kb: &KBufferTargets,
         range: std::ops::Range<u32>,
         clear: bool,
@@ -491,6 +498,7 @@ impl KBufferPass {
         if end <= range.start {
             return;
         }
+        let info = kb.info(device, occluder);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer raster"),
             layout: &self.raster.get_bind_group_layout(0),
@@ -498,7 +506,7 @@ impl KBufferPass {
                 entry(0, camera),
                 entry(1, &hair.points),
                 entry(2, &hair.segments),
-                entry(3, &kb.info),
+                entry(3, &info),
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: wgpu::BindingResource::TextureView(occluder_depth),
@@ -536,10 +544,11 @@ impl KBufferPass {
         encoder: &mut wgpu::CommandEncoder,
         camera: &wgpu::Buffer,
         hair: &GpuHair,
-        occluder_depth: &wgpu::TextureView,
+        (occluder_depth, occluder): (&wgpu::TextureView, bool),
         kb: &KBufferTargets,
         size: (u32, u32),
     ) {
+        let info = kb.info(device, occluder);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer composite"),
             layout: &self.composite.get_bind_group_layout(0),
@@ -547,7 +556,7 @@ impl KBufferPass {
                 entry(0, camera),
                 entry(1, &hair.points),
                 entry(2, &hair.segments),
-                entry(3, &kb.info),
+                entry(3, &info),
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: wgpu::BindingResource::TextureView(occluder_depth),

@@ -42,8 +42,9 @@ const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
 /// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
 const GUESS_SEGMENT_S: f64 = 1e-6;
-/// A segment drawn by the visibility pass (lavapipe: ~0.75 us each on two cores).
-const GUESS_VISIBILITY_SEGMENT_S: f64 = 1e-6;
+/// A segment drawn into the K-buffer (lavapipe, two cores: S0's preview drew 30000 segments in one
+/// 406 ms unit, the shader's compilation included, when this guess was the ribbons' 1 us).
+const GUESS_VISIBILITY_SEGMENT_S: f64 = 8e-6;
 /// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
 const GUESS_ROW_LIGHTS: f64 = 16.0;

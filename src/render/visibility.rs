@@ -100,7 +100,7 @@ impl VisibilityPass {
             encoder,
             camera,
             hair,
-            &targets.depth,
+            (&targets.depth, occluder.is_some()),
             &targets.kbuffer,
             range.clone(),
             clear,
@@ -112,7 +112,7 @@ impl VisibilityPass {
                 encoder,
                 camera,
                 hair,
-                &targets.depth,
+                (&targets.depth, occluder.is_some()),
                 &targets.kbuffer,
                 (targets.width, targets.height),
             );
