@@ -65,14 +65,36 @@ fn half_width_px(diameter: f32, depth: f32) -> f32 {
     return max(0.5 * diameter / (camera.pixel_angle * depth), 0.5 * camera.min_width_px);
 }
 
+// The part of the segment a..b in front of the near plane (moved in by a thousandth of it): an end
+// behind it slides along the segment to it. Both behind: the segment is not seen.
+struct NearClipped {
+    a: vec4<f32>,
+    b: vec4<f32>,
+    valid: bool,
+}
+
+fn clip_near(a: vec4<f32>, b: vec4<f32>) -> NearClipped {
+    let plane = 1.001 * camera.near;
+    let da = dot(a.xyz - camera.eye, camera.forward);
+    let db = dot(b.xyz - camera.eye, camera.forward);
+    var out = NearClipped(a, b, da > plane || db > plane);
+    if (da < plane && db > plane) {
+        out.a = mix(a, b, (plane - da) / (db - da));
+    } else if (db < plane && da > plane) {
+        out.b = mix(b, a, (plane - db) / (da - db));
+    }
+    return out;
+}
+
 fn ribbon_quad(seg: u32) -> RibbonQuad {
     let i0 = segments[seg];
-    let a = points[i0];
-    let b = points[i0 + 1u];
+    let clipped = clip_near(points[i0], points[i0 + 1u]);
+    let a = clipped.a;
+    let b = clipped.b;
     let pa = to_pixels(a.xyz);
     let pb = to_pixels(b.xyz);
     var q: RibbonQuad;
-    q.valid = pa.z > camera.near && pb.z > camera.near;
+    q.valid = clipped.valid;
     q.p0 = pa.xy;
     q.p1 = pb.xy;
     let d = pb.xy - pa.xy;
@@ -206,7 +228,8 @@ fn vs_fragments(@builtin(vertex_index) vi: u32) -> FragmentIn {
         return out;
     }
     let end = select(q.p0 - EXPAND_PX * q.dir, q.p1 + EXPAND_PX * q.dir, along);
-    let hw = select(q.half_width.x, q.half_width.y, along) + EXPAND_PX;
+    // The wider end's half-width at both ends: a tapering ribbon's slanted sides keep the margin.
+    let hw = max(q.half_width.x, q.half_width.y) + EXPAND_PX;
     let p = end + side * hw * q.normal;
     let size = vec2<f32>(camera.size);
     out.position = vec4<f32>(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y, 0.5, 1.0);
@@ -301,7 +324,8 @@ fn composite(@builtin(global_invocation_id) id: vec3<u32>) {
         // ones in proportion to their weights (with their mean radiance).
         let rest = select(0u, s.x - kept, s.x > kept);
         let behind = exp(-f32(rest) / OPTICAL_DEPTH_SCALE);
-        if (kinfo.tail == TAIL_FOLD) {
+        // (Spread over kept fragments too faint to move t, the tail goes to the last one instead.)
+        if (kinfo.tail == TAIL_FOLD || t >= 1.0) {
             let last = base + n - 1u;
             fragments[last].y = bitcast<u32>(bitcast<f32>(fragments[last].y) + t * (1.0 - behind));
         } else if (t < 1.0) {

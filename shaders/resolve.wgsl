@@ -37,7 +37,8 @@ struct ResolveRows {
     // 1: also look the background up (it depends on the camera alone: a shading band's resolve skips it).
     background: u32,
     // 1: progressive refinement has shaded part of the fragments: the hair's radiance is scaled by its
-    // alpha over the weight shaded so far (the unshaded fragments take the shaded ones' mean).
+    // alpha over the weight shaded so far (the unshaded fragments take the shaded ones' mean), by at
+    // most MAX_NORMALISE (a sliver in front, shaded first, would otherwise stand for a whole pixel).
     normalise: u32,
 }
 @group(0) @binding(12) var<storage, read> band: ResolveRows;
@@ -83,6 +84,8 @@ fn background_radiance(d: vec3<f32>) -> vec3<f32> {
     return top + (bottom - top) * f.y;
 }
 
+const MAX_NORMALISE: f32 = 4.0;
+
 @compute @workgroup_size(8, 8)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.y >= band.rows) {
@@ -111,7 +114,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     var hair_sum = aov_r[pixel].xyz + aov_tt[pixel].xyz + aov_trt[pixel].xyz + aov_ms_global[pixel].xyz + aov_ms_local[pixel].xyz;
     let shaded = aov_r[pixel].w;
     if (band.normalise != 0u && shaded > 0.0) {
-        hair_sum = hair_sum * (hair.x / shaded);
+        hair_sum = hair_sum * min(hair.x / shaded, MAX_NORMALISE);
     }
     let sum = hair_sum + occluder[pixel].xyz;
     beauty[pixel] = vec4<f32>(info.exposure_scale * sum, alpha);

@@ -1,7 +1,8 @@
-// Shading pass (Xu 2011 Sec. 5): for every pixel, the hair fragments of its K-buffer are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT),
-// each light scaled by its transmittance (swept through the fiber-density pyramid at the points of the
-// shadow grid, read trilinearly), and accumulated per lobe
-// weighted by the samples' coverage. Twin of src/render/shade.rs (shade_point).
+// Shading pass (Xu 2011 Sec. 5): for every pixel, the hair fragments of its K-buffer are shaded
+// under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT), each light
+// scaled by its transmittance (swept through the fiber-density pyramid at the points of the shadow
+// grid, read trilinearly), and accumulated per lobe weighted by the fragments' composite weights
+// (kbuffer.wgsl). Twin of src/render/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
 // the grid) to MS.global and MS.local.
@@ -9,8 +10,6 @@
 // dual_response, shadow_grid, camera.
 
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
-// `ShadeBatch.slot` of the preview's dispatches: every pixel shades one fragment for all of them.
-const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -33,7 +32,6 @@ const SLOT_REPRESENTATIVE: u32 = 0xffffffffu;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
 @group(0) @binding(18) var<storage, read> fragments: array<vec2<u32>>;
 @group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
-@group(0) @binding(20) var<storage, read> pixel_info: array<vec4<f32>>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -115,31 +113,11 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let xy = vec2<u32>(id.x, y);
     let pixel = y * camera.size.x + id.x;
-    // This dispatch shades K-buffer slot `batch.slot` of every pixel with its weight, or for the
-    // preview one fragment with the pixel's whole hair alpha (representative_fragment in shade.rs). (One shading call per invocation: looping over a pixel's fragments inside one
-    // invocation gave wrong sums on lavapipe.)
-    let base = pixel * batch.slots;
-    var f = fragments[base];
-    var w = pixel_info[pixel].x;
-    if (batch.slot != SLOT_REPRESENTATIVE) {
-        f = fragments[base + batch.slot];
-        w = bitcast<f32>(f.y);
-    } else {
-        // The fragment at which the weights reach half the hair's alpha (the front one is the most
-        // lit: standing for all, it brightened the preview).
-        var reached = 0.0;
-        for (var i = 0u; i < batch.slots; i++) {
-            let g = fragments[base + i];
-            if (g.x == 0u) {
-                break;
-            }
-            f = g;
-            reached = reached + bitcast<f32>(g.y);
-            if (reached >= 0.5 * w) {
-                break;
-            }
-        }
-    }
+    // This dispatch shades K-buffer slot `batch.slot` of every pixel with its weight. (One shading
+    // call per invocation: looping over a pixel's fragments inside one invocation gave wrong sums on
+    // lavapipe.)
+    let f = fragments[pixel * batch.slots + batch.slot];
+    let w = bitcast<f32>(f.y);
     if (f.x == 0u || w <= 0.0) {
         return;
     }
@@ -147,9 +125,10 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = pixel_ray(camera, f32(xy.x) + 0.5, f32(xy.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
     let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
-    // .w of R: the weight shaded so far, counted at each fragment's first light batch (the resolve
+    // .w of R: the weight shaded so far, each batch adding its share of the lights (the resolve
     // scales a partly shaded image by the pixel's hair alpha over it while refinement runs).
-    aov_r[pixel] = aov_r[pixel] + vec4<f32>(w * l.r, select(0.0, w, batch.first == 0u));
+    let share = f32(batch.count) / f32(max(batch.lights, 1u));
+    aov_r[pixel] = aov_r[pixel] + vec4<f32>(w * l.r, w * share);
     aov_tt[pixel] = aov_tt[pixel] + vec4<f32>(w * l.tt, 0.0);
     aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(w * l.trt, 0.0);
     aov_ms_global[pixel] = aov_ms_global[pixel] + vec4<f32>(w * l.ms_global, 0.0);

@@ -24,7 +24,8 @@ struct ShadeBatch {
     // progressive refinement).
     row0: u32,
     rows: u32,
-    _p2: u32,
+    // Lights in all the batches (the shaded weight counts a fragment's share of them).
+    lights: u32,
 }
 
 const FLAG_SHADOWS: u32 = 1u;

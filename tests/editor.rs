@@ -867,7 +867,6 @@ fn brush_stroke(h: &mut Harness<'static, EditorApp>, from: egui::Pos2, to: egui:
     h.step();
 }
 
-/// Mean of the beauty (un-premultiplied) over the pixels `which`, RGB.
 /// The hair's mean colour over the pixels `which`: the beauty less the head's radiance, over the
 /// hair's coverage.
 fn mean_colour(f: &Frame, which: &[usize]) -> [f64; 3] {

@@ -152,9 +152,18 @@ fn the_gpu_kbuffer_equals_its_cpu_twin() {
     let luts = Luts::default_tables();
     let b = bob(2000, 4.0 / 3.0);
     let (w, h) = (200, 150);
-    for tail in [Tail::Drop, Tail::Fold, Tail::Spread] {
+    // The default K with each tail, and few slots (the insertion chain's early-out busy).
+    let k20 = DEFAULT_FRAGMENTS;
+    for (k, tail) in [
+        (k20, Tail::Drop),
+        (k20, Tail::Fold),
+        (k20, Tail::Spread),
+        (1, Tail::Spread),
+        (4, Tail::Drop),
+    ] {
         let mut settings = plain(w, h);
         settings.tail = tail;
+        settings.fragments = k;
         let frame = common::render_uniform(
             &ctx,
             &settings,
@@ -167,7 +176,7 @@ fn the_gpu_kbuffer_equals_its_cpu_twin() {
         let (points, segments) = gpu_points(&b.hair);
         let cam = b.camera.uniform(w, h, 0.0);
         let ab = abuffer(&cam, &points, &segments);
-        let k = DEFAULT_FRAGMENTS as usize;
+        let k = k as usize;
         let (slots, info) = ab.kbuffer(k, tail);
         let (mut same, mut hair, mut worst_weight, mut worst_alpha) = (0, 0, 0f32, 0f32);
         let mut worst_alpha_any = 0f32;
@@ -193,12 +202,12 @@ fn the_gpu_kbuffer_equals_its_cpu_twin() {
         }
         let fragments: usize = ab.pixels.iter().map(Vec::len).sum();
         println!(
-            "{tail:?}: {fragments} fragments (at most {} in a pixel), {hair} hair pixels, the same {k} fragments in {same}; worst weight {worst_weight:.2e}, worst alpha {worst_alpha:.2e} ({worst_alpha_any:.2e} with the others); mean coverage {:.4}",
+            "K = {k}, {tail:?}: {fragments} fragments (at most {} in a pixel), {hair} hair pixels, the same {k} fragments in {same}; worst weight {worst_weight:.2e}, worst alpha {worst_alpha:.2e} ({worst_alpha_any:.2e} with the others); mean coverage {:.4}",
             ab.depth_complexity(),
             frame.beauty.iter().map(|p| p[3] as f64).sum::<f64>() / frame.pixel_count() as f64
         );
-        assert!(hair > 3000 && same as f64 >= 0.995 * hair as f64);
-        assert!(worst_weight < 1e-4 && worst_alpha < 1e-3);
+        assert!(hair > 3000 && same as f64 >= 0.99 * hair as f64);
+        assert!(worst_weight < 1e-4 && worst_alpha < 1e-3 && worst_alpha_any < 0.05);
     }
 }
 

@@ -199,6 +199,54 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
     }
     println!("AOVs with the occluder against the beauty: worst {sum_worst:.2e}");
     assert!(sum_worst < 1e-4, "{sum_worst}");
+    // The head hides the hair behind it: where every sample of a pixel shows the head, no kept
+    // fragment lies behind the head's surface on the pixel's centre ray (a CPU ray cast at the mesh),
+    // beyond the spread of the head's depth across the pixel; and the head is seen through the hair
+    // in front of it by the transmittance of those fragments.
+    let forward = Vec3::from(camera.forward);
+    let segments = strandlight::render::shade::segment_starts(&s.hair);
+    let (mut checked, mut behind, mut seen_through) = (0, 0, 0f32);
+    let (mut head_pixels_seen, mut dimmed_bare) = (0usize, 0usize);
+    for i in 0..frame.pixel_count() {
+        if !frame.sample_ids[i]
+            .iter()
+            .all(|&id| occluder_triangle(id).is_some())
+        {
+            continue;
+        }
+        let (x, y) = ((i % 96) as u32, (i / 96) as u32);
+        let (origin, dir) =
+            strandlight::render::camera::pixel_ray(&camera, x as f32 + 0.5, y as f32 + 0.5);
+        let Some((t, _, _)) = s.occluder.mesh.intersect(origin, dir, 0.0) else {
+            continue;
+        };
+        let head = t * dir.dot(forward);
+        let mut front = 0u32;
+        for f in frame.kept_fragments(i) {
+            let i0 = segments[f.id as usize - 1] as usize;
+            let (a, b) = (s.hair.positions[i0], s.hair.positions[i0 + 1]);
+            let depth = strandlight::render::kbuffer::fragment_depth(&camera, a, b, x, y);
+            checked += 1;
+            behind += (depth > head + 0.2) as usize;
+            front += (depth < head) as u32;
+        }
+        // With no hair in front the head shows whole (up to fragments between the head's samples
+        // and the centre's depth); with hair it is dimmed by its transmittance.
+        let t_occ = frame.pixel_fragments[i].occluder_transmittance;
+        head_pixels_seen += 1;
+        if front == 0 {
+            dimmed_bare += (t_occ < 0.999) as usize;
+        } else {
+            seen_through = seen_through.max(1.0 - t_occ);
+        }
+    }
+    println!(
+        "hair over the head: {checked} fragments in {head_pixels_seen} pixels all head, {behind} \
+         behind it; the head's largest attenuation by the hair in front {seen_through:.3}, dimmed \
+         with no kept fragment in front in {dimmed_bare}"
+    );
+    assert!(checked > 100 && behind == 0 && seen_through > 0.05);
+    assert!(dimmed_bare * 100 <= head_pixels_seen, "{dimmed_bare}");
 }
 
 /// The hair's green radiance at pixel `i` (its components, without the head's).

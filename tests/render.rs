@@ -18,7 +18,7 @@ use strandlight::render::reference::{
 };
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{
-    EVERY_FRAGMENT, FragmentChoice, REPRESENTATIVE, ShadingHair, shade_pixels, shade_point,
+    EVERY_FRAGMENT, FragmentChoice, ShadingHair, shade_pixels, shade_point,
 };
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
@@ -194,7 +194,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         };
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
         twin(&frame, &cam, EVERY_FRAGMENT, "frame");
-        // The preview (half resolution, each pixel's front fragment for all its hair), after a change.
+        // The preview (half resolution, its four fragments a pixel), after a change.
         renderer.set_preview(PreviewMode::Fixed(2));
         renderer.set_camera(&ctx, &s.camera);
         loop {
@@ -212,7 +212,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .expect("read back")
             .expect("a preview");
         assert_eq!((preview.width, preview.height), (32, 24));
-        twin(&preview, &preview_cam, REPRESENTATIVE, "preview");
+        twin(&preview, &preview_cam, EVERY_FRAGMENT, "preview");
     }
 }
 

@@ -79,7 +79,7 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
-    /// Points shaded per frame (each pixel's distinct hair segments among its visibility samples).
+    /// Points shaded per frame (each pixel's kept K-buffer fragments).
     shaded_points: usize,
     /// The shading pass's median GPU time per light per shaded point, microseconds (all threads of
     /// the GPU: compare with `bench-fast`'s one-thread CPU figure only as a ratio).
@@ -107,8 +107,8 @@ struct ProgressiveReport {
     /// Submission to completion of each pass's units, summed (wall clock as the polling saw it).
     pass_ms: std::collections::BTreeMap<&'static str, f64>,
     /// From the change until the preview is complete (reduced resolution, every light, the shadow
-    /// grid as it stood), and until the full image's first pass is (every light at the first
-    /// visibility sample, with the shadow grid).
+    /// grid as it stood), and until the full image's first pass is (every light at the front
+    /// K-buffer slot, with the shadow grid).
     #[serde(skip_serializing_if = "Option::is_none")]
     preview_ms: Option<f64>,
     first_pass_ms: f64,

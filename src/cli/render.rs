@@ -349,6 +349,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
         None => 0,
     };
+    // The reference modes shade the frame's K-buffer fragments, which a tiled still does not keep.
+    if tile > 0 && args.reference.is_some() {
+        bail!(
+            "--reference needs an untiled image ({}x{} with {} fragments a pixel would be rendered in tiles): render it smaller or with fewer --fragments",
+            settings.width,
+            settings.height,
+            settings.fragments
+        );
+    }
     let mut first = settings.clone();
     if tile > 0 {
         first.width = settings.width.min(tile);

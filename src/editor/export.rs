@@ -164,7 +164,7 @@ impl ExportJob {
             };
             self.fraction = (self.current as f32 + progress.fraction) / n as f32;
             if progress.converged {
-                self.reading = Some(self.renderer.start_read_frame(ctx));
+                self.reading = Some(self.renderer.start_read_image(ctx));
             }
             return None;
         };

@@ -26,6 +26,12 @@ pub enum GpuError {
          `apt-get install mesa-vulkan-drivers libvulkan1` (software Vulkan, lavapipe)"
     )]
     NoAdapter(String),
+    #[error(
+        "the GPU adapter '{adapter}' lacks what the hair's K-buffer needs (of {missing}: 64-bit atomics, \
+         Vulkan's VK_KHR_shader_atomic_int64), and no other adapter has it; on Debian/Ubuntu \
+         `apt-get install mesa-vulkan-drivers` gives lavapipe, which has it"
+    )]
+    MissingFeatures { adapter: String, missing: String },
     #[error("the GPU adapter '{adapter}' refused a device: {source}")]
     RequestDevice {
         adapter: String,
@@ -86,6 +92,23 @@ impl GpuContext {
             apply_limit_buckets: false,
         }))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        // The preferred adapter may lack the K-buffer's 64-bit atomics where another has them
+        // (DX12 below shader model 6.6 beside Vulkan): take the first that has them.
+        let adapter = if adapter.features().contains(REQUIRED_FEATURES) {
+            adapter
+        } else {
+            let others = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+            others
+                .into_iter()
+                .filter(|a| {
+                    !options.force_software || a.get_info().device_type == wgpu::DeviceType::Cpu
+                })
+                .find(|a| a.features().contains(REQUIRED_FEATURES))
+                .ok_or_else(|| GpuError::MissingFeatures {
+                    adapter: adapter.get_info().name,
+                    missing: format!("{REQUIRED_FEATURES:?}"),
+                })?
+        };
         let info = adapter.get_info();
         let summary = AdapterSummary::new(&info);
         let (device, queue) =

@@ -90,7 +90,6 @@ impl Frame {
         self.width as usize * self.height as usize
     }
 
-    /// Pixels with any coverage.
     /// Pixel `i`'s kept hair fragments (segment + 1 and weight), front to back.
     pub fn kept_fragments(&self, i: usize) -> &[Fragment] {
         let k = self.fragments_per_pixel as usize;
@@ -105,6 +104,7 @@ impl Frame {
         self.pixel_fragments.get(i).map_or(0.0, |p| p.alpha)
     }
 
+    /// Pixels with any coverage.
     pub fn covered(&self) -> impl Iterator<Item = usize> + '_ {
         (0..self.pixel_count()).filter(|&i| self.beauty[i][3] > 0.0)
     }

@@ -138,8 +138,29 @@ pub fn half_width_px(c: &CameraUniform, diameter: f32, depth: f32) -> f32 {
     (0.5 * diameter / (c.pixel_angle * depth)).max(0.5 * c.min_width_px)
 }
 
+/// The part of the segment a..b in front of the near plane, moved in by a thousandth of it (twin of
+/// `clip_near`): None when both ends are behind it.
+pub fn clip_near(c: &CameraUniform, a: Vec4, b: Vec4) -> Option<(Vec4, Vec4)> {
+    let plane = 1.001 * c.near;
+    let (eye, forward) = (Vec3::from(c.eye), Vec3::from(c.forward));
+    let da = (a.truncate() - eye).dot(forward);
+    let db = (b.truncate() - eye).dot(forward);
+    if da <= plane && db <= plane {
+        return None;
+    }
+    if da < plane && db > plane {
+        return Some((a + (b - a) * ((plane - da) / (db - da)), b));
+    }
+    if db < plane && da > plane {
+        return Some((a, b + (a - b) * ((plane - db) / (da - db))));
+    }
+    Some((a, b))
+}
+
 /// The ribbon of the segment between points `a` and `b` (xyz, diameter; twin of `ribbon_quad`).
 pub fn ribbon_quad(c: &CameraUniform, a: Vec4, b: Vec4) -> RibbonQuad {
+    let valid = clip_near(c, a, b).is_some();
+    let (a, b) = clip_near(c, a, b).unwrap_or((a, b));
     let pa = to_pixels(c, a.truncate());
     let pb = to_pixels(c, b.truncate());
     let d = pb.truncate() - pa.truncate();
@@ -154,7 +175,7 @@ pub fn ribbon_quad(c: &CameraUniform, a: Vec4, b: Vec4) -> RibbonQuad {
             half_width_px(c, a.w, pa.z.max(c.near)),
             half_width_px(c, b.w, pb.z.max(c.near)),
         ),
-        valid: pa.z > c.near && pb.z > c.near,
+        valid,
     }
 }
 
@@ -312,7 +333,7 @@ pub fn composite(list: &[RawFragment], k: usize, tail: Tail) -> (Vec<Fragment>, 
     let all: u32 = list.iter().map(|f| optical_depth(f.opacity)).sum();
     if tail != Tail::Drop && n == k && k > 0 {
         let behind = (-(all.saturating_sub(kept) as f32) / OPTICAL_DEPTH_SCALE).exp();
-        if tail == Tail::Fold {
+        if tail == Tail::Fold || t >= 1.0 {
             slots[n - 1].weight += t * (1.0 - behind);
         } else if t < 1.0 {
             let scale = 1.0 + t * (1.0 - behind) / (1.0 - t);
@@ -420,6 +441,14 @@ impl KBufferTargets {
             bytemuck::bytes_of(&KBufferInfo::new(self.k, self.tail, occluder)),
             wgpu::BufferUsages::STORAGE,
         )
+    }
+
+    /// The most of `k` fragments a width x height K-buffer can keep within `limit` bytes a binding (at
+    /// least 1).
+    pub fn fitting(limit: u64, width: u32, height: u32, k: u32) -> u32 {
+        let pixels = (width as u64 * height as u64).max(1);
+        let most = (limit / (8 * pixels)).min(MAX_FRAGMENTS as u64) as u32;
+        k.clamp(1, most.max(1))
     }
 
     /// Bytes per pixel of the K-buffer with `k` slots (the largest per-pixel buffer: tiling).

@@ -183,7 +183,10 @@ pub fn shade_occluder_frame(
                 }
             }
             // Seen through the hair in front of it.
-            let t = frame.pixel_fragments[i].occluder_transmittance;
+            let t = frame
+                .pixel_fragments
+                .get(i)
+                .map_or(1.0, |p| p.occluder_transmittance);
             out.map(|v| t * v)
         })
         .collect()
@@ -333,10 +336,10 @@ impl OccluderPass {
     }
 }
 
-/// Whether a batch also shades the occluder: the frame's first visibility sample (the occluder pass
-/// reads every sample itself) and the preview's.
+/// Whether a batch also shades the occluder: the front K-buffer slot's (the occluder pass reads every
+/// one of its own samples itself).
 pub fn shades_occluder(batch: &ShadeBatch) -> bool {
-    batch.slot == 0 || batch.slot == super::shading::SLOT_REPRESENTATIVE
+    batch.slot == 0
 }
 
 #[cfg(test)]

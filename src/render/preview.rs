@@ -1,7 +1,5 @@
 //! The preview that progressive refinement shows right after a change: the same view at a fraction of
-//! the resolution, every light, one shading per pixel (a K-buffer of four fragments, the one where
-//! the weights reach half the pixel's alpha standing for all of its hair:
-//! [`super::shade::representative_fragment`]), shadows from the
+//! the resolution, every light, a K-buffer of four fragments, each shaded (the rest spread over them), shadows from the
 //! grid as it stands (a light group whose entries are part-way through a rebuild is shaded
 //! unshadowed). Its own small frame targets and camera; the frame's are untouched, so the converged
 //! image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
@@ -12,15 +10,14 @@ use super::frame::Frame;
 use super::kbuffer::Tail;
 use super::renderer::{RenderError, Renderer};
 use super::shading::{
-    FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, SLOT_REPRESENTATIVE, ShadeBatch, ShadingInputs,
-    ShadingPass,
+    FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
 };
 use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
 use std::time::Duration;
 
-/// The preview's K-buffer: four fragments, one of them shaded for all
-/// ([`super::shade::representative_fragment`]).
+/// The preview's K-buffer: four fragments, each shaded, the rest spread over them (one fragment
+/// standing for a preview pixel's dozens of fibres made a speckled picture).
 const PREVIEW_FRAGMENTS: u32 = 4;
 
 /// Whether, and at what resolution, refinement previews a change.
@@ -145,8 +142,8 @@ impl Renderer {
         Some(h)
     }
 
-    /// The preview's camera: the frame's view at the preview's size, fibres at least as wide as one
-    /// pixel of the frame (a preview pixel's 1/factor), so they keep their width in the scene.
+    /// The preview's camera: the frame's view at the preview's size, its least fibre width (when the
+    /// settings ask for one) the frame's in the scene (a preview pixel's 1/factor).
     fn preview_camera(&self, factor: u32) -> CameraUniform {
         let (w, h) = Preview::size(self.settings.width, self.settings.height, factor);
         self.camera_view
@@ -232,18 +229,20 @@ impl Renderer {
             if self.settings.multiple_scattering {
                 flags |= FLAG_MULTIPLE_SCATTERING;
             }
-            let batch = ShadeBatch {
-                first,
-                count,
-                flags,
-                slots: PREVIEW_FRAGMENTS,
-                slot: SLOT_REPRESENTATIVE,
-                row0,
-                rows,
-                _pad: 0,
-            };
-            self.shading_pass
-                .encode_batch(device, enc, &inputs, &p.targets, &batch, None);
+            for slot in 0..PREVIEW_FRAGMENTS {
+                let batch = ShadeBatch {
+                    first,
+                    count,
+                    flags,
+                    slots: PREVIEW_FRAGMENTS,
+                    slot,
+                    row0,
+                    rows,
+                    lights: self.light_count,
+                };
+                self.shading_pass
+                    .encode_batch(device, enc, &inputs, &p.targets, &batch, None);
+            }
         }
         self.resolve_pass.encode(
             device,
@@ -280,7 +279,7 @@ impl Renderer {
 
     /// The last preview as drawn (None: no preview made yet) with the current camera at its size
     /// (the one it was drawn with unless the camera moved since; tests: the CPU twin shades its
-    /// representative samples).
+    /// fragments).
     pub fn read_preview(
         &self,
         ctx: &GpuContext,

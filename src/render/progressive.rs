@@ -165,7 +165,7 @@ struct Bands {
 
 impl Bands {
     /// Rows of a band from `row` (of `height`): as many as `budget` holds by the rows' own measured
-    /// costs (else the `prior` ones: an upper bound, the first sample's for the others; else the mean
+    /// costs (else the `prior` ones: an upper bound, the front slot's for the others; else the mean
     /// row's, or `guess`, and then at most twice the last band); at least one; whole workgroups (8
     /// rows) where the budget allows.
     fn rows(&self, row: u32, height: u32, budget: f64, guess: f64, prior: &[f64]) -> u32 {
@@ -235,8 +235,10 @@ pub struct Refinement {
     volume_cost: Option<f64>,
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
-    /// The frame's shading bands per K-buffer slot (costs per light: the first sample shades
-    /// every covered pixel, the others only where a new segment appears, a few times cheaper), and
+    /// The same for the preview's visibility.
+    preview_visibility_cost: Option<f64>,
+    /// The frame's shading bands per K-buffer slot (costs per light: the front slot shades every
+    /// covered pixel, the others only where more fragments lie, cheaper), and
     /// the preview's (costs per row of all lights).
     bands: [Bands; MAX_SLOTS],
     preview_bands: Bands,
@@ -272,6 +274,7 @@ impl Default for Refinement {
             grid_cost: None,
             volume_cost: None,
             visibility_cost: None,
+            preview_visibility_cost: None,
             bands: Default::default(),
             preview_bands: Bands::default(),
             grid_last: 1,
@@ -365,11 +368,15 @@ impl Refinement {
             b.resized(ratio);
         }
         self.preview_bands = Bands::default();
+        // A segment's fragments go with the image's width.
+        for c in [&mut self.visibility_cost, &mut self.preview_visibility_cost] {
+            *c = c.map(|c| c * ratio.max(1e-6));
+        }
     }
 
     /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
     /// measurement, so one slow unit does not halve the next ones); `batch`: a shading unit's
-    /// visibility sample and light count.
+    /// K-buffer slot and light count.
     fn measured(&mut self, unit: WorkUnit, elapsed: Duration, batch: Option<(u32, u32)>) {
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
@@ -401,12 +408,19 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.volume_cost = Some(self.volume_cost.map_or(per, |o| 0.5 * (o + per)));
             }
-            WorkUnit::Visibility { count, .. } | WorkUnit::PreviewVisibility { count, .. }
-                if count > 0 =>
-            {
-                // The clear and resolve of the last part ride along: a small overstatement.
+            // The clear, composite and resolve of the last part ride along: an overstatement. The
+            // frame's and the preview's apart: a segment leaves fragments in proportion to the
+            // image's resolution.
+            WorkUnit::Visibility { count, .. } if count > 0 => {
                 let per = seconds / count as f64;
                 self.visibility_cost = Some(self.visibility_cost.map_or(per, |o| 0.5 * (o + per)));
+            }
+            WorkUnit::PreviewVisibility { count, .. } if count > 0 => {
+                let per = seconds / count as f64;
+                self.preview_visibility_cost = Some(
+                    self.preview_visibility_cost
+                        .map_or(per, |o| 0.5 * (o + per)),
+                );
             }
             WorkUnit::VolumeResolve
             | WorkUnit::Visibility { .. }
@@ -812,15 +826,19 @@ impl Renderer {
 
     /// Segments of a visibility unit from `first`: as many as the budget holds at the measured cost
     /// per segment (drawing costs about the same per segment whatever the resolution).
-    fn visibility_part(&self, first: u32) -> u32 {
+    fn visibility_part(&self, first: u32, preview: bool) -> u32 {
         let r = &self.refinement;
         let remaining = self.hair.segment_count.saturating_sub(first);
-        r.items(
-            r.visibility_cost,
-            GUESS_VISIBILITY_SEGMENT_S,
-            u32::MAX / 2,
-            remaining,
-        )
+        // Before the frame's first part is measured: the preview's cost per segment times its
+        // divisor (fragments go with the resolution), or the guess.
+        let factor = self.preview.as_ref().map_or(1.0, |p| p.factor as f64);
+        let cost = match preview {
+            true => r.preview_visibility_cost,
+            false => r
+                .visibility_cost
+                .or(r.preview_visibility_cost.map(|c| c * factor)),
+        };
+        r.items(cost, GUESS_VISIBILITY_SEGMENT_S, u32::MAX / 2, remaining)
     }
 
     /// The next unit of the plan (sized to the budget); advances the plan past it. The shadow grid is
@@ -842,7 +860,7 @@ impl Renderer {
                     self.refinement.stage = Stage::Preview { row: 0 };
                     return self.next_unit(device);
                 }
-                let count = self.visibility_part(first);
+                let count = self.visibility_part(first, true);
                 self.refinement.stage = if first + count >= self.hair.segment_count {
                     Stage::Preview { row: 0 }
                 } else {
@@ -898,7 +916,7 @@ impl Renderer {
                 let (first, count) = if self.visibility_valid {
                     (segments, 0)
                 } else {
-                    (first, self.visibility_part(first))
+                    (first, self.visibility_part(first, false))
                 };
                 self.refinement.stage = if first + count < segments {
                     Stage::Visibility {
@@ -1068,6 +1086,7 @@ impl Renderer {
                 self.visibility_valid = true;
                 ShadingPass::clear(enc, &self.targets);
                 self.shading_partial = true;
+                self.converged_rows = 0;
                 self.encode_resolve(device, enc, 0..self.settings.height, true);
             }
             WorkUnit::Shade { batch, row0, rows } => {
@@ -1080,8 +1099,11 @@ impl Renderer {
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
                 // The last batch leaves its rows converged: resolved as render_frame resolves them.
                 let last = batch + 1 >= self.shading_pass.frame_batches().count() as u32;
-                if last && row0 + rows >= self.settings.height {
-                    self.shading_partial = false;
+                if last {
+                    self.converged_rows = self.converged_rows.max(row0 + rows);
+                    if row0 + rows >= self.settings.height {
+                        self.shading_partial = false;
+                    }
                 }
                 self.resolve_pass.encode(
                     device,

@@ -6,7 +6,7 @@
 use super::background::BackgroundMap;
 use super::camera::{Camera, Tile};
 use super::frame::Frame;
-use super::kbuffer::{DEFAULT_FRAGMENTS, MAX_FRAGMENTS, Tail};
+use super::kbuffer::{DEFAULT_FRAGMENTS, KBufferTargets, MAX_FRAGMENTS, Tail};
 use super::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
 use super::preview::{Preview, PreviewMode};
 use super::progressive::Refinement;
@@ -268,9 +268,14 @@ pub struct Renderer {
     pub(super) visibility_pass: VisibilityPass,
     pub(super) shading_pass: ShadingPass,
     pub(super) resolve_pass: ResolvePass,
+    /// The fragments per pixel asked for (`settings.fragments` is fewer when the K-buffer would not
+    /// fit one binding at this size).
+    pub(super) requested_fragments: u32,
     pub(super) volume_dirty: bool,
-    /// Progressive refinement has shaded part of the K-buffer's fragments (resolves normalise).
+    /// Progressive refinement has shaded part of the K-buffer's fragments (resolves normalise), and
+    /// the rows [0, converged_rows) the last batch has finished (they do not).
     pub(super) shading_partial: bool,
+    pub(super) converged_rows: u32,
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
     pub(super) volume_stale: bool,
@@ -308,6 +313,12 @@ fn environment_buffer(device: &wgpu::Device, map: Option<&BackgroundMap>) -> wgp
         contents: bytemuck::cast_slice(texels),
         usage: wgpu::BufferUsages::STORAGE,
     })
+}
+
+/// The largest storage buffer the device binds.
+fn binding_limit(device: &wgpu::Device) -> u64 {
+    let l = device.limits();
+    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -375,6 +386,16 @@ impl Renderer {
         if !(1..=MAX_FRAGMENTS).contains(&settings.fragments) {
             return Err(RenderError::Fragments(settings.fragments));
         }
+        // A K-buffer larger than one binding keeps fewer fragments (the editor's viewport; stills
+        // are tiled instead, `tiled::tile_side`).
+        let requested_fragments = settings.fragments;
+        let mut settings = settings;
+        settings.fragments = KBufferTargets::fitting(
+            binding_limit(device),
+            settings.width,
+            settings.height,
+            requested_fragments,
+        );
         if sigma_a.len() != hair.point_count() {
             return Err(RenderError::AbsorptionCount {
                 points: hair.point_count(),
@@ -504,7 +525,9 @@ impl Renderer {
             shading_pass: ShadingPass::new(device),
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
+            requested_fragments,
             shading_partial: false,
+            converged_rows: 0,
             volume_stale: false,
             volume_absorption_old: false,
             shadow_grid_dirty: true,
@@ -531,6 +554,7 @@ impl Renderer {
         }
         let slots = self.settings.fragments;
         let height = self.settings.height;
+        let lights = self.light_count;
         // Slot-major: every light batch at the front fragment (most of every pixel), then at the
         // ones behind it, so a refining image has all its lights early.
         let light_batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
@@ -544,7 +568,7 @@ impl Renderer {
                     slot,
                     row0: 0,
                     rows: height,
-                    _pad: 0,
+                    lights,
                 })
             })
             .collect();
@@ -970,6 +994,12 @@ impl Renderer {
         self.resized_preview(width, height);
         self.settings.width = width;
         self.settings.height = height;
+        self.settings.fragments = KBufferTargets::fitting(
+            binding_limit(&ctx.device),
+            width,
+            height,
+            self.requested_fragments,
+        );
         self.targets = FrameTargets::new(
             &ctx.device,
             width,
@@ -1054,17 +1084,30 @@ impl Renderer {
         let mut enc = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        self.resolve_pass.encode(
-            &ctx.device,
-            &mut enc,
-            &self.camera,
-            &self.resolve_info,
-            &self.background_map,
-            &self.targets,
-            0..self.settings.height,
-            (true, self.shading_partial),
-            None,
-        );
+        // Rows the last shading batch has finished resolve as render_frame's; the others normalised
+        // while refinement runs.
+        let height = self.settings.height;
+        let done = if self.shading_partial {
+            self.converged_rows.min(height)
+        } else {
+            height
+        };
+        for (rows, normalise) in [(0..done, false), (done..height, true)] {
+            if rows.is_empty() {
+                continue;
+            }
+            self.resolve_pass.encode(
+                &ctx.device,
+                &mut enc,
+                &self.camera,
+                &self.resolve_info,
+                &self.background_map,
+                &self.targets,
+                rows,
+                (true, normalise),
+                None,
+            );
+        }
         if let Some(p) = &self.preview {
             self.resolve_pass.encode(
                 &ctx.device,
@@ -1085,6 +1128,7 @@ impl Renderer {
         Extras {
             background: self.has_background(),
             occluder: self.occluder.is_some(),
+            fragments: true,
         }
     }
 
@@ -1269,13 +1313,31 @@ impl Renderer {
         self.read_targets(ctx, &self.targets)
     }
 
+    /// [`Renderer::read_frame`] without the K-buffer (a tile of a still).
+    pub fn read_image(&self, ctx: &GpuContext) -> Result<Frame, RenderError> {
+        let extras = Extras {
+            fragments: false,
+            ..self.extras()
+        };
+        self.read_with(ctx, &self.targets, extras)
+    }
+
     /// Reads every output of `t` (the frame's targets or the preview's) back, waiting for the GPU.
     pub(super) fn read_targets(
         &self,
         ctx: &GpuContext,
         t: &FrameTargets,
     ) -> Result<Frame, RenderError> {
-        let bytes = frame_buffers(t, self.extras())
+        self.read_with(ctx, t, self.extras())
+    }
+
+    fn read_with(
+        &self,
+        ctx: &GpuContext,
+        t: &FrameTargets,
+        extras: Extras,
+    ) -> Result<Frame, RenderError> {
+        let bytes = frame_buffers(t, extras)
             .iter()
             .map(|b| ctx.read_buffer::<u8>(b))
             .collect::<Result<Vec<_>, _>>()
@@ -1283,19 +1345,33 @@ impl Renderer {
         Ok(frame_from_bytes(
             shape(t),
             self.settings.exposure,
-            self.extras(),
+            extras,
             &bytes,
         ))
     }
 
     /// Starts reading the frame back without waiting: poll the result once a UI frame.
     pub fn start_read_frame(&self, ctx: &GpuContext) -> FrameReadBack {
+        self.start_read(ctx, self.extras())
+    }
+
+    /// [`Renderer::start_read_frame`] without the K-buffer (a tile of a still, which keeps only its
+    /// image: 8 x K bytes a pixel less to read).
+    pub fn start_read_image(&self, ctx: &GpuContext) -> FrameReadBack {
+        let extras = Extras {
+            fragments: false,
+            ..self.extras()
+        };
+        self.start_read(ctx, extras)
+    }
+
+    fn start_read(&self, ctx: &GpuContext, extras: Extras) -> FrameReadBack {
         let t = &self.targets;
         FrameReadBack {
-            pending: ctx.start_read(&frame_buffers(t, self.extras())),
+            pending: ctx.start_read(&frame_buffers(t, extras)),
             shape: shape(t),
             exposure: self.settings.exposure,
-            extras: self.extras(),
+            extras,
         }
     }
 
@@ -1324,19 +1400,19 @@ impl Renderer {
 struct Extras {
     background: bool,
     occluder: bool,
+    /// The K-buffer's fragments and summaries (not for a tile of a still: `paste` drops them).
+    fragments: bool,
 }
 
-/// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them (the background
-/// and the occluder last, when there are some).
+/// The buffers a [`Frame`] is read from, in the order [`frame_from_bytes`] takes them: beauty, depth,
+/// sample ids, the components, then the K-buffer's, the background and the occluder when there are
+/// some.
 fn frame_buffers(t: &FrameTargets, extras: Extras) -> Vec<&wgpu::Buffer> {
-    let mut v = vec![
-        &t.beauty,
-        &t.view_depth,
-        &t.sample_ids,
-        &t.kbuffer.fragments,
-        &t.kbuffer.pixel_info,
-    ];
+    let mut v = vec![&t.beauty, &t.view_depth, &t.sample_ids];
     v.extend(t.components.iter());
+    if extras.fragments {
+        v.extend([&t.kbuffer.fragments, &t.kbuffer.pixel_info]);
+    }
     if extras.background {
         v.push(&t.background);
     }
@@ -1361,6 +1437,10 @@ fn frame_from_bytes(
             .map(|p| [p[0] * scale, p[1] * scale, p[2] * scale])
             .collect()
     };
+    let mut rest = bytes[3 + COMPONENTS.len()..].iter();
+    let mut next = |wanted: bool| rest.next().filter(|_| wanted);
+    let (fragments, pixel_fragments) = (next(extras.fragments), next(extras.fragments));
+    let (background, occluder) = (next(extras.background), next(extras.occluder));
     Frame {
         width,
         height,
@@ -1368,22 +1448,18 @@ fn frame_from_bytes(
         beauty: bytemuck::pod_collect_to_vec(&bytes[0]),
         depth: bytemuck::pod_collect_to_vec(&bytes[1]),
         sample_ids: bytemuck::pod_collect_to_vec(&bytes[2]),
-        fragments: bytemuck::pod_collect_to_vec(&bytes[3]),
-        fragments_per_pixel: k,
-        pixel_fragments: bytemuck::pod_collect_to_vec(&bytes[4]),
-        components: bytes[5..5 + COMPONENTS.len()].iter().map(rgb).collect(),
+        fragments: fragments.map_or_else(Vec::new, |b| bytemuck::pod_collect_to_vec(b)),
+        fragments_per_pixel: if extras.fragments { k } else { 0 },
+        pixel_fragments: pixel_fragments.map_or_else(Vec::new, |b| bytemuck::pod_collect_to_vec(b)),
+        components: bytes[3..3 + COMPONENTS.len()].iter().map(rgb).collect(),
         // Exposed by the resolve already.
-        background: match extras.background {
-            true => bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes[5 + COMPONENTS.len()])
+        background: background.map_or_else(Vec::new, |b| {
+            bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b)
                 .into_iter()
                 .map(|p| [p[0], p[1], p[2]])
-                .collect(),
-            false => Vec::new(),
-        },
-        occluder: match extras.occluder {
-            true => rgb(&bytes[5 + COMPONENTS.len() + extras.background as usize]),
-            false => Vec::new(),
-        },
+                .collect()
+        }),
+        occluder: occluder.map_or_else(Vec::new, rgb),
     }
 }
 

@@ -181,8 +181,7 @@ pub fn is_hair(id: u32) -> bool {
     id != 0 && id & super::occluder::OCCLUDER_ID_BIT == 0
 }
 
-/// Which of a pixel's K-buffer fragments are shaded, as (segment + 1, weight): every kept fragment
-/// with its weight (the frame), or the front one for all of the hair (the preview).
+/// Which of a pixel's K-buffer fragments are shaded, as (segment + 1, weight).
 pub type FragmentChoice = fn(&[Fragment], &PixelFragments) -> Vec<(u32, f64)>;
 
 /// The frame's choice: every kept fragment with its composite weight (twin of a slot's dispatch).
@@ -193,29 +192,6 @@ pub const EVERY_FRAGMENT: FragmentChoice = |slots, _| {
         .map(|f| (f.id, f.weight as f64))
         .collect()
 };
-
-/// The preview's choice (twin of the WGSL's `SLOT_REPRESENTATIVE` branch): the fragment at which the
-/// weights reach half the pixel's hair alpha, with all of that alpha.
-pub fn representative_fragment(slots: &[Fragment], pixel: &PixelFragments) -> Vec<(u32, f64)> {
-    let w = pixel.alpha;
-    let mut chosen = slots.first().copied().unwrap_or_default();
-    let mut reached = 0.0f32;
-    for g in slots.iter().take_while(|g| g.id != 0) {
-        chosen = *g;
-        reached += g.weight;
-        if reached >= 0.5 * w {
-            break;
-        }
-    }
-    match chosen.id {
-        0 => Vec::new(),
-        _ if w > 0.0 => vec![(chosen.id, w as f64)],
-        _ => Vec::new(),
-    }
-}
-
-/// The preview's choice: [`representative_fragment`].
-pub const REPRESENTATIVE: FragmentChoice = representative_fragment;
 
 /// The pixel loop of the CPU shading passes (rayon over the given pixels): for each pixel, `fold` is
 /// called on a fresh `init()` for every kept fragment of its K-buffer, with the pixel index, the
@@ -267,8 +243,8 @@ pub fn fold_chosen_points<T: Send>(
 }
 
 /// The pixel loop of the shading pass on the CPU: for each pixel of `pixels`, the weighted sum of
-/// `shade` over the fragments `choose` picks ([`EVERY_FRAGMENT`] for the frame, [`REPRESENTATIVE`]
-/// for the preview), the radiance per lobe (before exposure).
+/// `shade` over the fragments `choose` picks ([`EVERY_FRAGMENT`] for the frame and the preview), the
+/// radiance per lobe (before exposure).
 pub fn shade_pixels(
     frame: &Frame,
     camera: &CameraUniform,

@@ -12,9 +12,6 @@ use bytemuck::{Pod, Zeroable};
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
-/// [`ShadeBatch::slot`] of the preview's dispatches: each pixel shades its front fragment for all of
-/// its hair ([`super::shade::representative_fragment`]) instead of one K-buffer slot.
-pub const SLOT_REPRESENTATIVE: u32 = u32::MAX;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
@@ -35,13 +32,13 @@ pub struct ShadeBatch {
     pub flags: u32,
     /// Fragments per pixel in the K-buffer.
     pub slots: u32,
-    /// The K-buffer slot this dispatch shades (one dispatch per slot and batch), or
-    /// [`SLOT_REPRESENTATIVE`].
+    /// The K-buffer slot this dispatch shades (one dispatch per slot and batch).
     pub slot: u32,
     /// Rows [row0, row0 + rows) of the image.
     pub row0: u32,
     pub rows: u32,
-    pub _pad: u32,
+    /// Lights in all the batches (the shaded weight counts each batch's share of them).
+    pub lights: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
@@ -143,11 +140,7 @@ impl ShadingPass {
             inputs.dual_tables,
         ];
         let buffers: Vec<&wgpu::Buffer> = buffers.into_iter().chain(&targets.components).collect();
-        let more = [
-            &targets.kbuffer.fragments,
-            inputs.azimuthal_table,
-            &targets.kbuffer.pixel_info,
-        ];
+        let more = [&targets.kbuffer.fragments, inputs.azimuthal_table];
         let extra = more
             .iter()
             .enumerate()

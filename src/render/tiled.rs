@@ -95,7 +95,7 @@ pub fn render_tiled(
     for t in Tile::cover(width, height, tile) {
         renderer.set_camera_tile(ctx, camera, t)?;
         renderer.render_frame(ctx);
-        let part = renderer.read_frame(ctx)?;
+        let part = renderer.read_image(ctx)?;
         let f = full
             .get_or_insert_with(|| empty_frame(width, height, part.samples, part.components.len()));
         paste(f, &t, &part);

@@ -53,7 +53,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
                     if !times.is_empty() {
                         ui.weak(times.join(" · ")).on_hover_text(
                             "Since the last change: the reduced-resolution preview, and the full \
-                             image with every light at the first sample",
+                             image with every light at the front fragment of each pixel",
                         );
                     }
                 }
