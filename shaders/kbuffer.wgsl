@@ -298,6 +298,8 @@ fn composite(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = id.y * camera.size.x + id.x;
     let base = p * kinfo.k;
     var t = 1.0;
+    // The kept weights' sum, 1 - t (summed: 1 - t loses its digits when the opacities are small).
+    var kept_alpha = 0.0;
     var n = 0u;
     var kept = 0u;
     var nearest = 1e10;
@@ -312,6 +314,7 @@ fn composite(@builtin(global_invocation_id) id: vec3<u32>) {
         let a = min(pixel_coverage(ribbon_quad(seg), pixel) * occluder_cover(pixel, depth).x, 1.0);
         kept = kept + optical_depth(a);
         fragments[base + i] = vec2<u32>(seg + 1u, bitcast<u32>(t * a));
+        kept_alpha = kept_alpha + t * a;
         t = t * (1.0 - a);
         n = i + 1u;
     }
@@ -324,12 +327,12 @@ fn composite(@builtin(global_invocation_id) id: vec3<u32>) {
         // ones in proportion to their weights (with their mean radiance).
         let rest = select(0u, s.x - kept, s.x > kept);
         let behind = exp(-f32(rest) / OPTICAL_DEPTH_SCALE);
-        // (Spread over kept fragments too faint to move t, the tail goes to the last one instead.)
-        if (kinfo.tail == TAIL_FOLD || t >= 1.0) {
+        // (Kept fragments of no weight at all: the tail goes to the last one instead.)
+        if (kinfo.tail == TAIL_FOLD || kept_alpha <= 0.0) {
             let last = base + n - 1u;
             fragments[last].y = bitcast<u32>(bitcast<f32>(fragments[last].y) + t * (1.0 - behind));
-        } else if (t < 1.0) {
-            let scale = 1.0 + t * (1.0 - behind) / (1.0 - t);
+        } else {
+            let scale = 1.0 + t * (1.0 - behind) / kept_alpha;
             for (var i = 0u; i < n; i++) {
                 fragments[base + i].y = bitcast<u32>(scale * bitcast<f32>(fragments[base + i].y));
             }

@@ -200,9 +200,15 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
     println!("AOVs with the occluder against the beauty: worst {sum_worst:.2e}");
     assert!(sum_worst < 1e-4, "{sum_worst}");
     // The head hides the hair behind it: where every sample of a pixel shows the head, no kept
-    // fragment lies behind the head's surface on the pixel's centre ray (a CPU ray cast at the mesh),
-    // beyond the spread of the head's depth across the pixel; and the head is seen through the hair
-    // in front of it by the transmittance of those fragments.
+    // fragment lies behind the head's surface at all four of the pixel's sample positions (CPU ray
+    // casts at the mesh; a fragment is kept where some sample is behind it); and the head is seen
+    // through the hair in front of it by the transmittance of those fragments.
+    const SAMPLES_4: [[f32; 2]; 4] = [
+        [0.375, 0.125],
+        [0.875, 0.375],
+        [0.125, 0.625],
+        [0.625, 0.875],
+    ];
     let forward = Vec3::from(camera.forward);
     let segments = strandlight::render::shade::segment_starts(&s.hair);
     let (mut checked, mut behind, mut seen_through) = (0, 0, 0f32);
@@ -215,19 +221,28 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
             continue;
         }
         let (x, y) = ((i % 96) as u32, (i / 96) as u32);
-        let (origin, dir) =
-            strandlight::render::camera::pixel_ray(&camera, x as f32 + 0.5, y as f32 + 0.5);
-        let Some((t, _, _)) = s.occluder.mesh.intersect(origin, dir, 0.0) else {
+        let head_at = |sx: f32, sy: f32| {
+            let (o, d) =
+                strandlight::render::camera::pixel_ray(&camera, x as f32 + sx, y as f32 + sy);
+            s.occluder
+                .mesh
+                .intersect(o, d, 0.0)
+                .map(|(t, _, _)| t * d.dot(forward))
+        };
+        let Some(head) = head_at(0.5, 0.5) else {
             continue;
         };
-        let head = t * dir.dot(forward);
+        let deepest = SAMPLES_4
+            .iter()
+            .filter_map(|p| head_at(p[0], p[1]))
+            .fold(head, f32::max);
         let mut front = 0u32;
         for f in frame.kept_fragments(i) {
             let i0 = segments[f.id as usize - 1] as usize;
             let (a, b) = (s.hair.positions[i0], s.hair.positions[i0 + 1]);
             let depth = strandlight::render::kbuffer::fragment_depth(&camera, a, b, x, y);
             checked += 1;
-            behind += (depth > head + 0.2) as usize;
+            behind += (depth > deepest + 0.02) as usize;
             front += (depth < head) as u32;
         }
         // With no hair in front the head shows whole (up to fragments between the head's samples

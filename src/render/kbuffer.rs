@@ -319,6 +319,7 @@ pub fn abuffer(c: &CameraUniform, points: &[[f32; 4]], segments: &[u32]) -> ABuf
 pub fn composite(list: &[RawFragment], k: usize, tail: Tail) -> (Vec<Fragment>, PixelFragments) {
     let mut slots = vec![Fragment::default(); k];
     let mut t = 1.0f32;
+    let mut kept_alpha = 0.0f32;
     let mut kept = 0u32;
     let n = list.len().min(k);
     for (slot, f) in slots.iter_mut().zip(&list[..n]) {
@@ -328,15 +329,16 @@ pub fn composite(list: &[RawFragment], k: usize, tail: Tail) -> (Vec<Fragment>, 
             id: f.segment + 1,
             weight: t * a,
         };
+        kept_alpha += t * a;
         t *= 1.0 - a;
     }
     let all: u32 = list.iter().map(|f| optical_depth(f.opacity)).sum();
     if tail != Tail::Drop && n == k && k > 0 {
         let behind = (-(all.saturating_sub(kept) as f32) / OPTICAL_DEPTH_SCALE).exp();
-        if tail == Tail::Fold || t >= 1.0 {
+        if tail == Tail::Fold || kept_alpha <= 0.0 {
             slots[n - 1].weight += t * (1.0 - behind);
-        } else if t < 1.0 {
-            let scale = 1.0 + t * (1.0 - behind) / (1.0 - t);
+        } else {
+            let scale = 1.0 + t * (1.0 - behind) / kept_alpha;
             for f in &mut slots[..n] {
                 f.weight *= scale;
             }

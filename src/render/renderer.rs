@@ -1438,7 +1438,7 @@ fn frame_from_bytes(
             .collect()
     };
     let mut rest = bytes[3 + COMPONENTS.len()..].iter();
-    let mut next = |wanted: bool| rest.next().filter(|_| wanted);
+    let mut next = |wanted: bool| if wanted { rest.next() } else { None };
     let (fragments, pixel_fragments) = (next(extras.fragments), next(extras.fragments));
     let (background, occluder) = (next(extras.background), next(extras.occluder));
     Frame {
