@@ -530,21 +530,12 @@ impl KBufferPass {
             return;
         }
         let info = kb.info(device, occluder);
+        let mut entries = inputs(camera, hair, &info, occluder_depth);
+        entries.extend([entry(5, &kb.keys), entry(6, &kb.sums)]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer raster"),
             layout: &self.raster.get_bind_group_layout(0),
-            entries: &[
-                entry(0, camera),
-                entry(1, &hair.points),
-                entry(2, &hair.segments),
-                entry(3, &info),
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(occluder_depth),
-                },
-                entry(5, &kb.keys),
-                entry(6, &kb.sums),
-            ],
+            entries: &entries,
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("k-buffer raster"),
@@ -580,23 +571,17 @@ impl KBufferPass {
         size: (u32, u32),
     ) {
         let info = kb.info(device, occluder);
+        let mut entries = inputs(camera, hair, &info, occluder_depth);
+        entries.extend([
+            entry(7, &kb.keys),
+            entry(8, &kb.sums),
+            entry(9, &kb.fragments),
+            entry(10, &kb.pixel_info),
+        ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer composite"),
             layout: &self.composite.get_bind_group_layout(0),
-            entries: &[
-                entry(0, camera),
-                entry(1, &hair.points),
-                entry(2, &hair.segments),
-                entry(3, &info),
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(occluder_depth),
-                },
-                entry(7, &kb.keys),
-                entry(8, &kb.sums),
-                entry(9, &kb.fragments),
-                entry(10, &kb.pixel_info),
-            ],
+            entries: &entries,
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("k-buffer composite"),
@@ -606,6 +591,25 @@ impl KBufferPass {
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
+}
+
+/// The bindings both passes read: the camera, the hair, the parameters and the head's depth.
+fn inputs<'a>(
+    camera: &'a wgpu::Buffer,
+    hair: &'a GpuHair,
+    info: &'a wgpu::Buffer,
+    occluder_depth: &'a wgpu::TextureView,
+) -> Vec<wgpu::BindGroupEntry<'a>> {
+    vec![
+        entry(0, camera),
+        entry(1, &hair.points),
+        entry(2, &hair.segments),
+        entry(3, info),
+        wgpu::BindGroupEntry {
+            binding: 4,
+            resource: wgpu::BindingResource::TextureView(occluder_depth),
+        },
+    ]
 }
 
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {

@@ -1087,7 +1087,7 @@ impl Renderer {
                 ShadingPass::clear(enc, &self.targets);
                 self.shading_partial = true;
                 self.converged_rows = 0;
-                self.encode_resolve(device, enc, 0..self.settings.height, true);
+                self.encode_resolve(device, enc, 0..self.settings.height, (true, true));
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
@@ -1105,17 +1105,7 @@ impl Renderer {
                         self.shading_partial = false;
                     }
                 }
-                self.resolve_pass.encode(
-                    device,
-                    enc,
-                    &self.camera,
-                    &self.resolve_info,
-                    &self.background_map,
-                    &self.targets,
-                    row0..row0 + rows,
-                    (false, !last),
-                    None,
-                );
+                self.encode_resolve(device, enc, row0..row0 + rows, (false, !last));
             }
         }
     }
@@ -1125,7 +1115,7 @@ impl Renderer {
         device: &wgpu::Device,
         enc: &mut wgpu::CommandEncoder,
         rows: std::ops::Range<u32>,
-        background: bool,
+        (background, normalise): (bool, bool),
     ) {
         self.resolve_pass.encode(
             device,
@@ -1135,7 +1125,7 @@ impl Renderer {
             &self.background_map,
             &self.targets,
             rows,
-            (background, self.shading_partial),
+            (background, normalise),
             None,
         );
     }
