@@ -319,6 +319,12 @@ pub fn compute_pipeline(
 /// A buffer holding `contents`, as `DeviceExt::create_buffer_init` makes it, except that a lost
 /// device does not panic: wgpu's helper unwraps the mapping, which fails once the device is gone, and
 /// the frame loop makes small buffers per unit (a lost device must reach the editor as an error).
+/// The largest storage buffer the device binds (the binding's limit or the buffer's, the smaller).
+pub fn binding_limit(device: &wgpu::Device) -> u64 {
+    let l = device.limits();
+    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
+}
+
 pub fn buffer_init(
     device: &wgpu::Device,
     label: &str,

@@ -381,6 +381,9 @@ impl ABuffer {
 /// The K-buffer's GPU buffers, per frame target.
 pub struct KBufferTargets {
     pub k: u32,
+    /// The image's size (the composite's dispatch).
+    pub width: u32,
+    pub height: u32,
     /// Per pixel, k inverted keys (u64).
     pub keys: wgpu::Buffer,
     /// Per pixel, four u32 sums.
@@ -426,6 +429,8 @@ impl KBufferTargets {
             .create_view(&Default::default());
         Self {
             k,
+            width,
+            height,
             keys: buffer("k-buffer keys", 8 * k as u64),
             sums: buffer("k-buffer sums", 16),
             fragments: buffer("k-buffer fragments", 8 * k as u64),
@@ -506,10 +511,11 @@ impl KBufferPass {
         }
     }
 
-    /// Draws segments `range` into the K-buffer (clearing it first when `clear`); `occluder_depth` is
-    /// the occluder's multisampled depth and whether an occluder was drawn into it.
+    /// Draws segments `range` into the K-buffer (clearing it first when `clear`), and composites it
+    /// when the range reaches the last segment; `occluder_depth` is the occluder's multisampled depth
+    /// and whether an occluder was drawn into it. The order segments arrive in does not matter.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode_raster(
+    pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -525,17 +531,47 @@ impl KBufferPass {
             encoder.clear_buffer(&kb.keys, 0, None);
             encoder.clear_buffer(&kb.sums, 0, None);
         }
-        let end = range.end.min(hair.segment_count);
-        if end <= range.start {
-            return;
-        }
         let info = kb.info(device, occluder);
-        let mut entries = inputs(camera, hair, &info, occluder_depth);
-        entries.extend([entry(5, &kb.keys), entry(6, &kb.sums)]);
+        let shared = inputs(camera, hair, &info, occluder_depth);
+        let end = range.end.min(hair.segment_count);
+        if end > range.start {
+            let mut entries = shared.clone();
+            entries.extend([entry(5, &kb.keys), entry(6, &kb.sums)]);
+            self.encode_raster(
+                device,
+                encoder,
+                &entries,
+                kb,
+                6 * range.start..6 * end,
+                timestamps,
+            );
+        }
+        if range.end >= hair.segment_count {
+            let mut entries = shared;
+            entries.extend([
+                entry(7, &kb.keys),
+                entry(8, &kb.sums),
+                entry(9, &kb.fragments),
+                entry(10, &kb.pixel_info),
+            ]);
+            self.encode_composite(device, encoder, &entries, kb);
+        }
+    }
+
+    /// The raster pass over `vertices` (six a segment).
+    fn encode_raster(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        entries: &[wgpu::BindGroupEntry],
+        kb: &KBufferTargets,
+        vertices: std::ops::Range<u32>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites>,
+    ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer raster"),
             layout: &self.raster.get_bind_group_layout(0),
-            entries: &entries,
+            entries,
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("k-buffer raster"),
@@ -555,33 +591,21 @@ impl KBufferPass {
         });
         pass.set_pipeline(&self.raster);
         pass.set_bind_group(0, &bind, &[]);
-        pass.draw(6 * range.start..6 * end, 0..1);
+        pass.draw(vertices, 0..1);
     }
 
-    /// The composite of every pixel (after the last segment was drawn).
-    #[allow(clippy::too_many_arguments)]
-    pub fn encode_composite(
+    /// The composite of every pixel.
+    fn encode_composite(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        camera: &wgpu::Buffer,
-        hair: &GpuHair,
-        (occluder_depth, occluder): (&wgpu::TextureView, bool),
+        entries: &[wgpu::BindGroupEntry],
         kb: &KBufferTargets,
-        size: (u32, u32),
     ) {
-        let info = kb.info(device, occluder);
-        let mut entries = inputs(camera, hair, &info, occluder_depth);
-        entries.extend([
-            entry(7, &kb.keys),
-            entry(8, &kb.sums),
-            entry(9, &kb.fragments),
-            entry(10, &kb.pixel_info),
-        ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer composite"),
             layout: &self.composite.get_bind_group_layout(0),
-            entries: &entries,
+            entries,
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("k-buffer composite"),
@@ -589,7 +613,7 @@ impl KBufferPass {
         });
         pass.set_pipeline(&self.composite);
         pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        pass.dispatch_workgroups(kb.width.div_ceil(8), kb.height.div_ceil(8), 1);
     }
 }
 

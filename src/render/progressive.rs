@@ -1085,7 +1085,6 @@ impl Renderer {
                 // The last part: the image's visibility is whole; the components restart.
                 self.visibility_valid = true;
                 ShadingPass::clear(enc, &self.targets);
-                self.shading_partial = true;
                 self.converged_rows = 0;
                 self.encode_resolve(device, enc, 0..self.settings.height, (true, true));
             }
@@ -1101,9 +1100,6 @@ impl Renderer {
                 let last = batch + 1 >= self.shading_pass.frame_batches().count() as u32;
                 if last {
                     self.converged_rows = self.converged_rows.max(row0 + rows);
-                    if row0 + rows >= self.settings.height {
-                        self.shading_partial = false;
-                    }
                 }
                 self.encode_resolve(device, enc, row0..row0 + rows, (false, !last));
             }

@@ -20,6 +20,7 @@ use super::timing::PassTimer;
 use super::visibility::VisibilityPass;
 use crate::envmap::SrbfLight;
 use crate::gpu::GpuContext;
+use crate::gpu::context::binding_limit;
 use crate::gpu::density_pyramid::{DensityPyramidPass, GpuDensityPyramid};
 use crate::gpu::dual_eval::dual_tables_texels;
 use crate::gpu::fast_eval::GpuLuts;
@@ -272,9 +273,8 @@ pub struct Renderer {
     /// fit one binding at this size).
     pub(super) requested_fragments: u32,
     pub(super) volume_dirty: bool,
-    /// Progressive refinement has shaded part of the K-buffer's fragments (resolves normalise), and
-    /// the rows [0, converged_rows) the last batch has finished (they do not).
-    pub(super) shading_partial: bool,
+    /// The rows [0, converged_rows) whose every fragment is shaded (the others, part-way through
+    /// progressive refinement, resolve normalised); u32::MAX after `render_frame`.
     pub(super) converged_rows: u32,
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
@@ -313,12 +313,6 @@ fn environment_buffer(device: &wgpu::Device, map: Option<&BackgroundMap>) -> wgp
         contents: bytemuck::cast_slice(texels),
         usage: wgpu::BufferUsages::STORAGE,
     })
-}
-
-/// The largest storage buffer the device binds.
-fn binding_limit(device: &wgpu::Device) -> u64 {
-    let l = device.limits();
-    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -526,8 +520,7 @@ impl Renderer {
             resolve_pass: ResolvePass::new(device),
             volume_dirty: true,
             requested_fragments,
-            shading_partial: false,
-            converged_rows: 0,
+            converged_rows: u32::MAX,
             volume_stale: false,
             volume_absorption_old: false,
             shadow_grid_dirty: true,
@@ -1087,11 +1080,7 @@ impl Renderer {
         // Rows the last shading batch has finished resolve as render_frame's; the others normalised
         // while refinement runs.
         let height = self.settings.height;
-        let done = if self.shading_partial {
-            self.converged_rows.min(height)
-        } else {
-            height
-        };
+        let done = self.converged_rows.min(height);
         for (rows, normalise) in [(0..done, false), (done..height, true)] {
             if rows.is_empty() {
                 continue;
@@ -1253,7 +1242,7 @@ impl Renderer {
             timer.and_then(|t| t.compute_writes("resolve")),
         );
         self.visibility_valid = true;
-        self.shading_partial = false;
+        self.converged_rows = u32::MAX;
         self.last_ran.extend(["visibility", "shading", "resolve"]);
         if let Some(t) = timer {
             t.resolve(&mut enc);

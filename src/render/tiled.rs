@@ -8,6 +8,7 @@ use super::frame::Frame;
 use super::kbuffer::KBufferTargets;
 use super::renderer::{RenderError, Renderer};
 use crate::gpu::GpuContext;
+use crate::gpu::context::binding_limit;
 
 /// Tiles of at most this many pixels a side by default (16 MiB per RGBA float buffer).
 pub const DEFAULT_TILE: u32 = 1024;
@@ -15,20 +16,16 @@ pub const DEFAULT_TILE: u32 = 1024;
 /// Whether a width x height image with `fragments` K-buffer slots exceeds what the device binds or rasterises at once (then it is
 /// rendered in tiles).
 pub fn needs_tiles(ctx: &GpuContext, width: u32, height: u32, fragments: u32) -> bool {
-    let l = ctx.device.limits();
-    let bytes = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
     let per_pixel = KBufferTargets::bytes_per_pixel(fragments).max(16);
-    width as u64 * height as u64 * per_pixel > bytes
-        || width.max(height) > l.max_texture_dimension_2d
+    width as u64 * height as u64 * per_pixel > binding_limit(&ctx.device)
+        || width.max(height) > ctx.device.limits().max_texture_dimension_2d
 }
 
 /// The side of the tiles a still with `fragments` K-buffer slots is rendered in: [`DEFAULT_TILE`], or
 /// less where a tile's K-buffer would not fit one binding.
 pub fn tile_side(ctx: &GpuContext, fragments: u32) -> u32 {
-    let l = ctx.device.limits();
-    let bytes = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
     let per_pixel = KBufferTargets::bytes_per_pixel(fragments).max(16);
-    let side = ((bytes / per_pixel) as f64).sqrt() as u32;
+    let side = ((binding_limit(&ctx.device) / per_pixel) as f64).sqrt() as u32;
     DEFAULT_TILE.min(side / 16 * 16).max(16)
 }
 

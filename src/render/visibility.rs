@@ -95,28 +95,17 @@ impl VisibilityPass {
         if clear {
             self.encode_occluder(device, encoder, camera, occluder, targets);
         }
-        self.kbuffer.encode_raster(
+        self.kbuffer.encode(
             device,
             encoder,
             camera,
             hair,
             (&targets.depth, occluder.is_some()),
             &targets.kbuffer,
-            range.clone(),
+            range,
             clear,
             timestamps,
         );
-        if range.end >= hair.segment_count {
-            self.kbuffer.encode_composite(
-                device,
-                encoder,
-                camera,
-                hair,
-                (&targets.depth, occluder.is_some()),
-                &targets.kbuffer,
-                (targets.width, targets.height),
-            );
-        }
     }
 
     /// Clears the id and depth targets and draws the occluder's triangles (when there is one).
