@@ -105,57 +105,55 @@ fn ribbon_quad(seg: u32) -> RibbonQuad {
     return q;
 }
 
-// A convex polygon of at most 8 vertices (the quad clipped by the pixel's four sides).
-struct Polygon {
-    v: array<vec2<f32>, 8>,
-    n: u32,
-}
-
-// Sutherland-Hodgman: the part of `poly` where dot(p, nrm) <= off.
-fn clip_half_plane(poly: Polygon, nrm: vec2<f32>, off: f32) -> Polygon {
-    var out: Polygon;
-    out.n = 0u;
-    for (var i = 0u; i < poly.n; i++) {
-        let a = poly.v[i];
-        let b = poly.v[(i + 1u) % poly.n];
-        let da = dot(a, nrm) - off;
-        let db = dot(b, nrm) - off;
-        if (da <= 0.0 && out.n < 8u) {
-            out.v[out.n] = a;
-            out.n = out.n + 1u;
-        }
-        if (((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) && out.n < 8u) {
-            out.v[out.n] = a + (b - a) * (da / (da - db));
-            out.n = out.n + 1u;
-        }
+// The mean over t in [0, 1] of clamp(y0 + t (y1 - y0), 0, 1): the share of the run above 1, plus
+// the share inside (0, 1) times its mean (ratios of differences: exact as y1 - y0 goes to zero).
+fn clamped_mean(y0: f32, y1: f32) -> f32 {
+    let lo = min(y0, y1);
+    let hi = max(y0, y1);
+    let dy = hi - lo;
+    if (dy <= 1e-20) {
+        return clamp(lo, 0.0, 1.0);
     }
-    return out;
+    let a = max(lo, 0.0);
+    let b = min(hi, 1.0);
+    let inside = max(b - a, 0.0);
+    return clamp((hi - 1.0) / dy, 0.0, 1.0) + inside / dy * 0.5 * (a + b);
 }
 
-// The area of the ribbon inside pixel (x, y) (the square [x, x + 1] x [y, y + 1]), in [0, 1].
+// Edge a -> b's term of the area inside the unit square by Green's theorem: the integral of
+// clamp(y, 0, 1) dx along the edge over x in [0, 1] (the boundary integral of the polygon's part
+// inside the square's slab of x, cut at its bottom and top).
+fn edge_area(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    let dx = b.x - a.x;
+    let lo = max(min(a.x, b.x), 0.0);
+    let hi = min(max(a.x, b.x), 1.0);
+    if (abs(dx) <= 1e-20 || hi <= lo) {
+        return 0.0;
+    }
+    let ylo = a.y + (lo - a.x) / dx * (b.y - a.y);
+    let yhi = a.y + (hi - a.x) / dx * (b.y - a.y);
+    return sign(dx) * (hi - lo) * clamped_mean(ylo, yhi);
+}
+
+// Coverage below this is the edges' terms' rounding (each term is at most 1, good to ~1e-7): a
+// ribbon passing by the pixel, which must leave no fragment (twin: kbuffer.rs).
+const MIN_COVERAGE: f32 = 1e-6;
+
+// The area of the ribbon inside pixel (x, y) (the square [x, x + 1] x [y, y + 1]), in [0, 1]: the
+// quad's four edges' terms (Green's theorem; no clipped polygon, whose arrays lavapipe keeps in
+// memory); 0 below MIN_COVERAGE.
 fn pixel_coverage(q: RibbonQuad, pixel: vec2<u32>) -> f32 {
     if (!q.valid) {
         return 0.0;
     }
-    // Corners relative to the pixel's corner (small numbers: the clipping keeps its precision).
+    // Corners relative to the pixel's corner (small numbers: the terms keep their precision).
     let o = vec2<f32>(pixel);
-    var poly: Polygon;
-    poly.n = 4u;
-    poly.v[0] = q.p0 - o - q.half_width.x * q.normal;
-    poly.v[1] = q.p1 - o - q.half_width.y * q.normal;
-    poly.v[2] = q.p1 - o + q.half_width.y * q.normal;
-    poly.v[3] = q.p0 - o + q.half_width.x * q.normal;
-    poly = clip_half_plane(poly, vec2<f32>(-1.0, 0.0), 0.0);
-    poly = clip_half_plane(poly, vec2<f32>(1.0, 0.0), 1.0);
-    poly = clip_half_plane(poly, vec2<f32>(0.0, -1.0), 0.0);
-    poly = clip_half_plane(poly, vec2<f32>(0.0, 1.0), 1.0);
-    var twice = 0.0;
-    for (var i = 0u; i < poly.n; i++) {
-        let a = poly.v[i];
-        let b = poly.v[(i + 1u) % poly.n];
-        twice = twice + (a.x * b.y - a.y * b.x);
-    }
-    return clamp(0.5 * abs(twice), 0.0, 1.0);
+    let v0 = q.p0 - o - q.half_width.x * q.normal;
+    let v1 = q.p1 - o - q.half_width.y * q.normal;
+    let v2 = q.p1 - o + q.half_width.y * q.normal;
+    let v3 = q.p0 - o + q.half_width.x * q.normal;
+    let area = abs(edge_area(v0, v1) + edge_area(v1, v2) + edge_area(v2, v3) + edge_area(v3, v0));
+    return select(0.0, min(area, 1.0), area >= MIN_COVERAGE);
 }
 
 // The view depth of segment `seg`'s point closest to the ray through pixel `pixel`'s centre (the

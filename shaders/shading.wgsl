@@ -1,8 +1,9 @@
-// Shading pass (Xu 2011 Sec. 5): for every pixel, the hair fragments of its K-buffer are shaded
-// under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT), each light
+// Shading pass (Xu 2011 Sec. 5): hair points are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT), each light
 // scaled by its transmittance (swept through the fiber-density pyramid at the points of the shadow
 // grid, read trilinearly), and accumulated per lobe weighted by the fragments' composite weights
-// (kbuffer.wgsl). Twin of src/render/shade.rs (shade_point).
+// (kbuffer.wgsl): per fragment (`shade`: the preview, and the frame with per-fragment shading) or per
+// visible segment (`claim_segments` .. `gather_segments` below: the frame). Twin of
+// src/render/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
 // the grid) to MS.global and MS.local.
@@ -14,7 +15,7 @@ const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<uniform> params: FastHairParams;
-@group(0) @binding(2) var<uniform> batch: ShadeBatch;
+@group(0) @binding(2) var<storage, read> batch: ShadeBatch;
 @group(0) @binding(3) var<uniform> shadow_grid: ShadowGridInfo;
 @group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> segments: array<u32>;
@@ -32,6 +33,16 @@ const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
 @group(0) @binding(18) var<storage, read> fragments: array<vec2<u32>>;
 @group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
+// Segment shading (the frame's: see `claim_segments`).
+@group(0) @binding(20) var<storage, read_write> segment_batches: array<atomic<u32>>;
+@group(0) @binding(21) var<storage, read_write> work_count: array<atomic<u32>>;
+@group(0) @binding(22) var<storage, read_write> work_list: array<u32>;
+@group(0) @binding(23) var<storage, read_write> work_args: array<u32>;
+@group(0) @binding(24) var<storage, read_write> segment_r: array<vec4<f32>>;
+@group(0) @binding(25) var<storage, read_write> segment_tt: array<vec4<f32>>;
+@group(0) @binding(26) var<storage, read_write> segment_trt: array<vec4<f32>>;
+@group(0) @binding(27) var<storage, read_write> segment_ms_global: array<vec4<f32>>;
+@group(0) @binding(28) var<storage, read_write> segment_ms_local: array<vec4<f32>>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -57,8 +68,9 @@ struct LobeRadiance {
     ms_local: vec3<f32>,
 }
 
-// Radiance towards omega_o from lights [first, first + count) at one shading point, per component.
-fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool, multiple: bool) -> LobeRadiance {
+// Radiance towards omega_o from lights [first, first + count) at one shading point, per component:
+// with `single` R, TT and TRT, with `multiple` MS.global and MS.local.
+fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool, single: bool, multiple: bool) -> LobeRadiance {
     var p = params;
     p.sigma_a = vec4<f32>(sp.sigma_a, 0.0);
     let frame = fiber_frame(sp.tangent);
@@ -73,9 +85,11 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
         let k = sh.transmittance * l.rgb;
-        out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
-        out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
-        out.trt = out.trt + k * srbf_response_lobe(p, 2u, light, o.x, o.y);
+        if (single) {
+            out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
+            out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
+            out.trt = out.trt + k * srbf_response_lobe(p, 2u, light, o.x, o.y);
+        }
         if (multiple) {
             // One spread for the three channels: their mean sigma_f^2.
             let s2 = (sh.sigma_f2.x + sh.sigma_f2.y + sh.sigma_f2.z) / 3.0;
@@ -124,7 +138,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let v = f.x;
     let ray = pixel_ray(camera, f32(xy.x) + 0.5, f32(xy.y) + 0.5);
     let sp = shading_point(v - 1u, ray);
-    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
+    let l = shade_point(sp, -ray.dir, batch.first, batch.count, (batch.flags & FLAG_SHADOWS) != 0u, true, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
     // .w of R: the weight shaded so far, each batch adding its share of the lights (the resolve
     // scales a partly shaded image by the pixel's hair alpha over it while refinement runs).
     let share = f32(batch.count) / f32(max(batch.lights, 1u));
@@ -133,4 +147,138 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     aov_trt[pixel] = aov_trt[pixel] + vec4<f32>(w * l.trt, 0.0);
     aov_ms_global[pixel] = aov_ms_global[pixel] + vec4<f32>(w * l.ms_global, 0.0);
     aov_ms_local[pixel] = aov_ms_local[pixel] + vec4<f32>(w * l.ms_local, 0.0);
+}
+
+// Segment shading (the frame's; twin: src/render/shade.rs, `shade_pixels_by_segment`). A segment's
+// shading point moves along it from pixel to pixel, but its tangent, the lights and (nearly) the view
+// direction do not: each visible segment is shaded once per light batch, single scattering at its two
+// ends (each end's position, absorption and direction to the eye) and multiple scattering, which
+// varies slowly (spread over sigma_f and read from the coarse shadow grid), once at its midpoint; every
+// fragment takes the single scattering between the ends at its own point (`between_ends`) and the
+// segment's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that cover ~8 pixels
+// each (S1), so this shades ~4x fewer points than one per fragment, and multiple scattering (half a
+// light's cost) at half of those.
+
+// The point of segment `seg` at t (0: its first point, 1: its second; absorption linear along it).
+fn segment_point(seg: u32, t: f32) -> ShadingPoint {
+    let i0 = segments[seg];
+    let a = points[i0].xyz;
+    let b = points[i0 + 1u].xyz;
+    return ShadingPoint(mix(a, b, t), b - a, mix(absorption[i0].xyz, absorption[i0 + 1u].xyz, t));
+}
+
+// Lists the segments of the batch's rows' kept fragments that this light batch has not shaded: a
+// segment's `segment_batches` entry holds 1 + the first light of the last batch that claimed it (0:
+// none; light batches run in order, so one claim per segment and batch wins).
+@compute @workgroup_size(8, 8)
+fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
+    let y = batch.row0 + id.y;
+    if (id.x >= camera.size.x || id.y >= batch.rows || y >= camera.size.y) {
+        return;
+    }
+    let pixel = y * camera.size.x + id.x;
+    for (var s = 0u; s < batch.slots; s++) {
+        let f = fragments[pixel * batch.slots + s];
+        if (f.x == 0u) {
+            break;
+        }
+        if (bitcast<f32>(f.y) > 0.0) {
+            let seg = f.x - 1u;
+            if (atomicMax(&segment_batches[seg], batch.first + 1u) <= batch.first) {
+                work_list[atomicAdd(&work_count[0], 1u)] = seg;
+            }
+        }
+    }
+}
+
+// The indirect dispatch of `shade_segments`: two invocations per listed segment (its ends' single
+// scattering) and with multiple scattering a third (its midpoint's), in workgroups of 64, as rows of
+// at most 65535 workgroups.
+@compute @workgroup_size(1)
+fn segment_dispatch() {
+    let kinds = select(2u, 3u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
+    let groups = (kinds * atomicLoad(&work_count[0]) + 63u) / 64u;
+    work_args[0] = min(groups, 65535u);
+    work_args[1] = (groups + 65534u) / 65535u;
+    work_args[2] = 1u;
+}
+
+// Invocation i < 2n (n segments listed): end i % 2 of listed segment i / 2, single scattering;
+// i >= 2n: the midpoint of listed segment i - 2n, multiple scattering (the kinds apart in the index,
+// so a SIMD group runs one of them). The first light batch (first == 0, every segment's first: the
+// batches run in order) stores the segment's radiance, the others add to it, so nothing needs clearing.
+@compute @workgroup_size(64)
+fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
+    // Rows of the indirect dispatch are 65535 workgroups wide whenever there is more than one.
+    let i = id.x + id.y * 65535u * 64u;
+    let n = atomicLoad(&work_count[0]);
+    let shadows = (batch.flags & FLAG_SHADOWS) != 0u;
+    let restart = batch.first == 0u;
+    if (i < 2u * n) {
+        let seg = work_list[i / 2u];
+        let sp = segment_point(seg, f32(i % 2u));
+        let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, true, false);
+        let k = 2u * seg + i % 2u;
+        segment_r[k] = select(segment_r[k], vec4<f32>(0.0), restart) + vec4<f32>(l.r, 0.0);
+        segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt, 0.0);
+        segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt, 0.0);
+    } else if (i < 3u * n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+        let seg = work_list[i - 2u * n];
+        let sp = segment_point(seg, 0.5);
+        let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
+        segment_ms_global[seg] = select(segment_ms_global[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);
+        segment_ms_local[seg] = select(segment_ms_local[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_local, 0.0);
+    }
+}
+
+// Single scattering at t between a segment's ends (twin: shade.rs, `between_ends`): log-linear where
+// both ends are positive (a light's transmittance falls off exponentially into the hair: linear
+// between a lit end and a shadowed one overstates the shadowed part by orders of magnitude), linear
+// where either is zero.
+fn between_ends(a: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
+    let both = (a > vec3<f32>(0.0)) & (b > vec3<f32>(0.0));
+    let tiny = vec3<f32>(1e-30);
+    let geometric = exp(mix(log(max(a, tiny)), log(max(b, tiny)), t));
+    return select(mix(a, b, t), geometric, both);
+}
+
+// The batch's rows' components: every kept fragment's weight times its segment's radiance at the
+// fragment's point (single scattering between the ends, multiple scattering the segment's);
+// .w of R the weight shaded (the hair's alpha).
+@compute @workgroup_size(8, 8)
+fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
+    let y = batch.row0 + id.y;
+    if (id.x >= camera.size.x || id.y >= batch.rows || y >= camera.size.y) {
+        return;
+    }
+    let pixel = y * camera.size.x + id.x;
+    let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(y) + 0.5);
+    var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var weight = 0.0;
+    for (var s = 0u; s < batch.slots; s++) {
+        let f = fragments[pixel * batch.slots + s];
+        if (f.x == 0u) {
+            break;
+        }
+        let w = bitcast<f32>(f.y);
+        if (w > 0.0) {
+            let seg = f.x - 1u;
+            let i0 = segments[seg];
+            let t = closest_on_segment(ray.origin, ray.dir, points[i0].xyz, points[i0 + 1u].xyz);
+            let k = 2u * seg;
+            out.r = out.r + w * between_ends(segment_r[k].xyz, segment_r[k + 1u].xyz, t);
+            out.tt = out.tt + w * between_ends(segment_tt[k].xyz, segment_tt[k + 1u].xyz, t);
+            out.trt = out.trt + w * between_ends(segment_trt[k].xyz, segment_trt[k + 1u].xyz, t);
+            if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+                out.ms_global = out.ms_global + w * segment_ms_global[seg].xyz;
+                out.ms_local = out.ms_local + w * segment_ms_local[seg].xyz;
+            }
+            weight = weight + w;
+        }
+    }
+    aov_r[pixel] = vec4<f32>(out.r, weight);
+    aov_tt[pixel] = vec4<f32>(out.tt, 0.0);
+    aov_trt[pixel] = vec4<f32>(out.trt, 0.0);
+    aov_ms_global[pixel] = vec4<f32>(out.ms_global, 0.0);
+    aov_ms_local[pixel] = vec4<f32>(out.ms_local, 0.0);
 }

@@ -274,8 +274,8 @@ fn the_head_shadows_the_hair_behind_it_from_a_narrow_light() {
     let ctx = context();
     // Sparse hair (little self-shadowing) seen from the right (+x); one narrow light behind the head
     // as the camera sees it (from the left, a little above and behind).
-    // One fragment a pixel (the front one, the rest dropped): each pixel's ratio below is one
-    // fibre point's transmittance.
+    // One fragment a pixel (the front one, the rest dropped), shaded at its own point (the default,
+    // not between its segment's ends): each pixel's ratio below is one fibre point's transmittance.
     let one_fragment = |mut s: Scene| {
         s.settings.fragments = 1;
         s.settings.tail = Tail::Drop;

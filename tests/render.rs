@@ -18,7 +18,7 @@ use strandlight::render::reference::{
 };
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{
-    EVERY_FRAGMENT, FragmentChoice, ShadingHair, shade_pixels, shade_point,
+    EVERY_FRAGMENT, ShadingHair, ShadingPoint, shade_pixels, shade_pixels_by_segment, shade_point,
 };
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
@@ -120,7 +120,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .collect();
         let values = GridValues::build(s.settings.shadow_grid(&s.hair), &sources, &light_dirs);
         let shading_hair = ShadingHair::new(&s.hair, &s.sigma_a);
-        let twin = |frame: &Frame, cam: &CameraUniform, choose: FragmentChoice, what: &str| {
+        let twin = |frame: &Frame, cam: &CameraUniform, by_segment: bool, what: &str| {
             let covered: Vec<usize> = frame.covered().collect();
             assert!(
                 covered.len() > 100,
@@ -132,7 +132,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                 .copied()
                 .step_by((covered.len() / 150).max(1))
                 .collect();
-            let cpu = shade_pixels(frame, cam, &shading_hair, &pixels, choose, |sp, wo| {
+            let shade = |sp: &ShadingPoint, wo| {
                 shade_point(
                     &luts,
                     &azimuthal,
@@ -143,7 +143,12 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                     shadows.then_some(&values),
                     multiple.then_some(&dual),
                 )
-            });
+            };
+            let cpu = if by_segment {
+                shade_pixels_by_segment(frame, cam, &shading_hair, &pixels, shade)
+            } else {
+                shade_pixels(frame, cam, &shading_hair, &pixels, EVERY_FRAGMENT, shade)
+            };
             let mut errors = Vec::new();
             let mut worst = (0.0f32, 0usize, 0usize, 0.0f32, 0.0f32);
             let scale = pixels
@@ -193,7 +198,27 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             );
         };
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
-        twin(&frame, &cam, EVERY_FRAGMENT, "frame");
+        assert!(!renderer.shades_segments());
+        twin(&frame, &cam, false, "frame");
+        // Shaded by segment: the same fragments, the segments' ends and midpoints.
+        let mut segment_renderer = Renderer::new(
+            &ctx,
+            RenderSettings {
+                segment_shading: true,
+                ..s.settings.clone()
+            },
+            &luts,
+            &s.hair,
+            &s.sigma_a,
+            &s.look,
+            &lights.lights,
+            &s.camera,
+        )
+        .expect("renderer");
+        segment_renderer.render_frame(&ctx);
+        let segment_frame = segment_renderer.read_frame(&ctx).expect("read back");
+        assert!(segment_renderer.shades_segments());
+        twin(&segment_frame, &cam, true, "frame (shaded by segment)");
         // The preview (half resolution, its four fragments a pixel), after a change.
         renderer.set_preview(PreviewMode::Fixed(2));
         renderer.set_camera(&ctx, &s.camera);
@@ -212,8 +237,57 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             .expect("read back")
             .expect("a preview");
         assert_eq!((preview.width, preview.height), (32, 24));
-        twin(&preview, &preview_cam, EVERY_FRAGMENT, "preview");
+        twin(&preview, &preview_cam, false, "preview");
     }
+}
+
+/// What shading each visible segment at its two ends (the frame's default) costs against shading
+/// every kept fragment at its own point: strands of 12 points (long segments, 10-20 pixels at
+/// 320x240), shadows and multiple scattering, the sunny fit.
+#[test]
+fn segment_shading_follows_per_fragment_shading() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = SrbfSet::read(&envmaps().join("sunny.srbf.json")).expect("sunny fit");
+    let mut s = scene(1500, 320, 240, true, Preset::Brown);
+    s.settings.multiple_scattering = true;
+    let (by_fragment, fragments) = render(&ctx, &luts, &s, &lights);
+    s.settings.segment_shading = true;
+    let (by_segment, segments) = render(&ctx, &luts, &s, &lights);
+    assert!(by_segment.shades_segments() && !by_fragment.shades_segments());
+    let kept: Vec<_> = (0..fragments.pixel_count())
+        .flat_map(|i| {
+            fragments
+                .kept_fragments(i)
+                .iter()
+                .filter(|f| f.weight > 0.0)
+        })
+        .collect();
+    let visible: std::collections::HashSet<u32> = kept.iter().map(|f| f.id).collect();
+    let e = relative_rmse(&segments, &fragments);
+    let mut rel: Vec<f64> = fragments
+        .covered()
+        .filter(|&i| fragments.hair_alpha(i) > 0.5)
+        .map(|i| {
+            let (a, b) = (segments.beauty[i], fragments.beauty[i]);
+            let l = |p: [f32; 4]| (p[0] + p[1] + p[2]) as f64;
+            (l(a) - l(b)).abs() / l(b).max(1e-9)
+        })
+        .collect();
+    rel.sort_by(f64::total_cmp);
+    let q = |f: f64| rel[((rel.len() - 1) as f64 * f) as usize];
+    println!(
+        "{} fragments shaded per fragment, {} segment ends per segment ({:.1}x fewer); beauty: relative RMSE {:.2}%, per pixel (alpha > 0.5, {} pixels) median {:.3}%, p99 {:.2}%, max {:.2}%",
+        kept.len(),
+        2 * visible.len(),
+        kept.len() as f64 / (2 * visible.len()) as f64,
+        100.0 * e,
+        rel.len(),
+        100.0 * q(0.5),
+        100.0 * q(0.99),
+        100.0 * q(1.0)
+    );
+    assert!(e <= 0.02, "segment shading differs by {e} (> 2%)");
 }
 
 /// sqrt(sum |a - b|^2 / sum |b|^2) over covered pixels and channels.
@@ -249,22 +323,31 @@ fn reference(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
 
 fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &EnvMap) -> [f64; 2] {
     [false, true].map(|shadows| {
-        let s = scene(1500, 96, 64, shadows, Preset::Brown);
+        let mut s = scene(1500, 96, 64, shadows, Preset::Brown);
         let (_, frame) = render(ctx, luts, &s, lights);
         let reference = reference(&s, &frame, env, lights.yaw);
-        let e = relative_rmse(&frame, &reference);
+        let e_fragment = relative_rmse(&frame, &reference);
+        // The same K-buffer shaded by segment: what shading segments at their ends costs.
+        s.settings.segment_shading = true;
+        let (_, by_segment) = render(ctx, luts, &s, lights);
+        let e = relative_rmse(&by_segment, &reference);
         let mean = |f: &Frame| {
             let n = f.covered().count().max(1) as f64;
             f.covered().map(|i| f.beauty[i][1] as f64).sum::<f64>() / n
         };
         println!(
-            "{name}, shadows {shadows}: relative RMSE {:.2}% over {} hair pixels (mean G: SRBF {:.4}, reference {:.4})",
-            100.0 * e,
+            "{name}, shadows {shadows}: relative RMSE {:.2}% over {} hair pixels, {:.2}% shaded by segment (mean G: SRBF {:.4}, reference {:.4})",
+            100.0 * e_fragment,
             frame.covered().count(),
+            100.0 * e,
             mean(&frame),
             mean(&reference)
         );
-        e
+        assert!(
+            e <= e_fragment + 0.01,
+            "{name}: segment shading {e} against {e_fragment} per fragment"
+        );
+        e_fragment.max(e)
     })
 }
 

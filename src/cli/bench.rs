@@ -37,6 +37,10 @@ pub struct BenchArgs {
     /// Single scattering only.
     #[arg(long)]
     pub single_scattering: bool,
+    /// Shade each visible segment once (its ends, its midpoint) instead of every kept K-buffer
+    /// fragment at its own point.
+    #[arg(long)]
+    pub segment_shading: bool,
     /// Keep the fiber-density volume and shadow grid between frames (what a parameter or camera
     /// edit costs); by default they are rebuilt every frame, as when geometry moves, so they are timed.
     #[arg(long)]
@@ -79,8 +83,14 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
-    /// Points shaded per frame (each pixel's kept K-buffer fragments).
+    /// Whether the frame shaded its visible segments (`--segment-shading`) or every kept fragment.
+    segment_shading: bool,
+    /// Points shaded per frame: each pixel's kept K-buffer fragments, or each visible segment's two
+    /// ends (single scattering) and with multiple scattering its midpoint.
     shaded_points: usize,
+    /// Kept fragments with a weight, and the distinct segments among them.
+    fragments: usize,
+    visible_segments: usize,
     /// The shading pass's median GPU time per light per shaded point, microseconds (all threads of
     /// the GPU: compare with `bench-fast`'s one-thread CPU figure only as a ratio).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -314,6 +324,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             height: scene.height,
             shadows: !args.no_shadows,
             multiple_scattering: !args.single_scattering,
+            segment_shading: args.segment_shading,
             ..Default::default()
         };
         let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
@@ -355,17 +366,21 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 per_pass.entry(name).or_default().push(ms);
             }
         }
-        // The points the shading pass shades: each pixel's kept fragments.
+        // The points the shading pass shades: each pixel's kept fragments, or each visible
+        // segment's two ends.
         let frame = renderer.read_frame(&ctx)?;
-        let shaded_points: usize = (0..frame.pixel_count())
-            .map(|i| {
-                frame
-                    .kept_fragments(i)
-                    .iter()
-                    .filter(|f| f.weight > 0.0)
-                    .count()
-            })
-            .sum();
+        let kept = (0..frame.pixel_count())
+            .flat_map(|i| frame.kept_fragments(i).iter().filter(|f| f.weight > 0.0));
+        let fragments = kept.clone().count();
+        let visible_segments = kept
+            .map(|f| f.id)
+            .collect::<std::collections::HashSet<_>>()
+            .len();
+        let shaded_points = if renderer.shades_segments() {
+            (2 + usize::from(!args.single_scattering)) * visible_segments
+        } else {
+            fragments
+        };
         let shading_us_per_light_per_point = per_pass
             .get("shading")
             .map(|v| median(v.clone()) * 1e3 / (lights.len() * shaded_points).max(1) as f64);
@@ -465,6 +480,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             segments: hair.point_count() - hair.strand_count(),
             shadows: !args.no_shadows,
             multiple_scattering: !args.single_scattering,
+            segment_shading: args.segment_shading,
             frames: args.frames,
             cpu_seconds: cpu,
             gpu_ms_median: per_pass.into_iter().map(|(k, v)| (k, median(v))).collect(),
@@ -472,6 +488,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             gpu_ms_total_median: median(totals),
             wall_ms_median: median(walls),
             shaded_points,
+            fragments,
+            visible_segments,
             shading_us_per_light_per_point,
             shadow_grid_wall_ms,
             progressive,

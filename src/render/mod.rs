@@ -15,6 +15,7 @@ pub mod reference_lights;
 pub mod renderer;
 pub mod resolve;
 pub mod scene;
+pub mod segment_shading;
 pub mod shade;
 pub mod shading;
 pub mod shadow_grid;

@@ -208,7 +208,7 @@ impl Renderer {
         };
         let device = &ctx.device;
         if row0 == 0 {
-            ShadingPass::clear(enc, &p.targets);
+            ShadingPass::clear(enc, &p.targets, None);
         }
         let inputs = ShadingInputs {
             camera: &p.camera,

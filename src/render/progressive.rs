@@ -12,19 +12,22 @@
 //! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
 //! lights or the forward table changed), visibility in ranges of segments (the K-buffer's atomic
 //! insertion does not depend on their order; the last part composites it), then every shading batch
-//! (a light batch at one K-buffer slot, every light batch at the front slot before any at the
-//! second) in bands of
-//! rows, each band followed by a resolve of its rows; the grid's entries for a light batch are built
+//! in bands of rows: shading segments, a light batch over the segments of the band's pixels it has
+//! not shaded yet, every light batch on a band before the next band, the band's rows gathered and
+//! resolved after its last (final then); shading fragments, a light batch at one K-buffer slot, every
+//! light batch at the front slot before any at the second, each band followed by a resolve of its
+//! rows. The grid's entries for a light batch are built
 //! just before the first shading batch that reads them. [`Progress::ready`] says when a finished unit
 //! left an image worth showing: the complete preview, then the full image once every light has shaded
-//! the front K-buffer slot (the "first pass"), updated unit by unit until converged. Every pixel
+//! the front K-buffer slot (the "first pass"; shading segments, every slot: the converged image),
+//! updated unit by unit until converged. Every pixel
 //! takes its batches in `render_frame`'s order, so the converged image is `render_frame`'s bit for
 //! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
 //! the shadow grid has built.
 
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
-use super::shading::{ShadeBatch, ShadingPass};
+use super::shading::{FLAG_SEGMENTS, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
@@ -69,7 +72,8 @@ pub enum WorkUnit {
     /// count 0 when the camera, size and fibres are those it last drew); the last part clears the
     /// components and resolves the image.
     Visibility { first: u32, count: u32 },
-    /// Frame batch `batch` (its lights at its K-buffer slot) over rows [row0, row0 + rows).
+    /// Frame batch `batch` (its lights, at its K-buffer slot when shading fragments) over rows
+    /// [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
     /// The preview's visibility pass over segments [first, first + count) (after a camera move; a
     /// parameter change reuses the last).
@@ -91,7 +95,8 @@ pub struct DisplayImage<'a> {
 pub enum ImageReady {
     /// The preview of the latest change is complete.
     Preview,
-    /// The full-resolution image: every light has shaded the front K-buffer slot (or more).
+    /// The full-resolution image: every light has shaded the front K-buffer slot (or more; shading
+    /// segments, every slot: converged).
     Full,
 }
 
@@ -1084,7 +1089,7 @@ impl Renderer {
                 }
                 // The last part: the image's visibility is whole; the components restart.
                 self.visibility_valid = true;
-                ShadingPass::clear(enc, &self.targets);
+                ShadingPass::clear(enc, &self.targets, self.segment_targets.as_ref());
                 self.converged_rows = 0;
                 self.encode_resolve(device, enc, 0..self.settings.height, (true, true));
             }
@@ -1097,11 +1102,14 @@ impl Renderer {
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);
                 // The last batch leaves its rows converged: resolved as render_frame resolves them.
+                // (Shaded by segment, rows have no image before it: their pixels gather then.)
                 let last = batch + 1 >= self.shading_pass.frame_batches().count() as u32;
                 if last {
                     self.converged_rows = self.converged_rows.max(row0 + rows);
                 }
-                self.encode_resolve(device, enc, row0..row0 + rows, (false, !last));
+                if last || b.flags & FLAG_SEGMENTS == 0 {
+                    self.encode_resolve(device, enc, row0..row0 + rows, (false, !last));
+                }
             }
         }
     }

@@ -76,6 +76,22 @@ impl<'a> ShadingHair<'a> {
     }
 }
 
+impl ShadingHair<'_> {
+    /// `segment_point` of the WGSL: the point of segment `seg` at t (0: its first point, 1: its
+    /// second), its absorption linear along it.
+    pub fn segment_point(&self, seg: u32, t: f32) -> ShadingPoint {
+        let i0 = self.segments[seg as usize] as usize;
+        let (a, b) = (self.hair.positions[i0], self.hair.positions[i0 + 1]);
+        let (s0, s1) = (self.sigma_a[i0], self.sigma_a[i0 + 1]);
+        ShadingPoint {
+            position: a * (1.0 - t) + b * t,
+            tangent: b - a,
+            sigma_a: std::array::from_fn(|c| s0[c] * (1.0 - t) + s1[c] * t),
+            segment: seg,
+        }
+    }
+}
+
 /// FiberFrame::from_tangent in f32 (twin of `fiber_frame` in `shaders/camera.wgsl`): (u, v, w).
 pub fn fiber_frame(tangent: Vec3) -> (Vec3, Vec3, Vec3) {
     let u = tangent.normalize();
@@ -270,4 +286,62 @@ pub fn shade_pixels(
             }
         },
     )
+}
+
+/// Single scattering at t between a segment's ends (twin of `between_ends`): log-linear where both
+/// ends are positive (a light's transmittance falls off exponentially into the hair), else linear.
+pub fn between_ends(a: f32, b: f32, t: f32) -> f32 {
+    if a > 0.0 && b > 0.0 {
+        (a.max(1e-30).ln() * (1.0 - t) + b.max(1e-30).ln() * t).exp()
+    } else {
+        a * (1.0 - t) + b * t
+    }
+}
+
+/// The frame's segment shading on the CPU (twin of `shade_segments` and `gather_segments`): for each
+/// pixel of `pixels`, every kept fragment's weight times its segment's radiance: single scattering
+/// (R, TT, TRT) between the segment's ends at the fragment's point ([`between_ends`]), multiple scattering that of
+/// its midpoint; each point shaded by `shade` towards the eye.
+pub fn shade_pixels_by_segment(
+    frame: &Frame,
+    camera: &CameraUniform,
+    hair: &ShadingHair,
+    pixels: &[usize],
+    shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
+) -> Vec<LobeRadiance> {
+    let eye = Vec3::from(camera.eye);
+    let at = |seg, t| {
+        let sp = hair.segment_point(seg, t);
+        shade(&sp, (eye - sp.position).normalize())
+    };
+    let k = frame.fragments_per_pixel as usize;
+    pixels
+        .par_iter()
+        .map(|&i| {
+            let mut acc = [[0.0f32; 3]; 5];
+            let slots = frame.fragments.get(i * k..(i + 1) * k).unwrap_or(&[]);
+            let (x, y) = (
+                (i % frame.width as usize) as f32,
+                (i / frame.width as usize) as f32,
+            );
+            let (origin, dir) = pixel_ray(camera, x + 0.5, y + 0.5);
+            for (id, weight) in EVERY_FRAGMENT(slots, &PixelFragments::default()) {
+                let seg = id - 1;
+                let i0 = hair.segments[seg as usize] as usize;
+                let (a, b) = (hair.hair.positions[i0], hair.hair.positions[i0 + 1]);
+                let t = closest_on_segment(origin, dir, a, b);
+                let (l0, l1, mid) = (at(seg, 0.0), at(seg, 1.0), at(seg, 0.5));
+                let w = weight as f32;
+                for c in 0..5 {
+                    for ch in 0..3 {
+                        acc[c][ch] += w * match c {
+                            0..=2 => between_ends(l0[c][ch], l1[c][ch], t),
+                            _ => mid[c][ch],
+                        };
+                    }
+                }
+            }
+            acc
+        })
+        .collect()
 }

@@ -1,9 +1,11 @@
-//! The shading passes (`shaders/shading.wgsl`): one dispatch per batch of at most
-//! [`MAX_LIGHTS_PER_PASS`] SRBF lights (Xu 2011's multi-pass scheme), each adding its lights' R, TT and
-//! TRT radiance (and with multiple scattering MS.global and MS.local) to the component buffers; one
-//! dispatch per K-buffer slot within a batch.
+//! The shading passes (`shaders/shading.wgsl`): per batch of at most [`MAX_LIGHTS_PER_PASS`] SRBF
+//! lights (Xu 2011's multi-pass scheme), its lights' R, TT and TRT radiance (and with multiple
+//! scattering MS.global and MS.local): per visible segment ([`super::segment_shading`], the frame's,
+//! gathered into the component buffers after the last batch), or per fragment, one dispatch per
+//! K-buffer slot within a batch, added to the component buffers (the preview's).
 
 use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
+use super::segment_shading::{SegmentShadingPass, SegmentTargets, last_light_batch};
 use super::targets::FrameTargets;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
@@ -12,6 +14,8 @@ use bytemuck::{Pod, Zeroable};
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
+/// The frame's batches shade segments ([`super::segment_shading`]), not fragments.
+pub const FLAG_SEGMENTS: u32 = 4;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
@@ -32,7 +36,8 @@ pub struct ShadeBatch {
     pub flags: u32,
     /// Fragments per pixel in the K-buffer.
     pub slots: u32,
-    /// The K-buffer slot this dispatch shades (one dispatch per slot and batch).
+    /// The K-buffer slot this dispatch shades (per fragment: one dispatch per slot and batch; 0 when
+    /// shading segments, which covers every slot).
     pub slot: u32,
     /// Rows [row0, row0 + rows) of the image.
     pub row0: u32,
@@ -59,10 +64,13 @@ pub struct ShadingInputs<'a> {
     pub azimuthal_table: &'a wgpu::Buffer,
     /// The occluder, shaded with the first slot's batches (and the preview's).
     pub occluder: Option<&'a GpuOccluder>,
+    /// The frame's per-segment buffers (batches flagged [`FLAG_SEGMENTS`] use them).
+    pub segment_targets: Option<&'a SegmentTargets>,
 }
 
 pub struct ShadingPass {
     pipeline: wgpu::ComputePipeline,
+    segments: SegmentShadingPass,
     occluder: OccluderPass,
     batches: Vec<(ShadeBatch, wgpu::Buffer)>,
 }
@@ -72,7 +80,7 @@ fn batch_uniform(device: &wgpu::Device, b: &ShadeBatch) -> wgpu::Buffer {
         device,
         "shade batch",
         bytemuck::bytes_of(b),
-        wgpu::BufferUsages::UNIFORM,
+        wgpu::BufferUsages::STORAGE,
     )
 }
 
@@ -84,6 +92,7 @@ impl ShadingPass {
         });
         Self {
             pipeline: compute_pipeline(device, &module, "shade"),
+            segments: SegmentShadingPass::new(device, &module),
             occluder: OccluderPass::new(device),
             batches: Vec::new(),
         }
@@ -110,10 +119,18 @@ impl ShadingPass {
         self.batches.iter().map(|(b, _)| b)
     }
 
-    /// Zeroes the component buffers and the occluder's (the start of a frame's shading).
-    pub fn clear(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+    /// Zeroes the component buffers and the occluder's, and the segments' radiance (the start of a
+    /// frame's shading).
+    pub fn clear(
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        segments: Option<&SegmentTargets>,
+    ) {
         for b in targets.components.iter().chain([&targets.occluder]) {
             encoder.clear_buffer(b, 0, None);
+        }
+        if let Some(s) = segments {
+            s.clear(encoder);
         }
     }
 
@@ -169,7 +186,8 @@ impl ShadingPass {
         pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
     }
 
-    /// A whole frame's shading: clears the components, then every batch over every row.
+    /// A whole frame's shading: clears the components, then every batch over every row (and with
+    /// segment shading, the gather after the last).
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -178,14 +196,9 @@ impl ShadingPass {
         targets: &FrameTargets,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        Self::clear(encoder, targets);
-        let binds: Vec<wgpu::BindGroup> = self
-            .batches
-            .iter()
-            .map(|(_, batch)| self.bind(device, inputs, targets, batch))
-            .collect();
-        let last = binds.len().saturating_sub(1);
-        for (k, (bind, (b, _))) in binds.iter().zip(&self.batches).enumerate() {
+        Self::clear(encoder, targets, inputs.segment_targets);
+        let last = self.batches.len().saturating_sub(1);
+        for (k, (b, uniform)) in self.batches.iter().enumerate() {
             let timestamp_writes = timestamps
                 .as_ref()
                 .filter(|_| k == 0 || k == last)
@@ -196,14 +209,64 @@ impl ShadingPass {
                         .filter(|_| k == 0),
                     end_of_pass_write_index: t.end_of_pass_write_index.filter(|_| k == last),
                 });
-            self.dispatch(
+            self.encode_with(
+                device,
                 encoder,
-                bind,
-                targets.width,
-                targets.height,
+                inputs,
+                targets,
+                (b, uniform),
                 timestamp_writes,
             );
-            self.encode_occluder(device, encoder, inputs, targets, b);
+        }
+    }
+
+    /// One batch (its rows) with its uniform: a slot's fragments, or the segments under the rows
+    /// (gathered after the last light batch), then the occluder.
+    fn encode_with(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        (batch, uniform): (&ShadeBatch, &wgpu::Buffer),
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let size = (targets.width, batch.rows);
+        match inputs.segment_targets {
+            Some(segments) if batch.flags & FLAG_SEGMENTS != 0 => {
+                let gather = last_light_batch(batch);
+                let (begin, end) = match &timestamps {
+                    Some(t) => (
+                        t.beginning_of_pass_write_index
+                            .map(|i| wgpu::ComputePassTimestampWrites {
+                                query_set: t.query_set,
+                                beginning_of_pass_write_index: Some(i),
+                                end_of_pass_write_index: None,
+                            }),
+                        t.end_of_pass_write_index
+                            .map(|i| wgpu::ComputePassTimestampWrites {
+                                query_set: t.query_set,
+                                beginning_of_pass_write_index: None,
+                                end_of_pass_write_index: Some(i),
+                            }),
+                    ),
+                    None => (None, None),
+                };
+                self.segments.encode_batch(
+                    device, encoder, inputs, targets, segments, uniform, size, begin,
+                );
+                self.encode_occluder(device, encoder, inputs, targets, batch);
+                if gather {
+                    self.segments.encode_gather(
+                        device, encoder, inputs, targets, segments, uniform, size, end,
+                    );
+                }
+            }
+            _ => {
+                let bind = self.bind(device, inputs, targets, uniform);
+                self.dispatch(encoder, &bind, size.0, size.1, timestamps);
+                self.encode_occluder(device, encoder, inputs, targets, batch);
+            }
         }
     }
 
@@ -237,8 +300,13 @@ impl ShadingPass {
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let uniform = batch_uniform(device, batch);
-        let bind = self.bind(device, inputs, targets, &uniform);
-        self.dispatch(encoder, &bind, targets.width, batch.rows, timestamps);
-        self.encode_occluder(device, encoder, inputs, targets, batch);
+        self.encode_with(
+            device,
+            encoder,
+            inputs,
+            targets,
+            (batch, &uniform),
+            timestamps,
+        );
     }
 }

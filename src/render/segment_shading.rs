@@ -1,0 +1,233 @@
+//! Segment shading, the frame's (`claim_segments`, `segment_dispatch`, `shade_segments` and
+//! `gather_segments` of `shaders/shading.wgsl`): per light batch, the visible segments of the rows'
+//! kept K-buffer fragments are listed once, each is shaded (single scattering at its two ends,
+//! multiple scattering at its midpoint), and once every batch has shaded them the rows' pixels gather
+//! their fragments' radiance, single scattering interpolated along each segment. The per-fragment pass
+//! ([`super::shading`]) shades the preview, whose fragments are mostly of different segments, the
+//! frame without `RenderSettings::segment_shading` (the default), a view in which a segment subtends
+//! more than [`super::renderer::MAX_SEGMENT_ANGLE`], and a hair whose segments' radiance would not
+//! fit one binding.
+
+use super::shading::{ShadeBatch, ShadingInputs};
+use super::targets::FrameTargets;
+use crate::gpu::context::compute_pipeline;
+
+/// Bytes of a single-scattering component's radiance per segment (two ends, RGBA f32); a
+/// multiple-scattering component's is half (the midpoint's).
+pub const RADIANCE_BYTES_PER_SEGMENT: u64 = 32;
+
+/// The per-segment buffers (sized by the hair's segments, not by the image).
+pub struct SegmentTargets {
+    /// Per segment: 1 + the first light of the last batch that shaded it (0: none).
+    pub batches: wgpu::Buffer,
+    /// [0]: segments listed by the unit's claim.
+    pub work_count: wgpu::Buffer,
+    pub work_list: wgpu::Buffer,
+    /// `shade_segments`' indirect dispatch.
+    pub work_args: wgpu::Buffer,
+    /// R, TT, TRT at each segment's two ends (index 2 segment + end), MS.global and MS.local at its
+    /// midpoint (index segment). Written by a frame's first light batch, added to by the others.
+    pub radiance: [wgpu::Buffer; 5],
+}
+
+impl SegmentTargets {
+    /// Buffers for `segments` segments, or None when one component's radiance would exceed
+    /// `binding_limit` bytes (the frame then shades per fragment).
+    pub fn new(device: &wgpu::Device, segments: u32, binding_limit: u64) -> Option<Self> {
+        let n = segments.max(1) as u64;
+        if n * RADIANCE_BYTES_PER_SEGMENT > binding_limit {
+            return None;
+        }
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let none = wgpu::BufferUsages::empty();
+        Some(Self {
+            batches: buffer("segment batches", 4 * n, none),
+            work_count: buffer("segment work count", 4, none),
+            work_list: buffer("segment work list", 4 * n, none),
+            work_args: buffer("segment dispatch", 12, wgpu::BufferUsages::INDIRECT),
+            radiance: std::array::from_fn(|c| {
+                let ends = if c < 3 { 2 } else { 1 };
+                buffer(
+                    super::targets::COMPONENTS[c],
+                    n * RADIANCE_BYTES_PER_SEGMENT / 2 * ends,
+                    none,
+                )
+            }),
+        })
+    }
+
+    /// No segment shaded (the start of a frame's shading; the first light batch overwrites the
+    /// radiance of each segment it claims).
+    pub fn clear(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.batches, 0, None);
+    }
+}
+
+/// The four pipelines.
+pub struct SegmentShadingPass {
+    claim: wgpu::ComputePipeline,
+    dispatch: wgpu::ComputePipeline,
+    shade: wgpu::ComputePipeline,
+    gather: wgpu::ComputePipeline,
+}
+
+/// A bind group of the given (binding, buffer) pairs for group 0 of `pipeline`.
+fn bind(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    entries: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry {
+            binding,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
+}
+
+fn compute<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes,
+    })
+}
+
+impl SegmentShadingPass {
+    pub fn new(device: &wgpu::Device, module: &wgpu::ShaderModule) -> Self {
+        Self {
+            claim: compute_pipeline(device, module, "claim_segments"),
+            dispatch: compute_pipeline(device, module, "segment_dispatch"),
+            shade: compute_pipeline(device, module, "shade_segments"),
+            gather: compute_pipeline(device, module, "gather_segments"),
+        }
+    }
+
+    /// One light batch over the segments of rows `batch.row0 .. + batch.rows` that it has not shaded
+    /// yet: the claim, the dispatch's size, the shading. `timestamps`: the claim's beginning.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_batch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        segments: &SegmentTargets,
+        batch: &wgpu::Buffer,
+        (width, rows): (u32, u32),
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        encoder.clear_buffer(&segments.work_count, 0, None);
+        let claim = bind(
+            device,
+            &self.claim,
+            "claim segments",
+            &[
+                (0, inputs.camera),
+                (2, batch),
+                (18, &targets.kbuffer.fragments),
+                (20, &segments.batches),
+                (21, &segments.work_count),
+                (22, &segments.work_list),
+            ],
+        );
+        {
+            let mut pass = compute(encoder, "claim segments", timestamps);
+            pass.set_pipeline(&self.claim);
+            pass.set_bind_group(0, &claim, &[]);
+            pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
+        }
+        let dispatch = bind(
+            device,
+            &self.dispatch,
+            "segment dispatch",
+            &[
+                (2, batch),
+                (21, &segments.work_count),
+                (23, &segments.work_args),
+            ],
+        );
+        {
+            let mut pass = compute(encoder, "segment dispatch", None);
+            pass.set_pipeline(&self.dispatch);
+            pass.set_bind_group(0, &dispatch, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        let mut entries = vec![
+            (0, inputs.camera),
+            (1, inputs.params),
+            (2, batch),
+            (3, inputs.shadow_grid),
+            (4, inputs.points),
+            (5, inputs.segments),
+            (6, inputs.absorption),
+            (7, inputs.lights),
+            (8, inputs.luts[0]),
+            (9, inputs.luts[1]),
+            (10, inputs.luts[2]),
+            (11, inputs.shadow_values),
+            (12, inputs.dual_tables),
+            (19, inputs.azimuthal_table),
+            (21, &segments.work_count),
+            (22, &segments.work_list),
+        ];
+        entries.extend((24..).zip(&segments.radiance));
+        let shade = bind(device, &self.shade, "shade segments", &entries);
+        let mut pass = compute(encoder, "shade segments", None);
+        pass.set_pipeline(&self.shade);
+        pass.set_bind_group(0, &shade, &[]);
+        pass.dispatch_workgroups_indirect(&segments.work_args, 0);
+    }
+
+    /// Rows `batch.row0 .. + batch.rows` of the components from the segments' radiance (after every
+    /// light batch shaded them). `timestamps`: the pass's end.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_gather(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        segments: &SegmentTargets,
+        batch: &wgpu::Buffer,
+        (width, rows): (u32, u32),
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let mut entries = vec![
+            (0, inputs.camera),
+            (2, batch),
+            (4, inputs.points),
+            (5, inputs.segments),
+            (18, &targets.kbuffer.fragments),
+        ];
+        entries.extend((13..).zip(&targets.components));
+        entries.extend((24..).zip(&segments.radiance));
+        let gather = bind(device, &self.gather, "gather segments", &entries);
+        let mut pass = compute(encoder, "gather segments", timestamps);
+        pass.set_pipeline(&self.gather);
+        pass.set_bind_group(0, &gather, &[]);
+        pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
+    }
+}
+
+/// Whether `batch` is the frame's last light batch (its gather follows).
+pub fn last_light_batch(batch: &ShadeBatch) -> bool {
+    batch.first + batch.count >= batch.lights
+}
