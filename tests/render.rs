@@ -69,9 +69,20 @@ fn scene(strands: usize, width: u32, height: u32, shadows: bool, preset: Preset)
 }
 
 fn render(ctx: &GpuContext, luts: &Luts, s: &Scene, lights: &SrbfSet) -> (Renderer, Frame) {
+    render_with(ctx, luts, s, s.settings.clone(), lights)
+}
+
+/// The scene rendered with other settings.
+fn render_with(
+    ctx: &GpuContext,
+    luts: &Luts,
+    s: &Scene,
+    settings: RenderSettings,
+    lights: &SrbfSet,
+) -> (Renderer, Frame) {
     let mut r = Renderer::new(
         ctx,
-        s.settings.clone(),
+        settings,
         luts,
         &s.hair,
         &s.sigma_a,
@@ -201,22 +212,11 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         assert!(!renderer.shades_segments());
         twin(&frame, &cam, false, "frame");
         // Shaded by segment: the same fragments, the segments' ends and midpoints.
-        let mut segment_renderer = Renderer::new(
-            &ctx,
-            RenderSettings {
-                segment_shading: true,
-                ..s.settings.clone()
-            },
-            &luts,
-            &s.hair,
-            &s.sigma_a,
-            &s.look,
-            &lights.lights,
-            &s.camera,
-        )
-        .expect("renderer");
-        segment_renderer.render_frame(&ctx);
-        let segment_frame = segment_renderer.read_frame(&ctx).expect("read back");
+        let settings = RenderSettings {
+            segment_shading: true,
+            ..s.settings.clone()
+        };
+        let (segment_renderer, segment_frame) = render_with(&ctx, &luts, &s, settings, &lights);
         assert!(segment_renderer.shades_segments());
         twin(&segment_frame, &cam, true, "frame (shaded by segment)");
         // The preview (half resolution, its four fragments a pixel), after a change.

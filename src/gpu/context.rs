@@ -348,6 +348,27 @@ pub fn buffer_init(
     buffer
 }
 
+/// A bind group for group 0 of `pipeline` of the given (binding, buffer) pairs.
+pub fn bind_entries(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    entries: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry {
+            binding,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
+}
+
 /// A bind group for group 0 of `pipeline`: `buffers` at bindings 0, 1, ... and the `extra` entries.
 pub fn bind_buffers(
     device: &wgpu::Device,

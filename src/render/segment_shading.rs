@@ -10,7 +10,7 @@
 
 use super::shading::{ShadeBatch, ShadingInputs};
 use super::targets::FrameTargets;
-use crate::gpu::context::compute_pipeline;
+use crate::gpu::context::{bind_entries as bind, compute_pipeline};
 
 /// Bytes of a single-scattering component's radiance per segment (two ends, RGBA f32); a
 /// multiple-scattering component's is half (the midpoint's).
@@ -76,27 +76,6 @@ pub struct SegmentShadingPass {
     dispatch: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
     gather: wgpu::ComputePipeline,
-}
-
-/// A bind group of the given (binding, buffer) pairs for group 0 of `pipeline`.
-fn bind(
-    device: &wgpu::Device,
-    pipeline: &wgpu::ComputePipeline,
-    label: &str,
-    entries: &[(u32, &wgpu::Buffer)],
-) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = entries
-        .iter()
-        .map(|&(binding, b)| wgpu::BindGroupEntry {
-            binding,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
-    })
 }
 
 fn compute<'e>(
@@ -170,24 +149,8 @@ impl SegmentShadingPass {
             pass.set_bind_group(0, &dispatch, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        let mut entries = vec![
-            (0, inputs.camera),
-            (1, inputs.params),
-            (2, batch),
-            (3, inputs.shadow_grid),
-            (4, inputs.points),
-            (5, inputs.segments),
-            (6, inputs.absorption),
-            (7, inputs.lights),
-            (8, inputs.luts[0]),
-            (9, inputs.luts[1]),
-            (10, inputs.luts[2]),
-            (11, inputs.shadow_values),
-            (12, inputs.dual_tables),
-            (19, inputs.azimuthal_table),
-            (21, &segments.work_count),
-            (22, &segments.work_list),
-        ];
+        let mut entries = inputs.shading_entries(batch);
+        entries.extend([(21, &segments.work_count), (22, &segments.work_list)]);
         entries.extend((24..).zip(&segments.radiance));
         let shade = bind(device, &self.shade, "shade segments", &entries);
         let mut pass = compute(encoder, "shade segments", None);

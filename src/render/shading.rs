@@ -7,7 +7,7 @@
 use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
 use super::segment_shading::{SegmentShadingPass, SegmentTargets, last_light_batch};
 use super::targets::FrameTargets;
-use crate::gpu::context::{bind_buffers, compute_pipeline};
+use crate::gpu::context::{bind_entries, compute_pipeline};
 use crate::gpu::shaders;
 use bytemuck::{Pod, Zeroable};
 
@@ -66,6 +66,28 @@ pub struct ShadingInputs<'a> {
     pub occluder: Option<&'a GpuOccluder>,
     /// The frame's per-segment buffers (batches flagged [`FLAG_SEGMENTS`] use them).
     pub segment_targets: Option<&'a SegmentTargets>,
+}
+
+impl<'a> ShadingInputs<'a> {
+    /// What every shading kernel reads, at its bindings (0-12 and 19), with the batch's buffer.
+    pub fn shading_entries(&self, batch: &'a wgpu::Buffer) -> Vec<(u32, &'a wgpu::Buffer)> {
+        vec![
+            (0, self.camera),
+            (1, self.params),
+            (2, batch),
+            (3, self.shadow_grid),
+            (4, self.points),
+            (5, self.segments),
+            (6, self.absorption),
+            (7, self.lights),
+            (8, self.luts[0]),
+            (9, self.luts[1]),
+            (10, self.luts[2]),
+            (11, self.shadow_values),
+            (12, self.dual_tables),
+            (19, self.azimuthal_table),
+        ]
+    }
 }
 
 pub struct ShadingPass {
@@ -141,32 +163,10 @@ impl ShadingPass {
         targets: &FrameTargets,
         batch: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        let buffers = [
-            inputs.camera,
-            inputs.params,
-            batch,
-            inputs.shadow_grid,
-            inputs.points,
-            inputs.segments,
-            inputs.absorption,
-            inputs.lights,
-            inputs.luts[0],
-            inputs.luts[1],
-            inputs.luts[2],
-            inputs.shadow_values,
-            inputs.dual_tables,
-        ];
-        let buffers: Vec<&wgpu::Buffer> = buffers.into_iter().chain(&targets.components).collect();
-        let more = [&targets.kbuffer.fragments, inputs.azimuthal_table];
-        let extra = more
-            .iter()
-            .enumerate()
-            .map(|(k, b)| wgpu::BindGroupEntry {
-                binding: buffers.len() as u32 + k as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        bind_buffers(device, &self.pipeline, "shading", &buffers, extra)
+        let mut entries = inputs.shading_entries(batch);
+        entries.extend((13..).zip(&targets.components));
+        entries.push((18, &targets.kbuffer.fragments));
+        bind_entries(device, &self.pipeline, "shading", &entries)
     }
 
     fn dispatch(
