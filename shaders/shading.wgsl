@@ -151,13 +151,13 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Segment shading (the frame's; twin: src/render/shade.rs, `shade_pixels_by_segment`). A segment's
 // shading point moves along it from pixel to pixel, but its tangent, the lights and (nearly) the view
-// direction do not: each visible segment is shaded once per light batch, single scattering at its two
-// ends (each end's position, absorption and direction to the eye) and multiple scattering, which
-// varies slowly (spread over sigma_f and read from the coarse shadow grid), once at its midpoint; every
-// fragment takes the single scattering between the ends at its own point (`between_ends`) and the
-// segment's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that cover ~8 pixels
-// each (S1), so this shades ~4x fewer points than one per fragment, and multiple scattering (half a
-// light's cost) at half of those.
+// direction do not: each visible segment is shaded once per light batch. Its single scattering
+// response to each light is evaluated once, at its midpoint, and weighted by the light's
+// transmittance at its ends and its midpoint (`shade_segment_single`); its multiple scattering, which
+// varies slowly (spread over sigma_f and read from the coarse shadow grid), once at its midpoint. Every
+// fragment takes the single scattering between the three samples at its own point (`between_samples`)
+// and the segment's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that
+// cover ~8 pixels each (S1): ~8x fewer responses than one per fragment.
 
 // The point of segment `seg` at t (0: its first point, 1: its second; absorption linear along it).
 fn segment_point(seg: u32, t: f32) -> ShadingPoint {
@@ -165,6 +165,44 @@ fn segment_point(seg: u32, t: f32) -> ShadingPoint {
     let a = points[i0].xyz;
     let b = points[i0 + 1u].xyz;
     return ShadingPoint(mix(a, b, t), b - a, mix(absorption[i0].xyz, absorption[i0 + 1u].xyz, t));
+}
+
+// Single scattering of a segment at t = 0, 1/2, 1 (`[0]`, `[1]`, `[2]`) towards omega_o from lights
+// [first, first + count): each light's response (R, TT, TRT) once at the midpoint `mid` (its tangent,
+// absorption and view), scaled by the light's transmittance at each sample (`ends`: the segment's
+// points). Where the light's transmittance falls steeply along the segment, into the hair's shadow,
+// the three samples follow it; the response itself changes by the few degrees the segment subtends.
+struct SegmentSingle {
+    r: array<vec3<f32>, 3>,
+    tt: array<vec3<f32>, 3>,
+    trt: array<vec3<f32>, 3>,
+}
+
+fn shade_segment_single(mid: ShadingPoint, a: vec3<f32>, b: vec3<f32>, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool) -> SegmentSingle {
+    var p = params;
+    p.sigma_a = vec4<f32>(mid.sigma_a, 0.0);
+    let frame = fiber_frame(mid.tangent);
+    let o = fiber_angles(frame, omega_o);
+    let zero = vec3<f32>(0.0);
+    var r0 = zero; var r1 = zero; var r2 = zero;
+    var tt0 = zero; var tt1 = zero; var tt2 = zero;
+    var trt0 = zero; var trt1 = zero; var trt2 = zero;
+    for (var j = first; j < first + count; j++) {
+        let l = lights[j];
+        let ang = fiber_angles(frame, l.direction);
+        var t = vec3<f32>(1.0);
+        if (shadows) {
+            t = vec3<f32>(grid_shadow(shadow_grid, a, j).transmittance, grid_shadow(shadow_grid, mid.position, j).transmittance, grid_shadow(shadow_grid, b, j).transmittance);
+        }
+        let light = SrbfInFrame(ang.x, ang.y, l.lambda);
+        let r = l.rgb * srbf_response_lobe(p, 0u, light, o.x, o.y);
+        let tt = l.rgb * srbf_response_lobe(p, 1u, light, o.x, o.y);
+        let trt = l.rgb * srbf_response_lobe(p, 2u, light, o.x, o.y);
+        r0 = r0 + t.x * r; r1 = r1 + t.y * r; r2 = r2 + t.z * r;
+        tt0 = tt0 + t.x * tt; tt1 = tt1 + t.y * tt; tt2 = tt2 + t.z * tt;
+        trt0 = trt0 + t.x * trt; trt1 = trt1 + t.y * trt; trt2 = trt2 + t.z * trt;
+    }
+    return SegmentSingle(array(r0, r1, r2), array(tt0, tt1, tt2), array(trt0, trt1, trt2));
 }
 
 // Lists the segments of the batch's rows' kept fragments that this light batch has not shaded: a
@@ -191,22 +229,23 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// The indirect dispatch of `shade_segments`: two invocations per listed segment (its ends' single
-// scattering) and with multiple scattering a third (its midpoint's), in workgroups of 64, as rows of
-// at most 65535 workgroups.
+// The indirect dispatch of `shade_segments`: one invocation per listed segment (its single scattering)
+// and with multiple scattering a second (its midpoint's), in workgroups of 64, as rows of at most 65535
+// workgroups.
 @compute @workgroup_size(1)
 fn segment_dispatch() {
-    let kinds = select(2u, 3u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
+    let kinds = select(1u, 2u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
     let groups = (kinds * atomicLoad(&work_count[0]) + 63u) / 64u;
     work_args[0] = min(groups, 65535u);
     work_args[1] = (groups + 65534u) / 65535u;
     work_args[2] = 1u;
 }
 
-// Invocation i < 2n (n segments listed): end i % 2 of listed segment i / 2, single scattering;
-// i >= 2n: the midpoint of listed segment i - 2n, multiple scattering (the kinds apart in the index,
-// so a SIMD group runs one of them). The first light batch (first == 0, every segment's first: the
-// batches run in order) stores the segment's radiance, the others add to it, so nothing needs clearing.
+// Invocation i < n (n segments listed): single scattering of listed segment i; i >= n: multiple
+// scattering at the midpoint of listed segment i - n. The kinds lie apart in the index, so a SIMD group
+// runs one of them (single and multiple scattering in one light loop spill on lavapipe and cost ~3x as
+// much as apart). The first light batch (first == 0, every segment's first: the batches run in order)
+// stores the segment's radiance, the others add to it, so nothing needs clearing.
 @compute @workgroup_size(64)
 fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     // Rows of the indirect dispatch are 65535 workgroups wide whenever there is more than one.
@@ -214,16 +253,19 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = atomicLoad(&work_count[0]);
     let shadows = (batch.flags & FLAG_SHADOWS) != 0u;
     let restart = batch.first == 0u;
-    if (i < 2u * n) {
-        let seg = work_list[i / 2u];
-        let sp = segment_point(seg, f32(i % 2u));
-        let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, true, false);
-        let k = 2u * seg + i % 2u;
-        segment_r[k] = select(segment_r[k], vec4<f32>(0.0), restart) + vec4<f32>(l.r, 0.0);
-        segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt, 0.0);
-        segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt, 0.0);
-    } else if (i < 3u * n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-        let seg = work_list[i - 2u * n];
+    if (i < n) {
+        let seg = work_list[i];
+        let mid = segment_point(seg, 0.5);
+        let i0 = segments[seg];
+        let l = shade_segment_single(mid, points[i0].xyz, points[i0 + 1u].xyz, normalize(camera.eye - mid.position), batch.first, batch.count, shadows);
+        for (var s = 0u; s < 3u; s++) {
+            let k = 3u * seg + s;
+            segment_r[k] = select(segment_r[k], vec4<f32>(0.0), restart) + vec4<f32>(l.r[s], 0.0);
+            segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt[s], 0.0);
+            segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
+        }
+    } else if (i < 2u * n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+        let seg = work_list[i - n];
         let sp = segment_point(seg, 0.5);
         let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
         segment_ms_global[seg] = select(segment_ms_global[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);
@@ -231,10 +273,10 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Single scattering at t between a segment's ends (twin: shade.rs, `between_ends`): log-linear where
-// both ends are positive (a light's transmittance falls off exponentially into the hair: linear
-// between a lit end and a shadowed one overstates the shadowed part by orders of magnitude), linear
-// where either is zero.
+// Single scattering at t between two samples (twin: shade.rs, `between_ends`): log-linear where
+// both are positive (a light's transmittance falls off exponentially into the hair: linear between a
+// lit end and a shadowed one overstates the shadowed part by orders of magnitude), linear where either
+// is zero.
 fn between_ends(a: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
     let both = (a > vec3<f32>(0.0)) & (b > vec3<f32>(0.0));
     let tiny = vec3<f32>(1e-30);
@@ -242,8 +284,19 @@ fn between_ends(a: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
     return select(mix(a, b, t), geometric, both);
 }
 
+// Single scattering at t along a segment from its samples a, m, b at t = 0, 1/2, 1, piecewise
+// by `between_ends` (twin: shade.rs, `between_samples`). The midpoint matters: a sum of lights each
+// exponential along the segment is log-convex, so one log-linear piece over the segment overstates
+// it (+11 % TT on the back-lit clump of tests/ms_reference.rs).
+fn between_samples(a: vec3<f32>, m: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
+    if (t < 0.5) {
+        return between_ends(a, m, 2.0 * t);
+    }
+    return between_ends(m, b, 2.0 * t - 1.0);
+}
+
 // The batch's rows' components: every kept fragment's weight times its segment's radiance at the
-// fragment's point (single scattering between the ends, multiple scattering the segment's);
+// fragment's point (single scattering between the samples, multiple scattering the segment's);
 // .w of R the weight shaded (the hair's alpha).
 @compute @workgroup_size(8, 8)
 fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -265,10 +318,10 @@ fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             let seg = f.x - 1u;
             let i0 = segments[seg];
             let t = closest_on_segment(ray.origin, ray.dir, points[i0].xyz, points[i0 + 1u].xyz);
-            let k = 2u * seg;
-            out.r = out.r + w * between_ends(segment_r[k].xyz, segment_r[k + 1u].xyz, t);
-            out.tt = out.tt + w * between_ends(segment_tt[k].xyz, segment_tt[k + 1u].xyz, t);
-            out.trt = out.trt + w * between_ends(segment_trt[k].xyz, segment_trt[k + 1u].xyz, t);
+            let k = 3u * seg;
+            out.r = out.r + w * between_samples(segment_r[k].xyz, segment_r[k + 1u].xyz, segment_r[k + 2u].xyz, t);
+            out.tt = out.tt + w * between_samples(segment_tt[k].xyz, segment_tt[k + 1u].xyz, segment_tt[k + 2u].xyz, t);
+            out.trt = out.trt + w * between_samples(segment_trt[k].xyz, segment_trt[k + 1u].xyz, segment_trt[k + 2u].xyz, t);
             if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
                 out.ms_global = out.ms_global + w * segment_ms_global[seg].xyz;
                 out.ms_local = out.ms_local + w * segment_ms_local[seg].xyz;

@@ -182,6 +182,8 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
         height: 64,
         shadows: true,
         multiple_scattering: true,
+        // Every fragment shaded at its own point; by segment (the default) below.
+        segment_shading: false,
         ..Default::default()
     };
     let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
@@ -220,7 +222,7 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
             },
         );
         let t_ref = t.elapsed().as_secs_f64();
-        // The same frame shaded by segment (`segment_shading`, off by default: this scene is why).
+        // The same frame shaded by segment (`segment_shading`, the default).
         let by_segment = common::render_uniform(
             &ctx,
             &RenderSettings {

@@ -19,6 +19,7 @@ use strandlight::render::reference::{
 use strandlight::render::scene::generated_hair;
 use strandlight::render::shade::{
     EVERY_FRAGMENT, ShadingHair, ShadingPoint, shade_pixels, shade_pixels_by_segment, shade_point,
+    shade_segment_single,
 };
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
@@ -109,6 +110,8 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
     for (shadows, multiple) in [(false, false), (true, true)] {
         let mut s = scene(400, 64, 48, shadows, Preset::Blond);
         s.settings.multiple_scattering = multiple;
+        // Every fragment at its own point first; by segment (the default) below.
+        s.settings.segment_shading = false;
         let (mut renderer, frame) = render(&ctx, &luts, &s, &lights);
         let volume = FiberDensity::build(&s.hair, &s.sigma_a, s.settings.voxel_size(&s.hair));
         let pyramid = DensityPyramid::build(&volume);
@@ -156,7 +159,19 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
                 )
             };
             let cpu = if by_segment {
-                shade_pixels_by_segment(frame, cam, &shading_hair, &pixels, shade)
+                let single = |mid: &ShadingPoint, ends, wo| {
+                    shade_segment_single(
+                        &luts,
+                        &azimuthal,
+                        &s.look.fast,
+                        mid,
+                        ends,
+                        wo,
+                        &lights.lights,
+                        shadows.then_some(&values),
+                    )
+                };
+                shade_pixels_by_segment(frame, cam, &shading_hair, &pixels, single, shade)
             } else {
                 shade_pixels(frame, cam, &shading_hair, &pixels, EVERY_FRAGMENT, shade)
             };
@@ -211,7 +226,7 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
         let cam = s.camera.uniform(64, 48, s.settings.min_width_px);
         assert!(!renderer.shades_segments());
         twin(&frame, &cam, false, "frame");
-        // Shaded by segment: the same fragments, the segments' ends and midpoints.
+        // Shaded by segment: the same fragments, each segment's response at its midpoint.
         let settings = RenderSettings {
             segment_shading: true,
             ..s.settings.clone()
@@ -241,9 +256,10 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
     }
 }
 
-/// What shading each visible segment at its two ends (the frame's default) costs against shading
-/// every kept fragment at its own point: strands of 12 points (long segments, 10-20 pixels at
-/// 320x240), shadows and multiple scattering, the sunny fit.
+/// What shading each visible segment once (the frame's default: each light's response at its
+/// midpoint, its transmittance at the ends and the midpoint) costs against shading every kept
+/// fragment at its own point: strands of 12 points (long segments, 10-20 pixels at 320x240), shadows
+/// and multiple scattering, the sunny fit.
 #[test]
 fn segment_shading_follows_per_fragment_shading() {
     let ctx = context();
@@ -251,6 +267,7 @@ fn segment_shading_follows_per_fragment_shading() {
     let lights = SrbfSet::read(&envmaps().join("sunny.srbf.json")).expect("sunny fit");
     let mut s = scene(1500, 320, 240, true, Preset::Brown);
     s.settings.multiple_scattering = true;
+    s.settings.segment_shading = false;
     let (by_fragment, fragments) = render(&ctx, &luts, &s, &lights);
     s.settings.segment_shading = true;
     let (by_segment, segments) = render(&ctx, &luts, &s, &lights);
@@ -277,10 +294,10 @@ fn segment_shading_follows_per_fragment_shading() {
     rel.sort_by(f64::total_cmp);
     let q = |f: f64| rel[((rel.len() - 1) as f64 * f) as usize];
     println!(
-        "{} fragments shaded per fragment, {} segment ends per segment ({:.1}x fewer); beauty: relative RMSE {:.2}%, per pixel (alpha > 0.5, {} pixels) median {:.3}%, p99 {:.2}%, max {:.2}%",
+        "{} fragments shaded per fragment, {} segments by segment ({:.1}x fewer responses); beauty: relative RMSE {:.2}%, per pixel (alpha > 0.5, {} pixels) median {:.3}%, p99 {:.2}%, max {:.2}%",
         kept.len(),
-        2 * visible.len(),
-        kept.len() as f64 / (2 * visible.len()) as f64,
+        visible.len(),
+        kept.len() as f64 / visible.len() as f64,
         100.0 * e,
         rel.len(),
         100.0 * q(0.5),
@@ -324,10 +341,11 @@ fn reference(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
 fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &EnvMap) -> [f64; 2] {
     [false, true].map(|shadows| {
         let mut s = scene(1500, 96, 64, shadows, Preset::Brown);
+        s.settings.segment_shading = false;
         let (_, frame) = render(ctx, luts, &s, lights);
         let reference = reference(&s, &frame, env, lights.yaw);
         let e_fragment = relative_rmse(&frame, &reference);
-        // The same K-buffer shaded by segment: what shading segments at their ends costs.
+        // The same K-buffer shaded by segment (the default): what shading segments once costs.
         s.settings.segment_shading = true;
         let (_, by_segment) = render(ctx, luts, &s, lights);
         let e = relative_rmse(&by_segment, &reference);

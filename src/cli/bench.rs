@@ -37,10 +37,10 @@ pub struct BenchArgs {
     /// Single scattering only.
     #[arg(long)]
     pub single_scattering: bool,
-    /// Shade each visible segment once (its ends, its midpoint) instead of every kept K-buffer
-    /// fragment at its own point.
+    /// Shade every kept K-buffer fragment at its own point instead of each visible segment once
+    /// (the default).
     #[arg(long)]
-    pub segment_shading: bool,
+    pub per_fragment: bool,
     /// Keep the fiber-density volume and shadow grid between frames (what a parameter or camera
     /// edit costs); by default they are rebuilt every frame, as when geometry moves, so they are timed.
     #[arg(long)]
@@ -83,10 +83,11 @@ struct SceneReport {
     gpu_ms_total_min: f64,
     /// Wall-clock milliseconds from submit to read-back, median.
     wall_ms_median: f64,
-    /// Whether the frame shaded its visible segments (`--segment-shading`) or every kept fragment.
+    /// Whether the frame shaded its visible segments (the default) or every kept fragment
+    /// (`--per-fragment`).
     segment_shading: bool,
-    /// Points shaded per frame: each pixel's kept K-buffer fragments, or each visible segment's two
-    /// ends (single scattering) and with multiple scattering its midpoint.
+    /// Points shaded per frame: each pixel's kept K-buffer fragments, or each visible segment's
+    /// midpoint (one response per light, its transmittance read at the ends and the midpoint).
     shaded_points: usize,
     /// Kept fragments with a weight, and the distinct segments among them.
     fragments: usize,
@@ -324,7 +325,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             height: scene.height,
             shadows: !args.no_shadows,
             multiple_scattering: !args.single_scattering,
-            segment_shading: args.segment_shading,
+            segment_shading: !args.per_fragment,
             ..Default::default()
         };
         let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
@@ -367,7 +368,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             }
         }
         // The points the shading pass shades: each pixel's kept fragments, or each visible
-        // segment's two ends.
+        // segment's midpoint.
         let frame = renderer.read_frame(&ctx)?;
         let kept = (0..frame.pixel_count())
             .flat_map(|i| frame.kept_fragments(i).iter().filter(|f| f.weight > 0.0));
@@ -377,7 +378,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             .collect::<std::collections::HashSet<_>>()
             .len();
         let shaded_points = if renderer.shades_segments() {
-            (2 + usize::from(!args.single_scattering)) * visible_segments
+            visible_segments
         } else {
             fragments
         };
@@ -480,7 +481,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             segments: hair.point_count() - hair.strand_count(),
             shadows: !args.no_shadows,
             multiple_scattering: !args.single_scattering,
-            segment_shading: args.segment_shading,
+            segment_shading: !args.per_fragment,
             frames: args.frames,
             cpu_seconds: cpu,
             gpu_ms_median: per_pass.into_iter().map(|(k, v)| (k, median(v))).collect(),

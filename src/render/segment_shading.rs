@@ -1,7 +1,7 @@
 //! Segment shading, the frame's (`claim_segments`, `segment_dispatch`, `shade_segments` and
 //! `gather_segments` of `shaders/shading.wgsl`): per light batch, the visible segments of the rows'
-//! kept K-buffer fragments are listed once, each is shaded (single scattering at its two ends,
-//! multiple scattering at its midpoint), and once every batch has shaded them the rows' pixels gather
+//! kept K-buffer fragments are listed once, each is shaded (single scattering at its two ends and
+//! its midpoint, multiple scattering at its midpoint), and once every batch has shaded them the rows' pixels gather
 //! their fragments' radiance, single scattering interpolated along each segment. The per-fragment pass
 //! ([`super::shading`]) shades the preview, whose fragments are mostly of different segments, the
 //! frame without `RenderSettings::segment_shading` (the default), a view in which a segment subtends
@@ -12,9 +12,12 @@ use super::shading::{ShadeBatch, ShadingInputs};
 use super::targets::FrameTargets;
 use crate::gpu::context::{bind_entries as bind, compute_pipeline};
 
-/// Bytes of a single-scattering component's radiance per segment (two ends, RGBA f32); a
-/// multiple-scattering component's is half (the midpoint's).
-pub const RADIANCE_BYTES_PER_SEGMENT: u64 = 32;
+/// Samples of single scattering along a segment: its ends and its midpoint (t = 0, 1/2, 1).
+pub const SINGLE_SAMPLES: u64 = 3;
+
+/// Bytes of a single-scattering component's radiance per segment (three samples, RGBA f32); a
+/// multiple-scattering component's is a third (the midpoint's).
+pub const RADIANCE_BYTES_PER_SEGMENT: u64 = 16 * SINGLE_SAMPLES;
 
 /// The per-segment buffers (sized by the hair's segments, not by the image).
 pub struct SegmentTargets {
@@ -25,8 +28,8 @@ pub struct SegmentTargets {
     pub work_list: wgpu::Buffer,
     /// `shade_segments`' indirect dispatch.
     pub work_args: wgpu::Buffer,
-    /// R, TT, TRT at each segment's two ends (index 2 segment + end), MS.global and MS.local at its
-    /// midpoint (index segment). Written by a frame's first light batch, added to by the others.
+    /// R, TT, TRT at each segment's t = 0, 1/2, 1 (index 3 segment + 2 t), MS.global and MS.local
+    /// at its midpoint (index segment). Written by a frame's first light batch, added to by the others.
     pub radiance: [wgpu::Buffer; 5],
 }
 
@@ -53,10 +56,10 @@ impl SegmentTargets {
             work_list: buffer("segment work list", 4 * n, none),
             work_args: buffer("segment dispatch", 12, wgpu::BufferUsages::INDIRECT),
             radiance: std::array::from_fn(|c| {
-                let ends = if c < 3 { 2 } else { 1 };
+                let samples = if c < 3 { SINGLE_SAMPLES } else { 1 };
                 buffer(
                     super::targets::COMPONENTS[c],
-                    n * RADIANCE_BYTES_PER_SEGMENT / 2 * ends,
+                    n * RADIANCE_BYTES_PER_SEGMENT / SINGLE_SAMPLES * samples,
                     none,
                 )
             }),

@@ -192,6 +192,49 @@ pub fn shade_point(
     out
 }
 
+/// Single scattering of a segment at its samples t = 0, 1/2, 1, per sample per lobe (R, TT, TRT).
+pub type SegmentSingle = [[Rgb; 3]; 3];
+
+/// `shade_segment_single` of the WGSL: a segment's single scattering at t = 0, 1/2, 1 towards omega_o,
+/// each light's response once at the midpoint `mid` (its tangent, absorption and view), scaled by the
+/// light's transmittance at each sample (`ends`: the segment's points).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_segment_single(
+    luts: &Luts,
+    table: &AzimuthalTable,
+    params: &FastHairParams,
+    mid: &ShadingPoint,
+    ends: [Vec3; 2],
+    omega_o: Vec3,
+    lights: &[SrbfLight],
+    shadows: Option<GridShadows>,
+) -> SegmentSingle {
+    let mut p = *params;
+    p.sigma_a = [mid.sigma_a[0], mid.sigma_a[1], mid.sigma_a[2], 0.0];
+    let frame = fiber_frame(mid.tangent);
+    let (theta_o, phi_o) = fiber_angles(frame, omega_o);
+    let at = [ends[0], mid.position, ends[1]];
+    let mut out = [[[0.0; 3]; 3]; 3];
+    for (li, l) in lights.iter().enumerate() {
+        let (theta, phi) = fiber_angles(frame, l.dir().normalize().as_vec3());
+        let light = SrbfInFrame {
+            theta,
+            phi,
+            lambda: l.lambda as f32,
+        };
+        let m = srbf_response(luts, table, &p, light, theta_o, phi_o);
+        for (s, x) in at.iter().enumerate() {
+            let t = shadows.map_or(1.0, |g| g.shadow(*x, li).transmittance);
+            for lobe in 0..3 {
+                for c in 0..3 {
+                    out[s][lobe][c] += t * (l.rgb[c] as f32 * m[lobe][c]);
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Whether a resolved sample id names a hair segment (segment + 1; not 0, not the occluder's).
 pub fn is_hair(id: u32) -> bool {
     id != 0 && id & super::occluder::OCCLUDER_ID_BIT == 0
@@ -288,8 +331,8 @@ pub fn shade_pixels(
     )
 }
 
-/// Single scattering at t between a segment's ends (twin of `between_ends`): log-linear where both
-/// ends are positive (a light's transmittance falls off exponentially into the hair), else linear.
+/// Single scattering at t between two samples (twin of `between_ends`): log-linear where both are
+/// positive (a light's transmittance falls off exponentially into the hair), else linear.
 pub fn between_ends(a: f32, b: f32, t: f32) -> f32 {
     if a > 0.0 && b > 0.0 {
         (a.max(1e-30).ln() * (1.0 - t) + b.max(1e-30).ln() * t).exp()
@@ -298,22 +341,31 @@ pub fn between_ends(a: f32, b: f32, t: f32) -> f32 {
     }
 }
 
+/// Single scattering at t along a segment from its samples a, m, b at t = 0, 1/2, 1 (twin of
+/// `between_samples`): [`between_ends`] on each half. A sum of lights each exponential along the
+/// segment is log-convex, so one log-linear piece over the whole segment overstates it.
+pub fn between_samples(a: f32, m: f32, b: f32, t: f32) -> f32 {
+    if t < 0.5 {
+        between_ends(a, m, 2.0 * t)
+    } else {
+        between_ends(m, b, 2.0 * t - 1.0)
+    }
+}
+
 /// The frame's segment shading on the CPU (twin of `shade_segments` and `gather_segments`): for each
 /// pixel of `pixels`, every kept fragment's weight times its segment's radiance: single scattering
-/// (R, TT, TRT) between the segment's ends at the fragment's point ([`between_ends`]), multiple scattering that of
-/// its midpoint; each point shaded by `shade` towards the eye.
+/// (R, TT, TRT) from `single` (`shade_segment_single` with the segment's midpoint, its ends and the
+/// direction to the eye) between its samples at the fragment's point ([`between_samples`]), multiple
+/// scattering that of its midpoint by `multiple` towards the eye.
 pub fn shade_pixels_by_segment(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
-    shade: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
+    single: impl Fn(&ShadingPoint, [Vec3; 2], Vec3) -> SegmentSingle + Sync,
+    multiple: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
 ) -> Vec<LobeRadiance> {
     let eye = Vec3::from(camera.eye);
-    let at = |seg, t| {
-        let sp = hair.segment_point(seg, t);
-        shade(&sp, (eye - sp.position).normalize())
-    };
     let k = frame.fragments_per_pixel as usize;
     pixels
         .par_iter()
@@ -330,13 +382,16 @@ pub fn shade_pixels_by_segment(
                 let i0 = hair.segments[seg as usize] as usize;
                 let (a, b) = (hair.hair.positions[i0], hair.hair.positions[i0 + 1]);
                 let t = closest_on_segment(origin, dir, a, b);
-                let (l0, l1, mid) = (at(seg, 0.0), at(seg, 1.0), at(seg, 0.5));
+                let mid = hair.segment_point(seg, 0.5);
+                let omega_o = (eye - mid.position).normalize();
+                let ss = single(&mid, [a, b], omega_o);
+                let ms = multiple(&mid, omega_o);
                 let w = weight as f32;
                 for c in 0..5 {
                     for ch in 0..3 {
                         acc[c][ch] += w * match c {
-                            0..=2 => between_ends(l0[c][ch], l1[c][ch], t),
-                            _ => mid[c][ch],
+                            0..=2 => between_samples(ss[0][c][ch], ss[1][c][ch], ss[2][c][ch], t),
+                            _ => ms[c][ch],
                         };
                     }
                 }
