@@ -125,21 +125,16 @@ fn trt_root_term(eta: f32, cos_d: f32, eta_p: f32, sigma_p: vec3<f32>, h: f32) -
     return (1.0 - f) * (1.0 - f) * f * t * t / (2.0 * max(d, 1e-6));
 }
 
+// The root h_2 of 2 asin(h/eta') = asin(h) for sqrt(2) < eta' < 2, closed form (trt_zero_root in Rust).
+fn trt_zero_root(eta_p: f32) -> f32 {
+    return min(eta_p * sqrt(max(1.0 - 0.25 * eta_p * eta_p, 0.0)), 1.0);
+}
+
 // N_TRT(0), the full root sum.
 fn trt_value_at_zero(eta: f32, cos_d: f32, eta_p: f32, sigma_p: vec3<f32>) -> vec3<f32> {
     var n = trt_root_term(eta, cos_d, eta_p, sigma_p, 0.0);
     if (eta_p > SQRT_2 && eta_p < 2.0) {
-        var lo = sqrt((4.0 - eta_p * eta_p) / 3.0);
-        var hi = 1.0;
-        for (var it = 0; it < 24; it++) {
-            let mid = 0.5 * (lo + hi);
-            if (2.0 * asin_precise(mid / eta_p) - asin_precise(mid) > 0.0) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        n = n + 2.0 * trt_root_term(eta, cos_d, eta_p, sigma_p, 0.5 * (lo + hi));
+        n = n + 2.0 * trt_root_term(eta, cos_d, eta_p, sigma_p, trt_zero_root(eta_p));
     }
     return n;
 }

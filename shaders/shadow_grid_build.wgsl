@@ -51,14 +51,15 @@ struct SweepDirection {
     behind: bool,
 }
 
-// The light's sweeps (sweep_directions in sweep.rs): srbf_cones' directions with their weights (one
-// of weight 1 when the inner half of G is narrower than 0.05 rad, else the centre (1/2) and six on the
-// ring (1/12 each)), then with multiple scattering the centre reversed.
+// The light's sweeps (sweep_directions in sweep.rs): srbf_cones_on_ring's directions with their weights
+// (one of weight 1 when the inner half of G is narrower than 0.05 rad, else the centre (1/2) and
+// SWEEP_RING on the ring (1/6 each)), then with multiple scattering the centre reversed.
+const SWEEP_RING: u32 = 3u;
 fn sweep_direction_count(lambda: f32, forward: bool) -> u32 {
     let kappa = 2.0 / (lambda * lambda);
     let e = exp(-2.0 * kappa);
     let inner = acos(clamp(1.0 + log(0.5 * (1.0 - e) + e) / kappa, -1.0, 1.0));
-    return select(7u, 1u, inner < 0.05) + select(0u, 1u, forward);
+    return select(1u + SWEEP_RING, 1u, inner < 0.05) + select(0u, 1u, forward);
 }
 
 fn sweep_direction(centre: vec3<f32>, lambda: f32, j: u32, count: u32, forward: bool) -> SweepDirection {
@@ -78,8 +79,8 @@ fn sweep_direction(centre: vec3<f32>, lambda: f32, j: u32, count: u32, forward: 
     var e1 = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(centre.x) < 0.9);
     e1 = normalize(e1 - centre * dot(centre, e1));
     let e2 = cross(centre, e1);
-    let a = f32(j - 1u) * TAU / 6.0;
-    return SweepDirection(normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring)), 0.5 / 6.0, false);
+    let a = f32(j - 1u) * TAU / f32(SWEEP_RING);
+    return SweepDirection(normalize(centre * cos(ring) + (e1 * cos(a) + e2 * sin(a)) * sin(ring)), 0.5 / f32(SWEEP_RING), false);
 }
 
 // SweepAxes in sweep.rs: slices across axis a (omega's largest component, ties to the lower axis),
@@ -203,10 +204,10 @@ fn finish(e: u32, g: ShadowGridInfo) {
     shadow_values[2u * e + 1u] = vec4<f32>(v1.xyz / max(v0.yzw - vec3<f32>(v0.x), vec3<f32>(1e-12)), behind);
 }
 
-// A light's sweeps are slots 0-7 of its entries: 0 the centre, 1-6 the ring (empty for a narrow
-// light), 7 the centre reversed (empty without multiple scattering), after which its entries are
+// A light's sweeps are slots 0-4 of its entries: 0 the centre, 1-3 the ring (empty for a narrow
+// light), 4 the centre reversed (empty without multiple scattering), after which its entries are
 // finished. A unit of refinement may hold part of a light's slots.
-const SWEEP_SLOTS: u32 = 8u;
+const SWEEP_SLOTS: u32 = 2u + SWEEP_RING;
 
 // The slot's direction, or none (weight 0) for an empty slot.
 fn slot_direction(l: GpuLight, slot: u32, forward: bool) -> SweepDirection {
@@ -296,6 +297,8 @@ fn build_shadow_grid(
         let sa = strides[ax.a];
         let sb = strides[ax.b];
         let sc = strides[ax.c];
+        // Whether the path carries the forward-scattering terms (the depth behind reads tau alone).
+        let carried = forward && !d.behind;
         let x0 = g.origin + vec3<f32>(0.5 * g.spacing) + d.omega * (0.5 * ax.step);
         for (var i = 0u; i < na; i++) {
             let k = select(i, na - 1u - i, ax.towards_high);
@@ -309,24 +312,26 @@ fn build_shadow_grid(
                 let ib = q - ic * nb;
                 var up = path_zero();
                 if (i > 0u) {
-                    up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, forward);
+                    up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, carried);
                 }
                 let p = k * sa + ib * sb + ic * sc;
                 let x = x0 + f32(k) * ea + f32(ib) * eb + f32(ic) * ec;
                 var f = path_zero();
-                if (forward) {
+                if (carried) {
                     f = forward_integrand(x, d.omega, lod);
-                    // The depth behind counts hair only: the head's solid is not fibres that
-                    // scatter light back (`sweep` in sweep.rs, `behind`).
+                } else {
                     let v = forward_voxel_at(x);
-                    if (d.behind && v >= 0) {
-                        f.tau = f.tau * (1.0 - volume[3u * u32(v) + 2u].w);
+                    if (v >= 0) {
+                        // Zero outside the volume, as forward_integrand.
+                        f.tau = crossings_at(x, d.omega, lod);
+                        // The depth behind counts hair only: the head's solid is not fibres that
+                        // scatter light back (`sweep` in sweep.rs, `behind`).
+                        if (d.behind) {
+                            f.tau = f.tau * (1.0 - volume[3u * u32(v) + 2u].w);
+                        }
                     }
-                } else if (forward_voxel_at(x) >= 0) {
-                    // Zero outside the volume, as forward_integrand.
-                    f.tau = crossings_at(x, d.omega, lod);
                 }
-                scratch_store(cur, q, path_add_scaled(up, f, ax.step), forward);
+                scratch_store(cur, q, path_add_scaled(up, f, ax.step), carried);
                 accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
             }
             storageBarrier();

@@ -231,28 +231,34 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
             segment_shading: true,
             ..s.settings.clone()
         };
-        let (segment_renderer, segment_frame) = render_with(&ctx, &luts, &s, settings, &lights);
+        let (mut segment_renderer, segment_frame) = render_with(&ctx, &luts, &s, settings, &lights);
         assert!(segment_renderer.shades_segments());
         twin(&segment_frame, &cam, true, "frame (shaded by segment)");
-        // The preview (half resolution, its four fragments a pixel), after a change.
-        renderer.set_preview(PreviewMode::Fixed(2));
-        renderer.set_camera(&ctx, &s.camera);
-        loop {
-            let p = renderer.refine(&ctx).expect("refine");
-            if p.ready == Some(ImageReady::Preview) {
-                break;
+        // The preview (half resolution, its four fragments a pixel), after a change: shaded as the
+        // frame is, per fragment or by segment.
+        for (r, by_segment) in [(&mut renderer, false), (&mut segment_renderer, true)] {
+            r.set_preview(PreviewMode::Fixed(2));
+            r.set_camera(&ctx, &s.camera);
+            loop {
+                let p = r.refine(&ctx).expect("refine");
+                if p.ready == Some(ImageReady::Preview) {
+                    break;
+                }
+                assert!(!p.converged, "no preview");
+                ctx.device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .expect("poll");
             }
-            assert!(!p.converged, "no preview");
-            ctx.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .expect("poll");
+            let (preview, preview_cam) =
+                r.read_preview(&ctx).expect("read back").expect("a preview");
+            assert_eq!((preview.width, preview.height), (32, 24));
+            let what = if by_segment {
+                "preview (shaded by segment)"
+            } else {
+                "preview"
+            };
+            twin(&preview, &preview_cam, by_segment, what);
         }
-        let (preview, preview_cam) = renderer
-            .read_preview(&ctx)
-            .expect("read back")
-            .expect("a preview");
-        assert_eq!((preview.width, preview.height), (32, 24));
-        twin(&preview, &preview_cam, false, "preview");
     }
 }
 

@@ -10,7 +10,7 @@ use super::frame::Frame;
 use super::kbuffer::Tail;
 use super::renderer::{RenderError, Renderer};
 use super::shading::{
-    FLAG_MULTIPLE_SCATTERING, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
+    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
 };
 use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
@@ -195,7 +195,11 @@ impl Renderer {
     }
 
     /// Encodes preview rows [row0, row0 + rows) (the first unit clears the preview's components):
-    /// every light batch, then the rows' resolve.
+    /// every light batch, then the rows' resolve. Shaded as the frame is: by segment when the frame
+    /// shades segments (a segment's shading does not depend on the image's resolution, only on the
+    /// eye), in the frame's segment buffers, whose markers the first unit clears (the frame's
+    /// visibility unit clears them again before the frame shades); else per fragment, one dispatch
+    /// per K-buffer slot.
     pub(super) fn encode_preview(
         &self,
         ctx: &GpuContext,
@@ -207,11 +211,13 @@ impl Renderer {
             return;
         };
         let device = &ctx.device;
+        let segments = self.segment_targets.as_ref().filter(|_| self.by_segment);
         if row0 == 0 {
-            ShadingPass::clear(enc, &p.targets, None);
+            ShadingPass::clear(enc, &p.targets, segments);
         }
         let inputs = ShadingInputs {
             camera: &p.camera,
+            segment_targets: segments,
             ..self.shading_inputs()
         };
         let batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
@@ -229,7 +235,15 @@ impl Renderer {
             if self.settings.multiple_scattering {
                 flags |= FLAG_MULTIPLE_SCATTERING;
             }
-            for slot in 0..PREVIEW_FRAGMENTS {
+            if segments.is_some() {
+                flags |= FLAG_SEGMENTS;
+            }
+            let slots = if segments.is_some() {
+                1
+            } else {
+                PREVIEW_FRAGMENTS
+            };
+            for slot in 0..slots {
                 let batch = ShadeBatch {
                     first,
                     count,

@@ -97,9 +97,10 @@ pub struct ShadowGridInputs<'a> {
     pub light_group: u32,
 }
 
-/// Entries of a light in the build: its sweeps' slots (the centre, six on the ring, the centre
-/// reversed), some empty (`slot_direction` in `shaders/shadow_grid_build.wgsl`).
-pub const SWEEP_SLOTS: u32 = 8;
+/// Entries of a light in the build: its sweeps' slots (the centre, three on the ring,
+/// [`crate::shadow::sweep::SWEEP_RING`], the centre reversed), some empty (`slot_direction` in
+/// `shaders/shadow_grid_build.wgsl`).
+pub const SWEEP_SLOTS: u32 = 2 + crate::shadow::sweep::SWEEP_RING;
 
 pub struct ShadowGridPass {
     pipeline: wgpu::ComputePipeline,

@@ -260,22 +260,18 @@ fn trt_root_term(eta: f32, cos_d: f32, eta_p: f32, sigma_p: Rgb32, h: f32) -> Rg
     })
 }
 
-/// N_TRT(0), the full root sum: h = 0, and +-h_2 with 2 asin(h_2/eta') = asin(h_2) when eta' > sqrt(2).
+/// The root h_2 in (0, 1] of 2 asin(h/eta') = asin(h) for sqrt(2) < eta' < 2 (TRT's outgoing azimuth
+/// 0 away from h = 0), in closed form: with gamma_t = asin(h/eta') <= pi/4 (true for eta' >= sqrt(2)),
+/// sin(2 gamma_t) = h gives 2 (h/eta') sqrt(1 - h^2/eta'^2) = h, so h_2 = eta' sqrt(1 - eta'^2/4).
+pub fn trt_zero_root(eta_p: f32) -> f32 {
+    (eta_p * (1.0 - 0.25 * eta_p * eta_p).max(0.0).sqrt()).min(1.0)
+}
+
+/// N_TRT(0), the full root sum: h = 0, and +-h_2 ([`trt_zero_root`]) when eta' > sqrt(2).
 pub fn trt_value_at_zero(eta: f32, cos_d: f32, eta_p: f32, sigma_p: Rgb32) -> Rgb32 {
     let mut n = trt_root_term(eta, cos_d, eta_p, sigma_p, 0.0);
     if eta_p > SQRT_2 && eta_p < 2.0 {
-        // g(h) = 2 asin(h/eta') - asin(h): positive at the caustic h_c, negative at h = 1.
-        let g = |h: f32| 2.0 * asin_precise(h / eta_p) - asin_precise(h);
-        let (mut lo, mut hi) = (((4.0 - eta_p * eta_p) / 3.0).sqrt(), 1.0f32);
-        for _ in 0..24 {
-            let mid = 0.5 * (lo + hi);
-            if g(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let extra = trt_root_term(eta, cos_d, eta_p, sigma_p, 0.5 * (lo + hi));
+        let extra = trt_root_term(eta, cos_d, eta_p, sigma_p, trt_zero_root(eta_p));
         for c in 0..3 {
             n[c] += 2.0 * extra[c];
         }
@@ -402,6 +398,30 @@ mod tests {
     use super::*;
     use crate::scattering::marschner::AzimuthalLobe;
     use crate::scattering::{CausticModel, HairParams, Lobe, ModelVariant};
+
+    /// The closed-form root of 2 asin(h/eta') = asin(h) against bisection of the same equation (the
+    /// way it was found before): g(h_c) > 0 at the caustic, g(1) < 0.
+    #[test]
+    fn trt_zero_root_solves_its_equation() {
+        use crate::scattering::circular_gaussian::asin_precise;
+        let mut worst = 0.0f32;
+        for k in 1..400 {
+            let eta_p = SQRT_2 + (2.0 - SQRT_2) * k as f32 / 400.0;
+            let g = |h: f32| 2.0 * asin_precise(h / eta_p) - asin_precise(h);
+            let (mut lo, mut hi) = (((4.0 - eta_p * eta_p) / 3.0).sqrt(), 1.0f32);
+            for _ in 0..40 {
+                let mid = 0.5 * (lo + hi);
+                if g(mid) > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            worst = worst.max((trt_zero_root(eta_p) - 0.5 * (lo + hi)).abs());
+        }
+        println!("closed-form TRT root against bisection: worst {worst:.2e}");
+        assert!(worst < 1e-5, "{worst}");
+    }
 
     #[test]
     fn kappa_inversion_recovers_the_energy() {

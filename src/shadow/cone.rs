@@ -262,6 +262,12 @@ pub fn srbf_centre_cone(lambda: f32) -> f32 {
 /// half-angle max(inner, 1e-4) when the inner half of G is narrower than 0.05 rad, else the central cone
 /// (weight 1/2) and six on the ring (1/12 each).
 pub fn srbf_cones(centre: Vec3, lambda: f32) -> Vec<(Vec3, f32, f32)> {
+    srbf_cones_on_ring(centre, lambda, 6)
+}
+
+/// [`srbf_cones`] with `ring` cones on the ring (weight 1/(2 ring) each; the shadow grid's sweeps take
+/// three, [`super::sweep::SWEEP_RING`]).
+pub fn srbf_cones_on_ring(centre: Vec3, lambda: f32, ring_cones: u32) -> Vec<(Vec3, f32, f32)> {
     let kappa = 2.0 / (lambda * lambda);
     let e = (-2.0 * kappa).exp();
     let quantile = |q: f32| (1.0 + (q * (1.0 - e) + e).ln() / kappa).clamp(-1.0, 1.0);
@@ -277,12 +283,13 @@ pub fn srbf_cones(centre: Vec3, lambda: f32) -> Vec<(Vec3, f32, f32)> {
     };
     let e1 = (e1 - centre * centre.dot(e1)).normalize();
     let e2 = centre.cross(e1);
-    let sub = (ring * std::f32::consts::PI / 6.0).min(ring);
+    let n = ring_cones.max(1) as f32;
+    let sub = (ring * std::f32::consts::PI / n).min(ring);
     let mut cones = vec![(centre, inner, 0.5)];
-    for k in 0..6 {
-        let a = k as f32 * std::f32::consts::TAU / 6.0;
+    for k in 0..ring_cones {
+        let a = k as f32 * std::f32::consts::TAU / n;
         let d = (centre * ring.cos() + (e1 * a.cos() + e2 * a.sin()) * ring.sin()).normalize();
-        cones.push((d, sub, 0.5 / 6.0));
+        cones.push((d, sub, 0.5 / n));
     }
     cones
 }
