@@ -1,8 +1,8 @@
 // Shading pass (Xu 2011 Sec. 5): hair points are shaded under one batch of up to 16 SRBF lights with the fast per-SRBF response (R, TT, TRT), each light
 // scaled by its transmittance (swept through the fiber-density pyramid at the points of the shadow
 // grid, read trilinearly), and accumulated per lobe weighted by the fragments' composite weights
-// (kbuffer.wgsl): per fragment (`shade`: the preview, and the frame with per-fragment shading) or per
-// visible segment (`claim_segments` .. `gather_segments` below: the frame). Twin of
+// (kbuffer.wgsl): per visible segment (`claim_segments` .. `gather_segments` below: the default, for
+// the frame and its preview) or per fragment (`shade`). Twin of
 // src/render/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
@@ -33,7 +33,7 @@ const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
 @group(0) @binding(18) var<storage, read> fragments: array<vec2<u32>>;
 @group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
-// Segment shading (the frame's: see `claim_segments`).
+// Segment shading (see `claim_segments`).
 @group(0) @binding(20) var<storage, read_write> segment_batches: array<atomic<u32>>;
 @group(0) @binding(21) var<storage, read_write> work_count: array<atomic<u32>>;
 @group(0) @binding(22) var<storage, read_write> work_list: array<u32>;
@@ -149,7 +149,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     aov_ms_local[pixel] = aov_ms_local[pixel] + vec4<f32>(w * l.ms_local, 0.0);
 }
 
-// Segment shading (the frame's; twin: src/render/shade.rs, `shade_pixels_by_segment`). A segment's
+// Segment shading (twin: src/render/shade.rs, `shade_pixels_by_segment`). A segment's
 // shading point moves along it from pixel to pixel, but its tangent, the lights and (nearly) the view
 // direction do not: each visible segment is shaded once per light batch. Its single scattering
 // response to each light is evaluated once, at its midpoint, and weighted by the light's
@@ -168,19 +168,28 @@ fn segment_point(seg: u32, t: f32) -> ShadingPoint {
 }
 
 // Single scattering of a segment at t = 0, 1/2, 1 (`[0]`, `[1]`, `[2]`) towards omega_o from lights
-// [first, first + count): each light's response (R, TT, TRT) once at the midpoint `mid` (its tangent,
-// absorption and view), scaled by the light's transmittance at each sample (`ends`: the segment's
-// points). Where the light's transmittance falls steeply along the segment, into the hair's shadow,
-// the three samples follow it; the response itself changes by the few degrees the segment subtends.
+// [first, first + count): each light's response (R, TT, TRT) at the midpoint `mid` (its tangent and
+// view), scaled by the light's transmittance at each sample (`a`, `b`: the segment's ends, their
+// positions and absorption). Where the light's transmittance falls steeply along the segment, into
+// the hair's shadow, the three samples follow it; the response itself changes by the few degrees the
+// segment subtends. One response per light where the two ends' absorption is the same (unpainted
+// hair, a uniform dye); where it differs (a painted edge, a gradient) one at each end's absorption, the
+// midpoint's between them (log-linear: the absorption attenuates exponentially), so paint keeps its
+// gradient along the segment.
 struct SegmentSingle {
-    r: array<vec3<f32>, 3>,
-    tt: array<vec3<f32>, 3>,
-    trt: array<vec3<f32>, 3>,
+    r: array<vec3<f32>, SINGLE_SAMPLES>,
+    tt: array<vec3<f32>, SINGLE_SAMPLES>,
+    trt: array<vec3<f32>, SINGLE_SAMPLES>,
 }
 
-fn shade_segment_single(mid: ShadingPoint, a: vec3<f32>, b: vec3<f32>, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool) -> SegmentSingle {
-    var p = params;
-    p.sigma_a = vec4<f32>(mid.sigma_a, 0.0);
+const SINGLE_SAMPLES: u32 = 3u;
+
+fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, shadows: bool) -> SegmentSingle {
+    var pa = params;
+    pa.sigma_a = vec4<f32>(a.sigma_a, 0.0);
+    var pb = params;
+    pb.sigma_a = vec4<f32>(b.sigma_a, 0.0);
+    let painted = any(a.sigma_a != b.sigma_a);
     let frame = fiber_frame(mid.tangent);
     let o = fiber_angles(frame, omega_o);
     let zero = vec3<f32>(0.0);
@@ -192,15 +201,23 @@ fn shade_segment_single(mid: ShadingPoint, a: vec3<f32>, b: vec3<f32>, omega_o: 
         let ang = fiber_angles(frame, l.direction);
         var t = vec3<f32>(1.0);
         if (shadows) {
-            t = vec3<f32>(grid_shadow(shadow_grid, a, j).transmittance, grid_shadow(shadow_grid, mid.position, j).transmittance, grid_shadow(shadow_grid, b, j).transmittance);
+            t = vec3<f32>(grid_shadow(shadow_grid, a.position, j).transmittance, grid_shadow(shadow_grid, mid.position, j).transmittance, grid_shadow(shadow_grid, b.position, j).transmittance);
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
-        let r = l.rgb * srbf_response_lobe(p, 0u, light, o.x, o.y);
-        let tt = l.rgb * srbf_response_lobe(p, 1u, light, o.x, o.y);
-        let trt = l.rgb * srbf_response_lobe(p, 2u, light, o.x, o.y);
-        r0 = r0 + t.x * r; r1 = r1 + t.y * r; r2 = r2 + t.z * r;
-        tt0 = tt0 + t.x * tt; tt1 = tt1 + t.y * tt; tt2 = tt2 + t.z * tt;
-        trt0 = trt0 + t.x * trt; trt1 = trt1 + t.y * trt; trt2 = trt2 + t.z * trt;
+        let ra = l.rgb * srbf_response_lobe(pa, 0u, light, o.x, o.y);
+        let tta = l.rgb * srbf_response_lobe(pa, 1u, light, o.x, o.y);
+        let trta = l.rgb * srbf_response_lobe(pa, 2u, light, o.x, o.y);
+        var rb = ra;
+        var ttb = tta;
+        var trtb = trta;
+        if (painted) {
+            rb = l.rgb * srbf_response_lobe(pb, 0u, light, o.x, o.y);
+            ttb = l.rgb * srbf_response_lobe(pb, 1u, light, o.x, o.y);
+            trtb = l.rgb * srbf_response_lobe(pb, 2u, light, o.x, o.y);
+        }
+        r0 = r0 + t.x * ra; r1 = r1 + t.y * between_ends(ra, rb, 0.5); r2 = r2 + t.z * rb;
+        tt0 = tt0 + t.x * tta; tt1 = tt1 + t.y * between_ends(tta, ttb, 0.5); tt2 = tt2 + t.z * ttb;
+        trt0 = trt0 + t.x * trta; trt1 = trt1 + t.y * between_ends(trta, trtb, 0.5); trt2 = trt2 + t.z * trtb;
     }
     return SegmentSingle(array(r0, r1, r2), array(tt0, tt1, tt2), array(trt0, trt1, trt2));
 }
@@ -256,10 +273,9 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     if (i < n) {
         let seg = work_list[i];
         let mid = segment_point(seg, 0.5);
-        let i0 = segments[seg];
-        let l = shade_segment_single(mid, points[i0].xyz, points[i0 + 1u].xyz, normalize(camera.eye - mid.position), batch.first, batch.count, shadows);
-        for (var s = 0u; s < 3u; s++) {
-            let k = 3u * seg + s;
+        let l = shade_segment_single(mid, segment_point(seg, 0.0), segment_point(seg, 1.0), normalize(camera.eye - mid.position), batch.first, batch.count, shadows);
+        for (var s = 0u; s < SINGLE_SAMPLES; s++) {
+            let k = SINGLE_SAMPLES * seg + s;
             segment_r[k] = select(segment_r[k], vec4<f32>(0.0), restart) + vec4<f32>(l.r[s], 0.0);
             segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt[s], 0.0);
             segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
@@ -318,7 +334,7 @@ fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             let seg = f.x - 1u;
             let i0 = segments[seg];
             let t = closest_on_segment(ray.origin, ray.dir, points[i0].xyz, points[i0 + 1u].xyz);
-            let k = 3u * seg;
+            let k = SINGLE_SAMPLES * seg;
             out.r = out.r + w * between_samples(segment_r[k].xyz, segment_r[k + 1u].xyz, segment_r[k + 2u].xyz, t);
             out.tt = out.tt + w * between_samples(segment_tt[k].xyz, segment_tt[k + 1u].xyz, segment_tt[k + 2u].xyz, t);
             out.trt = out.trt + w * between_samples(segment_trt[k].xyz, segment_trt[k + 1u].xyz, segment_trt[k + 2u].xyz, t);

@@ -75,10 +75,32 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 ty.name
             );
         }
+        // Constants the Rust side mirrors (counts that size buffers and units of work).
+        for (_, c) in module.constants.iter() {
+            let expected = match c.name.as_deref() {
+                Some("SWEEP_RING") => strandlight::shadow::sweep::SWEEP_RING,
+                Some("SWEEP_SLOTS") => strandlight::render::shadow_grid::SWEEP_SLOTS,
+                Some("SINGLE_SAMPLES") => {
+                    strandlight::render::segment_shading::SINGLE_SAMPLES as u32
+                }
+                _ => continue,
+            };
+            seen.insert(c.name.clone().unwrap_or_default());
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => {
+                    assert_eq!(v, expected, "{name}: WGSL {:?} vs Rust", c.name)
+                }
+                ref other => panic!("{name}: {:?} is {other:?}", c.name),
+            }
+        }
         println!("{name}: {} lines valid", source.lines().count());
     }
-    println!("struct layouts compared: {seen:?}");
-    assert_eq!(seen.len(), 15, "every shared struct was found and compared");
+    println!("struct layouts and constants compared: {seen:?}");
+    assert_eq!(
+        seen.len(),
+        18,
+        "every shared struct and constant was found and compared"
+    );
 }
 
 fn queries(n: usize) -> Vec<FastQuery> {

@@ -223,7 +223,7 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
         );
         let t_ref = t.elapsed().as_secs_f64();
         // The same frame shaded by segment (`segment_shading`, the default).
-        let by_segment = common::render_uniform(
+        let (by_segment, shaded_by_segment) = common::render_uniform_shaded(
             &ctx,
             &RenderSettings {
                 segment_shading: true,
@@ -235,6 +235,7 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
             std::slice::from_ref(&light),
             &camera,
         );
+        assert!(shaded_by_segment, "the view shades the clump per fragment");
         let component_means = |f: &Frame| -> Vec<f64> {
             let n = f.covered().count().max(1) as f64;
             (0..5)

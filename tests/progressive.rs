@@ -433,6 +433,8 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
     progressive.set_unit_budget(Duration::from_millis(10));
     progressive.set_preview(PreviewMode::Fixed(3));
     assert_eq!(progressive.preview_factor(), 3);
+    // The preview and the frame shade by segment (in the same segment buffers).
+    assert!(progressive.shades_segments());
 
     whole.render_frame(&ctx);
     let a = whole.read_frame(&ctx).expect("read");

@@ -97,6 +97,19 @@ fn render_with(
     (r, f)
 }
 
+/// A dye gradient from root to tip (absorption x0.5 to x2) on every other strand: segments whose
+/// two points' absorption differs (shaded by segment, two responses each) beside uniform ones.
+fn dye_every_other_strand(s: &mut Scene) {
+    for k in (0..s.hair.strand_count()).step_by(2) {
+        let r = s.hair.strand_range(k);
+        let n = (r.len() as f32 - 1.0).max(1.0);
+        for (j, i) in r.enumerate() {
+            let f = 0.5 + 1.5 * j as f32 / n;
+            s.sigma_a[i] = s.sigma_a[i].map(|v| v * f);
+        }
+    }
+}
+
 fn envmaps() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("envmaps")
 }
@@ -110,6 +123,9 @@ fn gpu_render_equals_the_cpu_twin_at_visible_pixels() {
     for (shadows, multiple) in [(false, false), (true, true)] {
         let mut s = scene(400, 64, 48, shadows, Preset::Blond);
         s.settings.multiple_scattering = multiple;
+        if multiple {
+            dye_every_other_strand(&mut s);
+        }
         // Every fragment at its own point first; by segment (the default) below.
         s.settings.segment_shading = false;
         let (mut renderer, frame) = render(&ctx, &luts, &s, &lights);
@@ -274,6 +290,8 @@ fn segment_shading_follows_per_fragment_shading() {
     let mut s = scene(1500, 320, 240, true, Preset::Brown);
     s.settings.multiple_scattering = true;
     s.settings.segment_shading = false;
+    // Half the strands dyed along their length: segments shaded with each end's absorption.
+    dye_every_other_strand(&mut s);
     let (by_fragment, fragments) = render(&ctx, &luts, &s, &lights);
     s.settings.segment_shading = true;
     let (by_segment, segments) = render(&ctx, &luts, &s, &lights);
@@ -353,7 +371,8 @@ fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &E
         let e_fragment = relative_rmse(&frame, &reference);
         // The same K-buffer shaded by segment (the default): what shading segments once costs.
         s.settings.segment_shading = true;
-        let (_, by_segment) = render(ctx, luts, &s, lights);
+        let (r, by_segment) = render(ctx, luts, &s, lights);
+        assert!(r.shades_segments(), "{name}: the view shades per fragment");
         let e = relative_rmse(&by_segment, &reference);
         let mean = |f: &Frame| {
             let n = f.covered().count().max(1) as f64;

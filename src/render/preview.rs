@@ -1,8 +1,9 @@
 //! The preview that progressive refinement shows right after a change: the same view at a fraction of
 //! the resolution, every light, a K-buffer of four fragments, each shaded (the rest spread over them), shadows from the
 //! grid as it stands (a light group whose entries are part-way through a rebuild is shaded
-//! unshadowed). Its own small frame targets and camera; the frame's are untouched, so the converged
-//! image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
+//! unshadowed). Its own small frame targets and camera (shaded by segment, it writes the frame's
+//! segment buffers, which the frame's visibility unit clears before the frame shades), so the
+//! converged image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
 //! preview takes about [`PREVIEW_TARGET`].
 
 use super::camera::CameraUniform;

@@ -6,10 +6,10 @@
 //! still pass the budget).
 //!
 //! The plan after a change: first, when the renderer has one ([`Renderer::set_preview`]), a preview of
-//! the change (reduced resolution, one shading per pixel, all lights, the shadow grid as it stands:
+//! the change (reduced resolution, all lights, the shadow grid as it stands:
 //! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed: its
 //! deposit in ranges of segments, whose fixed-point sums add up exactly, then its resolve), the
-//! shadow grid in ranges of sweeps (eight entries per light, one per direction; when the volume, the
+//! shadow grid in ranges of sweeps (`SWEEP_SLOTS` entries per light, one per direction; when the volume, the
 //! lights or the forward table changed), visibility in ranges of segments (the K-buffer's atomic
 //! insertion does not depend on their order; the last part composites it), then every shading batch
 //! in bands of rows: shading segments, a light batch over the segments of the band's pixels it has
@@ -331,14 +331,18 @@ impl Refinement {
     }
 
     /// A finished preview (at divisor `factor`, `lights` lights) gives the first-sample bands the
-    /// cost of the rows not measured yet: a preview row costs what `factor` frame rows of its width
-    /// under every light do, so a frame row costs about its preview row's cost times `factor` over
-    /// the lights (the first bands of a new view are sized from the picture, not from the mean of the
-    /// empty rows above it).
-    fn seed_from_preview(&mut self, factor: u32, lights: u32, height: u32) {
+    /// cost of the rows not measured yet (the first bands of a new view are sized from the picture,
+    /// not from the mean of the empty rows above it). Per fragment a preview row costs what `factor`
+    /// frame rows of its width under every light do, so a frame row costs about its preview row's
+    /// cost times `factor` over the lights. `by_segment` a preview row shades the segments of its
+    /// `factor` frame rows that its four fragments a pixel keep: at most 11k of 59k on S1 at divisor
+    /// 11, so a frame row costs about its preview row's over the lights (S1 on lavapipe: about 13 ms a
+    /// preview row and 14 ms a frame row, every light).
+    fn seed_from_preview(&mut self, factor: u32, lights: u32, height: u32, by_segment: bool) {
         // A new view (the preview drew its visibility): the rows measured before show another picture.
         let new_view = self.preview_new_view;
         let f = factor.max(1);
+        let scale = if by_segment { 1.0 } else { f as f64 };
         let seeded: Vec<f64> = (0..height)
             .map(|y| {
                 let measured = self.bands[0]
@@ -355,7 +359,7 @@ impl Refinement {
                 if measured > 0.0 && !(new_view && preview > 0.0) {
                     measured
                 } else {
-                    preview * f as f64 / lights.max(1) as f64
+                    preview * scale / lights.max(1) as f64
                 }
             })
             .collect();
@@ -596,7 +600,8 @@ impl Renderer {
                     r.stats.preview.get_or_insert(since);
                     let shading = r.preview_shading;
                     let factor = self.preview.as_ref().map_or(1, |p| p.factor);
-                    r.seed_from_preview(factor, self.light_count, self.settings.height);
+                    let by_segment = self.by_segment;
+                    r.seed_from_preview(factor, self.light_count, self.settings.height, by_segment);
                     self.adapt_preview(shading);
                 }
                 _ => {
@@ -1010,15 +1015,22 @@ impl Renderer {
     /// Rows of a preview band from `row` (of `height`).
     fn preview_rows(&mut self, row: u32, height: u32) -> u32 {
         // Before the preview is measured: the frame's cost of a row under every light batch, scaled
-        // to the preview's width.
+        // to the preview's width (per fragment), or as it is (by segment: `seed_from_preview`).
         let factor = self.preview.as_ref().map_or(1, |p| p.factor) as f64;
+        let by_segment = self.by_segment;
         let light_batches = self.first_pass_batches().max(1) as f64;
         let width = self.settings.width as f64 / factor;
         let r = &mut self.refinement;
         let lights = self.light_count as f64;
         let guess = r.bands[0].cost.map_or(
             GUESS_SHADE_ROW_S * light_batches * width / GUESS_ROW_PIXELS,
-            |c| c * lights / factor,
+            |c| {
+                if by_segment {
+                    c * lights
+                } else {
+                    c * lights / factor
+                }
+            },
         );
         // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
         // unit saved), even past a shorter unit budget.

@@ -153,10 +153,10 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
     }
 }
 
-/// The largest angle (radians) a segment may subtend from the eye for the frame to shade it at its
-/// ends: about half the narrowest default lobe (TT's longitudinal width, beta_R / 2 = 3.75 degrees).
-/// Over a segment the view direction turns by up to this angle, while single scattering is
-/// interpolated between the ends.
+/// The largest angle (radians) a segment may subtend from the eye for the frame to shade it once:
+/// about half the narrowest default lobe (TT's longitudinal width, beta_R / 2 = 3.75 degrees). Over a
+/// segment the view direction turns by up to this angle, while each light's response is evaluated
+/// once, at the segment's midpoint.
 pub const MAX_SEGMENT_ANGLE: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
 /// The hair's longest segment and its bounds.
@@ -202,9 +202,12 @@ pub struct RenderSettings {
     /// Shade each visible segment once (each light's single-scattering response at its midpoint,
     /// weighted by the light's transmittance at its ends and midpoint; multiple scattering at its
     /// midpoint) instead of every kept fragment at its own point (false): ~8x fewer responses at full
-    /// resolution (S1 on lavapipe: 9.9 s a frame against 66 s). On by default; its cost against
-    /// per-fragment shading is 0.42 % relative RMSE (`tests/render.rs`), and on the blond clump of
-    /// `tests/ms_reference.rs` it stays as close to ray shooting (9.0 % against 9.7 %).
+    /// resolution (S1 on lavapipe: 8.9 s a frame against 101 s, one sitting). On by default; its cost
+    /// against per-fragment shading is 0.42 % relative RMSE (`tests/render.rs`), and on the blond clump
+    /// of `tests/ms_reference.rs` it stays as close to ray shooting (9.0 % against 9.7 %). Each light's
+    /// response reads the absorption at the segment's midpoint (the mean of its points'), so paint
+    /// that differs between a segment's two points shades as a step at segment resolution there, not
+    /// as a gradient between them.
     pub segment_shading: bool,
 }
 
@@ -300,7 +303,7 @@ pub struct Renderer {
     /// The frame's per-segment radiance (None: the frame shades per fragment).
     pub(super) segment_targets: Option<SegmentTargets>,
     /// The hair's longest segment and its bounds (whether segments are short enough, as the eye sees
-    /// them, to be shaded at their ends: [`MAX_SEGMENT_ANGLE`]).
+    /// them, to be shaded once each: [`MAX_SEGMENT_ANGLE`]).
     pub(super) segment_extent: (f32, Vec3, Vec3),
     /// The frame's batches shade segments (else fragments).
     pub(super) by_segment: bool,
@@ -586,7 +589,7 @@ impl Renderer {
         Ok(renderer)
     }
 
-    /// Whether the frame can shade segments at their ends as the eye sees them now: every segment
+    /// Whether the frame can shade each segment once as the eye sees them now: every segment
     /// subtends at most [`MAX_SEGMENT_ANGLE`] (bounded by the longest over the distance from the eye
     /// to the hair's bounds).
     fn segments_fit_view(&self) -> bool {
@@ -1247,7 +1250,7 @@ impl Renderer {
         }
     }
 
-    /// Whether the frame shades visible segments at their ends (else every fragment: per-fragment
+    /// Whether the frame (and its preview) shades each visible segment once (else every fragment: per-fragment
     /// shading asked for, segment buffers that would not fit a binding, or segments that the eye sees
     /// under more than [`MAX_SEGMENT_ANGLE`]).
     pub fn shades_segments(&self) -> bool {

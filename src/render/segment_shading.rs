@@ -1,12 +1,13 @@
-//! Segment shading, the frame's (`claim_segments`, `segment_dispatch`, `shade_segments` and
-//! `gather_segments` of `shaders/shading.wgsl`): per light batch, the visible segments of the rows'
-//! kept K-buffer fragments are listed once, each is shaded (single scattering at its two ends and
-//! its midpoint, multiple scattering at its midpoint), and once every batch has shaded them the rows' pixels gather
-//! their fragments' radiance, single scattering interpolated along each segment. The per-fragment pass
-//! ([`super::shading`]) shades the preview, whose fragments are mostly of different segments, the
-//! frame without `RenderSettings::segment_shading` (the default), a view in which a segment subtends
-//! more than [`super::renderer::MAX_SEGMENT_ANGLE`], and a hair whose segments' radiance would not
-//! fit one binding.
+//! Segment shading, the default for the frame and its preview (`claim_segments`, `segment_dispatch`,
+//! `shade_segments` and `gather_segments` of `shaders/shading.wgsl`): per light batch, the visible
+//! segments of the rows' kept K-buffer fragments are listed once, each is shaded (each light's
+//! single-scattering response once at its midpoint, weighted by the light's transmittance at its
+//! ends and midpoint; multiple scattering at its midpoint), and once every batch has shaded them the
+//! rows' pixels gather their fragments' radiance, single scattering interpolated along each segment.
+//! The per-fragment pass ([`super::shading`]) shades the frame and preview without
+//! `RenderSettings::segment_shading`, a view in which a segment subtends more than
+//! [`super::renderer::MAX_SEGMENT_ANGLE`], and a hair whose segments' radiance would not fit one
+//! binding.
 
 use super::shading::{ShadeBatch, ShadingInputs};
 use super::targets::FrameTargets;

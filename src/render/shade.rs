@@ -196,24 +196,31 @@ pub fn shade_point(
 pub type SegmentSingle = [[Rgb; 3]; 3];
 
 /// `shade_segment_single` of the WGSL: a segment's single scattering at t = 0, 1/2, 1 towards omega_o,
-/// each light's response once at the midpoint `mid` (its tangent, absorption and view), scaled by the
-/// light's transmittance at each sample (`ends`: the segment's points).
+/// each light's response at the midpoint `mid` (its tangent and view), scaled by the light's
+/// transmittance at each sample (`ends`: the segment's ends, their positions and absorption). One
+/// response per light where the ends' absorption is the same; where it differs one at each end's,
+/// the midpoint's between them ([`between_ends`]).
 #[allow(clippy::too_many_arguments)]
 pub fn shade_segment_single(
     luts: &Luts,
     table: &AzimuthalTable,
     params: &FastHairParams,
     mid: &ShadingPoint,
-    ends: [Vec3; 2],
+    ends: [ShadingPoint; 2],
     omega_o: Vec3,
     lights: &[SrbfLight],
     shadows: Option<GridShadows>,
 ) -> SegmentSingle {
-    let mut p = *params;
-    p.sigma_a = [mid.sigma_a[0], mid.sigma_a[1], mid.sigma_a[2], 0.0];
+    let with_sigma = |sp: &ShadingPoint| {
+        let mut p = *params;
+        p.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
+        p
+    };
+    let (pa, pb) = (with_sigma(&ends[0]), with_sigma(&ends[1]));
+    let painted = ends[0].sigma_a != ends[1].sigma_a;
     let frame = fiber_frame(mid.tangent);
     let (theta_o, phi_o) = fiber_angles(frame, omega_o);
-    let at = [ends[0], mid.position, ends[1]];
+    let at = [ends[0].position, mid.position, ends[1].position];
     let mut out = [[[0.0; 3]; 3]; 3];
     for (li, l) in lights.iter().enumerate() {
         let (theta, phi) = fiber_angles(frame, l.dir().normalize().as_vec3());
@@ -222,12 +229,23 @@ pub fn shade_segment_single(
             phi,
             lambda: l.lambda as f32,
         };
-        let m = srbf_response(luts, table, &p, light, theta_o, phi_o);
+        let ma = srbf_response(luts, table, &pa, light, theta_o, phi_o);
+        let mb = if painted {
+            srbf_response(luts, table, &pb, light, theta_o, phi_o)
+        } else {
+            ma
+        };
         for (s, x) in at.iter().enumerate() {
             let t = shadows.map_or(1.0, |g| g.shadow(*x, li).transmittance);
             for lobe in 0..3 {
                 for c in 0..3 {
-                    out[s][lobe][c] += t * (l.rgb[c] as f32 * m[lobe][c]);
+                    let k = l.rgb[c] as f32;
+                    let (a, b) = (k * ma[lobe][c], k * mb[lobe][c]);
+                    out[s][lobe][c] += t * match s {
+                        0 => a,
+                        1 => between_ends(a, b, 0.5),
+                        _ => b,
+                    };
                 }
             }
         }
@@ -355,14 +373,14 @@ pub fn between_samples(a: f32, m: f32, b: f32, t: f32) -> f32 {
 /// The frame's segment shading on the CPU (twin of `shade_segments` and `gather_segments`): for each
 /// pixel of `pixels`, every kept fragment's weight times its segment's radiance: single scattering
 /// (R, TT, TRT) from `single` (`shade_segment_single` with the segment's midpoint, its ends and the
-/// direction to the eye) between its samples at the fragment's point ([`between_samples`]), multiple
+/// direction to the eye from the midpoint) between its samples at the fragment's point ([`between_samples`]), multiple
 /// scattering that of its midpoint by `multiple` towards the eye.
 pub fn shade_pixels_by_segment(
     frame: &Frame,
     camera: &CameraUniform,
     hair: &ShadingHair,
     pixels: &[usize],
-    single: impl Fn(&ShadingPoint, [Vec3; 2], Vec3) -> SegmentSingle + Sync,
+    single: impl Fn(&ShadingPoint, [ShadingPoint; 2], Vec3) -> SegmentSingle + Sync,
     multiple: impl Fn(&ShadingPoint, Vec3) -> LobeRadiance + Sync,
 ) -> Vec<LobeRadiance> {
     let eye = Vec3::from(camera.eye);
@@ -384,7 +402,8 @@ pub fn shade_pixels_by_segment(
                 let t = closest_on_segment(origin, dir, a, b);
                 let mid = hair.segment_point(seg, 0.5);
                 let omega_o = (eye - mid.position).normalize();
-                let ss = single(&mid, [a, b], omega_o);
+                let ends = [hair.segment_point(seg, 0.0), hair.segment_point(seg, 1.0)];
+                let ss = single(&mid, ends, omega_o);
                 let ms = multiple(&mid, omega_o);
                 let w = weight as f32;
                 for c in 0..5 {

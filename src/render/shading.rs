@@ -1,8 +1,8 @@
 //! The shading passes (`shaders/shading.wgsl`): per batch of at most [`MAX_LIGHTS_PER_PASS`] SRBF
 //! lights (Xu 2011's multi-pass scheme), its lights' R, TT and TRT radiance (and with multiple
-//! scattering MS.global and MS.local): per visible segment ([`super::segment_shading`], the frame's,
+//! scattering MS.global and MS.local): per visible segment ([`super::segment_shading`], the default,
 //! gathered into the component buffers after the last batch), or per fragment, one dispatch per
-//! K-buffer slot within a batch, added to the component buffers (the preview's).
+//! K-buffer slot within a batch, added to the component buffers.
 
 use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
 use super::segment_shading::{SegmentShadingPass, SegmentTargets, last_light_batch};
@@ -14,7 +14,7 @@ use bytemuck::{Pod, Zeroable};
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
-/// The frame's batches shade segments ([`super::segment_shading`]), not fragments.
+/// The batches shade segments ([`super::segment_shading`]), not fragments.
 pub const FLAG_SEGMENTS: u32 = 4;
 
 /// One SRBF light as the shaders read it.

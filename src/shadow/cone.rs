@@ -265,9 +265,10 @@ pub fn srbf_cones(centre: Vec3, lambda: f32) -> Vec<(Vec3, f32, f32)> {
     srbf_cones_on_ring(centre, lambda, 6)
 }
 
-/// [`srbf_cones`] with `ring` cones on the ring (weight 1/(2 ring) each; the shadow grid's sweeps take
-/// three, [`super::sweep::SWEEP_RING`]).
+/// [`srbf_cones`] with `ring_cones` (at least 1) cones on the ring, weight 1/(2 ring_cones) each (the
+/// shadow grid's sweeps take three, [`super::sweep::SWEEP_RING`]).
 pub fn srbf_cones_on_ring(centre: Vec3, lambda: f32, ring_cones: u32) -> Vec<(Vec3, f32, f32)> {
+    assert!(ring_cones >= 1, "an SRBF's ring needs a cone");
     let kappa = 2.0 / (lambda * lambda);
     let e = (-2.0 * kappa).exp();
     let quantile = |q: f32| (1.0 + (q * (1.0 - e) + e).ln() / kappa).clamp(-1.0, 1.0);

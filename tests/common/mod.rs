@@ -145,6 +145,19 @@ pub fn render_uniform(
     lights: &[strandlight::envmap::SrbfLight],
     camera: &strandlight::render::Camera,
 ) -> strandlight::render::Frame {
+    render_uniform_shaded(ctx, settings, luts, hair, look, lights, camera).0
+}
+
+/// [`render_uniform`], and whether the frame was shaded by segment (`Renderer::shades_segments`).
+pub fn render_uniform_shaded(
+    ctx: &strandlight::gpu::GpuContext,
+    settings: &strandlight::render::RenderSettings,
+    luts: &strandlight::scattering::lut::Luts,
+    hair: &strandlight::hair::Hair,
+    look: &strandlight::render::HairLook,
+    lights: &[strandlight::envmap::SrbfLight],
+    camera: &strandlight::render::Camera,
+) -> (strandlight::render::Frame, bool) {
     let sigma_a = vec![look.fast.sigma_a_rgb(); hair.point_count()];
     let mut r = strandlight::render::Renderer::new(
         ctx,
@@ -158,7 +171,7 @@ pub fn render_uniform(
     )
     .expect("renderer");
     r.render_frame(ctx);
-    r.read_frame(ctx).expect("read back")
+    (r.read_frame(ctx).expect("read back"), r.shades_segments())
 }
 
 /// A procedural bob (12 points per strand) framed at three-quarters, with uniform absorption: the
