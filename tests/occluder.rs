@@ -147,8 +147,12 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
          T_f), {worst_behind:.2e} (depth behind, hair only); {inside} (point, light) entries inside \
          the head"
     );
+    // The worst difference doubled (9.4e-4 to 1.9e-3) when a ring direction's share of the light
+    // did (1/12 with six on the ring, 1/6 with three): one path differing between the twins,
+    // presumably a sample point a rounding away from a voxel face of the head's solid (its fraction
+    // is read per voxel, and the two compute the point in a different order).
     assert!(
-        worst < 1e-3 && worst_behind < 1e-3 && inside > 0,
+        worst < 2.5e-3 && worst_behind < 1e-3 && inside > 0,
         "{worst} {worst_behind} {inside}"
     );
     // The occluder's radiance: GPU against shade_occluder_frame over the same samples, reading the
