@@ -103,7 +103,8 @@ fn sub_pixel_parallel_fibres_cover_their_width_over_their_spacing() {
             &look,
             &lights,
             &camera,
-        );
+        )
+        .0;
         // The middle 100 x 100 pixels, which every fibre crosses from side to side.
         let window: Vec<usize> = (50..150)
             .flat_map(|y| (50..150).map(move |x| y * size as usize + x))
@@ -172,7 +173,8 @@ fn the_gpu_kbuffer_equals_its_cpu_twin() {
             &b.look,
             &lights(4),
             &b.camera,
-        );
+        )
+        .0;
         let (points, segments) = gpu_points(&b.hair);
         let cam = b.camera.uniform(w, h, 0.0);
         let ab = abuffer(&cam, &points, &segments);
@@ -345,7 +347,7 @@ fn anti_aliasing_against_a_16x_supersampled_render() {
     let lights = lights(8);
     let (w, h) = (200, 150);
     let render = |settings: &RenderSettings| {
-        common::render_uniform(&ctx, settings, &luts, &b.hair, &b.look, &lights, &b.camera)
+        common::render_uniform(&ctx, settings, &luts, &b.hair, &b.look, &lights, &b.camera).0
     };
     // Anti-aliasing, not the tail: both keep (nearly) every fragment.
     let mut fine = plain(4 * w, 4 * h);

@@ -207,7 +207,8 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
             &look,
             std::slice::from_ref(&light),
             &camera,
-        );
+        )
+        .0;
         let t_gpu = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let reference = reference_frame(
@@ -223,7 +224,7 @@ fn dual_scattering_matches_the_ray_shooting_reference_on_a_blond_clump() {
         );
         let t_ref = t.elapsed().as_secs_f64();
         // The same frame shaded by segment (`segment_shading`, the default).
-        let (by_segment, shaded_by_segment) = common::render_uniform_shaded(
+        let (by_segment, shaded_by_segment) = common::render_uniform(
             &ctx,
             &RenderSettings {
                 segment_shading: true,

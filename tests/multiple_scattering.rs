@@ -40,7 +40,7 @@ fn render(ctx: &GpuContext, luts: &Luts, hair: &Hair, look: &HairLook, multiple:
         shadow_grid_resolution: 12,
         ..Default::default()
     };
-    common::render_uniform(ctx, &settings, luts, hair, look, &lights().lights, &camera)
+    common::render_uniform(ctx, &settings, luts, hair, look, &lights().lights, &camera).0
 }
 
 /// Sum over covered pixels of the green channel of component `c` (None: the beauty).

@@ -70,7 +70,8 @@ fn furnace(
         &look,
         std::slice::from_ref(&light),
         camera,
-    );
+    )
+    .0;
     let (env, _) = EnvMap::new(64, 32, vec![[1.0; 3]; 64 * 32], Path::new("white")).expect("env");
     let max_depth = 64;
     let settings = PathTraceSettings {

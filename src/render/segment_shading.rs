@@ -82,15 +82,31 @@ pub struct SegmentShadingPass {
     gather: wgpu::ComputePipeline,
 }
 
-fn compute<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
+/// How a kernel's workgroups are counted: given, or read from a buffer (`shade_segments`).
+enum Workgroups<'a> {
+    Direct(u32, u32),
+    Indirect(&'a wgpu::Buffer),
+}
+
+/// One compute pass running `pipeline` with its bind group over `workgroups`.
+fn run(
+    encoder: &mut wgpu::CommandEncoder,
     label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    bind_group: &wgpu::BindGroup,
+    workgroups: Workgroups,
     timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
-) -> wgpu::ComputePass<'e> {
-    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
         timestamp_writes,
-    })
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    match workgroups {
+        Workgroups::Direct(x, y) => pass.dispatch_workgroups(x, y, 1),
+        Workgroups::Indirect(args) => pass.dispatch_workgroups_indirect(args, 0),
+    }
 }
 
 impl SegmentShadingPass {
@@ -131,12 +147,15 @@ impl SegmentShadingPass {
                 (22, &segments.work_list),
             ],
         );
-        {
-            let mut pass = compute(encoder, "claim segments", timestamps);
-            pass.set_pipeline(&self.claim);
-            pass.set_bind_group(0, &claim, &[]);
-            pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
-        }
+        let pixels = Workgroups::Direct(width.div_ceil(8), rows.div_ceil(8));
+        run(
+            encoder,
+            "claim segments",
+            &self.claim,
+            &claim,
+            pixels,
+            timestamps,
+        );
         let dispatch = bind(
             device,
             &self.dispatch,
@@ -147,20 +166,21 @@ impl SegmentShadingPass {
                 (23, &segments.work_args),
             ],
         );
-        {
-            let mut pass = compute(encoder, "segment dispatch", None);
-            pass.set_pipeline(&self.dispatch);
-            pass.set_bind_group(0, &dispatch, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-        }
+        let one = Workgroups::Direct(1, 1);
+        run(
+            encoder,
+            "segment dispatch",
+            &self.dispatch,
+            &dispatch,
+            one,
+            None,
+        );
         let mut entries = inputs.shading_entries(batch);
         entries.extend([(21, &segments.work_count), (22, &segments.work_list)]);
         entries.extend((24..).zip(&segments.radiance));
         let shade = bind(device, &self.shade, "shade segments", &entries);
-        let mut pass = compute(encoder, "shade segments", None);
-        pass.set_pipeline(&self.shade);
-        pass.set_bind_group(0, &shade, &[]);
-        pass.dispatch_workgroups_indirect(&segments.work_args, 0);
+        let listed = Workgroups::Indirect(&segments.work_args);
+        run(encoder, "shade segments", &self.shade, &shade, listed, None);
     }
 
     /// Rows `batch.row0 .. + batch.rows` of the components from the segments' radiance (after every
@@ -187,10 +207,15 @@ impl SegmentShadingPass {
         entries.extend((13..).zip(&targets.components));
         entries.extend((24..).zip(&segments.radiance));
         let gather = bind(device, &self.gather, "gather segments", &entries);
-        let mut pass = compute(encoder, "gather segments", timestamps);
-        pass.set_pipeline(&self.gather);
-        pass.set_bind_group(0, &gather, &[]);
-        pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
+        let pixels = Workgroups::Direct(width.div_ceil(8), rows.div_ceil(8));
+        run(
+            encoder,
+            "gather segments",
+            &self.gather,
+            &gather,
+            pixels,
+            timestamps,
+        );
     }
 }
 

@@ -135,21 +135,8 @@ pub const OBJ: &str =
     "o quad\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvn 0 1 0\nf 1//1 2//1 3//1 4//1\n";
 
 /// One frame of `hair` with the look's absorption at every point (a renderer made, drawn once, read
-/// back).
+/// back), and whether it was shaded by segment (`Renderer::shades_segments`).
 pub fn render_uniform(
-    ctx: &strandlight::gpu::GpuContext,
-    settings: &strandlight::render::RenderSettings,
-    luts: &strandlight::scattering::lut::Luts,
-    hair: &strandlight::hair::Hair,
-    look: &strandlight::render::HairLook,
-    lights: &[strandlight::envmap::SrbfLight],
-    camera: &strandlight::render::Camera,
-) -> strandlight::render::Frame {
-    render_uniform_shaded(ctx, settings, luts, hair, look, lights, camera).0
-}
-
-/// [`render_uniform`], and whether the frame was shaded by segment (`Renderer::shades_segments`).
-pub fn render_uniform_shaded(
     ctx: &strandlight::gpu::GpuContext,
     settings: &strandlight::render::RenderSettings,
     luts: &strandlight::scattering::lut::Luts,
@@ -242,6 +229,7 @@ impl BobScene {
             lights,
             &self.camera,
         )
+        .0
     }
 
     /// The reference modes' scene under 1024 directions importance-sampled from `env` (turned by `yaw`).
