@@ -11,6 +11,8 @@
 // dual_response, shadow_grid, camera.
 
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
+// By segment: multiple scattering alone, the segments' single scattering kept (shading.rs).
+const FLAG_SINGLE_KEPT: u32 = 8u;
 
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -247,11 +249,13 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // The indirect dispatch of `shade_segments`: one invocation per listed segment (its single scattering)
-// and with multiple scattering a second (its midpoint's), in workgroups of 64, as rows of at most 65535
-// workgroups.
+// (none with FLAG_SINGLE_KEPT) and with multiple scattering a second (its midpoint's), in workgroups of
+// 64, as rows of at most 65535 workgroups.
 @compute @workgroup_size(1)
 fn segment_dispatch() {
-    let kinds = select(1u, 2u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
+    let single = (batch.flags & FLAG_SINGLE_KEPT) == 0u;
+    let multiple = (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u;
+    let kinds = select(0u, 1u, single) + select(0u, 1u, multiple);
     let groups = (kinds * atomicLoad(&work_count[0]) + 63u) / 64u;
     work_args[0] = min(groups, 65535u);
     work_args[1] = (groups + 65534u) / 65535u;
@@ -262,7 +266,8 @@ fn segment_dispatch() {
 // scattering at the midpoint of listed segment i - n. The kinds lie apart in the index, so a SIMD group
 // runs one of them (single and multiple scattering in one light loop spill on lavapipe and cost ~3x as
 // much as apart). The first light batch (first == 0, every segment's first: the batches run in order)
-// stores the segment's radiance, the others add to it, so nothing needs clearing.
+// stores the segment's radiance, the others add to it, so nothing needs clearing. With FLAG_SINGLE_KEPT
+// every invocation i < n is listed segment i's multiple scattering, and its single scattering stays.
 @compute @workgroup_size(64)
 fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     // Rows of the indirect dispatch are 65535 workgroups wide whenever there is more than one.
@@ -270,7 +275,9 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = atomicLoad(&work_count[0]);
     let shadows = (batch.flags & FLAG_SHADOWS) != 0u;
     let restart = batch.first == 0u;
-    if (i < n) {
+    // With the single scattering kept, every invocation is a segment's multiple scattering.
+    let n_single = select(n, 0u, (batch.flags & FLAG_SINGLE_KEPT) != 0u);
+    if (i < n_single) {
         let seg = work_list[i];
         let mid = segment_point(seg, 0.5);
         let l = shade_segment_single(mid, segment_point(seg, 0.0), segment_point(seg, 1.0), normalize(camera.eye - mid.position), batch.first, batch.count, shadows);
@@ -280,8 +287,8 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt[s], 0.0);
             segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
         }
-    } else if (i < 2u * n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-        let seg = work_list[i - n];
+    } else if (i < n_single + n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+        let seg = work_list[i - n_single];
         let sp = segment_point(seg, 0.5);
         let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
         segment_ms_global[seg] = select(segment_ms_global[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);

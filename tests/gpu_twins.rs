@@ -83,6 +83,11 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 Some("SINGLE_SAMPLES") => {
                     strandlight::render::segment_shading::SINGLE_SAMPLES as u32
                 }
+                Some("FLAG_SHADOWS") => strandlight::render::shading::FLAG_SHADOWS,
+                Some("FLAG_MULTIPLE_SCATTERING") => {
+                    strandlight::render::shading::FLAG_MULTIPLE_SCATTERING
+                }
+                Some("FLAG_SINGLE_KEPT") => strandlight::render::shading::FLAG_SINGLE_KEPT,
                 _ => continue,
             };
             seen.insert(c.name.clone().unwrap_or_default());
@@ -98,7 +103,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
     println!("struct layouts and constants compared: {seen:?}");
     assert_eq!(
         seen.len(),
-        18,
+        21,
         "every shared struct and constant was found and compared"
     );
 }

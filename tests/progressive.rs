@@ -260,6 +260,9 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
         );
         if multiple {
             assert!(live.rebuild_stale_volume());
+            // The density (so the grid's transmittance) stays: the converged image keeps its single
+            // scattering, shaded at the new absorption already.
+            assert!(live.keeps_single_scattering());
             let units = refine_all(&mut live, &ctx);
             assert!(matches!(
                 units.first(),
@@ -276,6 +279,55 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
         );
         assert_eq!(d, 0.0);
     }
+}
+
+/// Tables that arrive after the image converged (a look edit, handed over as the editor and bench do
+/// once the first pass shows): the grid's forward terms are rebuilt and multiple scattering alone is
+/// shaded again, each segment keeping its single scattering (which reads no table); the image equals
+/// a frame rendered with the new look.
+#[test]
+fn tables_after_convergence_shade_multiple_scattering_alone() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let scene = small_bob(true);
+    let new = || bob_renderer(&ctx, &luts, &scene, &scene.hair, &scene.sigma_a, &lights);
+    let mut live = new();
+    live.set_unit_budget(Duration::from_millis(20));
+    assert!(live.shades_segments());
+    refine_all(&mut live, &ctx);
+    let mut params = scene.look.params;
+    params.beta_r = 4f64.to_radians();
+    params.beta_tt = Some(4f64.to_radians());
+    let look = strandlight::render::HairLook::new(params);
+    assert!(live.set_params_deferred(&ctx, &look));
+    assert!(!live.keeps_single_scattering(), "a new look shades it all");
+    refine_all(&mut live, &ctx);
+    let old_tables = live.read_frame(&ctx).expect("read");
+    let tables = build_tables(&params, Some(live.azimuthal_table()));
+    assert!(live.set_tables(&ctx, &params, &tables));
+    assert!(live.keeps_single_scattering());
+    let units = refine_all(&mut live, &ctx);
+    assert!(
+        units
+            .iter()
+            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. }))
+    );
+    assert!(units.iter().any(|u| matches!(u, WorkUnit::Shade { .. })));
+    let got = live.read_frame(&ctx).expect("read");
+    let mut fresh = new();
+    fresh.set_params(&ctx, &look);
+    fresh.render_frame(&ctx);
+    let want = fresh.read_frame(&ctx).expect("read");
+    let (d, moved) = (difference(&want, &got), difference(&want, &old_tables));
+    println!(
+        "multiple scattering alone after the tables: {d:.1e} from a fresh frame ({moved:.1e} before them)"
+    );
+    assert!(moved > 1e-4, "the tables change the image");
+    assert_eq!(d, 0.0);
+    // A camera change shades everything again.
+    live.set_camera(&ctx, &scene.camera);
+    assert!(!live.keeps_single_scattering());
 }
 
 /// A fiber thickness change (`set_thickness_scale`) rebuilds the volume and grid and converges to the

@@ -362,8 +362,17 @@ fn reference(s: &Scene, frame: &Frame, env: &EnvMap, yaw: f64) -> Frame {
     )
 }
 
-fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &EnvMap) -> [f64; 2] {
-    [false, true].map(|shadows| {
+/// Relative RMSE against the reference for each shadow setting given (per fragment and by segment,
+/// the worse of the two).
+fn fidelity(
+    ctx: &GpuContext,
+    luts: &Luts,
+    name: &str,
+    lights: &SrbfSet,
+    env: &EnvMap,
+    shadow_settings: &[bool],
+) -> Vec<f64> {
+    shadow_settings.iter().map(|&shadows| {
         let mut s = scene(1500, 96, 64, shadows, Preset::Brown);
         s.settings.segment_shading = false;
         let (_, frame) = render(ctx, luts, &s, lights);
@@ -391,7 +400,7 @@ fn fidelity(ctx: &GpuContext, luts: &Luts, name: &str, lights: &SrbfSet, env: &E
             "{name}: segment shading {e} against {e_fragment} per fragment"
         );
         e_fragment.max(e)
-    })
+    }).collect()
 }
 
 #[test]
@@ -402,7 +411,7 @@ fn srbf_render_is_close_to_the_reference_on_the_project_environments() {
     for name in ["sunny", "overcast", "studio"] {
         let lights = SrbfSet::read(&envmaps().join(format!("{name}.srbf.json"))).expect("fit");
         let (env, _) = load_env(&envmaps().join(format!("{name}.exr"))).expect("env");
-        for e in fidelity(&ctx, &luts, name, &lights, &env) {
+        for e in fidelity(&ctx, &luts, name, &lights, &env, &[false, true]) {
             worst = worst.max(e);
         }
     }
@@ -429,7 +438,9 @@ fn srbf_render_is_close_to_the_reference_on_the_shared_environments() {
         let path = data.join("envmaps").join(file);
         let env = strandlight::render::scene::load_environment(&path, 40).expect("fit");
         let image = env.image.expect("an image");
-        for e in fidelity(&ctx, &luts, file, &env.lights, &image) {
+        // With shadows only (the project environments above check both): the full shading path on
+        // photographed light; the shadowless variant is left out for CI's time.
+        for e in fidelity(&ctx, &luts, file, &env.lights, &image, &[true]) {
             worst = worst.max(e);
         }
     }

@@ -27,7 +27,7 @@
 
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
-use super::shading::{FLAG_SEGMENTS, ShadeBatch, ShadingPass};
+use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
 use crate::gpu::GpuContext;
@@ -507,7 +507,30 @@ impl Renderer {
     /// stage the change made stale, with a preview first.
     pub(super) fn restart_refinement(&mut self) {
         self.refinement.preview_owed = true;
+        self.single_kept = false;
         self.replan();
+    }
+
+    /// [`Renderer::restart_as_refinement`] for a change that reaches only the forward and
+    /// dual-scattering terms (the grid's forward terms, the shading's dual terms): when the image is
+    /// converged and shaded by segment, the segments keep their single scattering and the plan shades
+    /// multiple scattering alone ([`Renderer::keeps_single_scattering`]).
+    pub(super) fn refine_multiple_only(&mut self, change: impl FnOnce(&mut Self)) {
+        // Kept already (a plan shading multiple scattering alone, its single scattering untouched),
+        // or converged.
+        let keep = self.single_kept
+            || (self.by_segment
+                && self.settings.multiple_scattering
+                && self.refinement.stage == Stage::Converged
+                && !self.refinement.preview_owed);
+        self.restart_as_refinement(change);
+        self.single_kept = keep;
+    }
+
+    /// Whether the refinement under way shades multiple scattering alone, keeping the segments'
+    /// single scattering ([`Renderer::set_tables`] after the image converged).
+    pub fn keeps_single_scattering(&self) -> bool {
+        self.single_kept
     }
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
@@ -1109,7 +1132,17 @@ impl Renderer {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
                     return;
                 };
-                let b = ShadeBatch { row0, rows, ..*b };
+                let kept = if self.single_kept && b.flags & FLAG_SEGMENTS != 0 {
+                    FLAG_SINGLE_KEPT
+                } else {
+                    0
+                };
+                let b = ShadeBatch {
+                    row0,
+                    rows,
+                    flags: b.flags | kept,
+                    ..*b
+                };
                 let inputs = self.shading_inputs();
                 self.shading_pass
                     .encode_batch(device, enc, &inputs, &self.targets, &b, None);

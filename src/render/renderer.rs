@@ -322,6 +322,10 @@ pub struct Renderer {
     /// when multiple scattering is turned on.
     pub(super) volume_absorption_old: bool,
     pub(super) shadow_grid_dirty: bool,
+    /// The refinement's plan re-shades multiple scattering alone: the segments' single scattering
+    /// from the last converged pass still holds (a change that reaches only the forward and
+    /// dual-scattering terms: new tables, a deferred absorption's volume).
+    pub(super) single_kept: bool,
     pub(super) timer: Option<PassTimer>,
     pub(super) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
@@ -576,6 +580,7 @@ impl Renderer {
             volume_stale: false,
             volume_absorption_old: false,
             shadow_grid_dirty: true,
+            single_kept: false,
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
             refinement: Refinement::default(),
@@ -755,7 +760,9 @@ impl Renderer {
                 self.restart_refinement();
             }
         } else if multiple {
-            self.restart_as_refinement(|r| r.mark_shadow_grid_dirty());
+            // The grid's transmittance and the single scattering read no table: a converged image
+            // keeps its single scattering, and only multiple scattering is shaded again.
+            self.refine_multiple_only(|r| r.mark_shadow_grid_dirty());
         }
         true
     }
@@ -867,8 +874,10 @@ impl Renderer {
         if !self.volume_stale {
             return false;
         }
-        // The change itself is on screen (shaded with the old volume): no new preview.
-        self.restart_as_refinement(|r| r.mark_volume_dirty());
+        // The change itself is on screen (shaded with the old volume): no new preview. The
+        // volume's density, and so the grid's transmittance, stays: a converged image keeps its
+        // single scattering (shaded at the new absorption already).
+        self.refine_multiple_only(|r| r.mark_volume_dirty());
         true
     }
 

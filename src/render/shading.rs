@@ -16,6 +16,9 @@ pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
 /// The batches shade segments ([`super::segment_shading`]), not fragments.
 pub const FLAG_SEGMENTS: u32 = 4;
+/// A batch by segment shades multiple scattering alone: the segments' single scattering is kept from
+/// the last converged pass ([`super::Renderer::keeps_single_scattering`]).
+pub const FLAG_SINGLE_KEPT: u32 = 8;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
