@@ -330,6 +330,89 @@ fn tables_after_convergence_shade_multiple_scattering_alone() {
     assert!(!live.keeps_single_scattering());
 }
 
+/// A brush dab on the converged image (`repaint_points`): only the segments at the changed points are
+/// shaded again (one `Repaint` unit per light batch), and the image equals the one a restart
+/// converges to; on an image still refining the dab is refused (the caller restarts).
+#[test]
+fn a_dab_repaints_its_segments_and_equals_a_restart() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let scene = small_bob(true);
+    let new =
+        |sigma_a: &[[f32; 3]]| bob_renderer(&ctx, &luts, &scene, &scene.hair, sigma_a, &lights);
+    let mut live = new(&scene.sigma_a);
+    assert!(live.shades_segments());
+    refine_all(&mut live, &ctx);
+    let before = live.read_frame(&ctx).expect("read");
+    // The dab: every tenth strand's tip half, darker.
+    let mut sigma_a = scene.sigma_a.clone();
+    let changed: Vec<u32> = (0..scene.hair.strand_count())
+        .step_by(10)
+        .flat_map(|k| {
+            let r = scene.hair.strand_range(k);
+            (r.start + r.len() / 2)..r.end
+        })
+        .map(|i| i as u32)
+        .collect();
+    for &i in &changed {
+        sigma_a[i as usize] = [2.0, 2.5, 3.0];
+    }
+    live.set_absorption_points_deferred(&ctx, &sigma_a, &changed)
+        .expect("absorption");
+    assert!(live.repaint_points(&changed));
+    let units = refine_all(&mut live, &ctx);
+    println!("repaint of {} points: {units:?}", changed.len());
+    let batches = lights.len().div_ceil(16);
+    assert_eq!(units.len(), batches);
+    assert!(
+        units
+            .iter()
+            .all(|u| matches!(u, WorkUnit::Repaint { segments, .. } if *segments > 0))
+    );
+    let got = live.read_frame(&ctx).expect("read");
+    // The same dab through a restart.
+    let mut restarted = new(&scene.sigma_a);
+    refine_all(&mut restarted, &ctx);
+    restarted
+        .set_absorption_points_deferred(&ctx, &sigma_a, &changed)
+        .expect("absorption");
+    restarted.restart();
+    refine_all(&mut restarted, &ctx);
+    let want = restarted.read_frame(&ctx).expect("read");
+    let (d, moved) = (difference(&want, &got), difference(&before, &got));
+    println!("repaint against a restart {d:.1e} (the dab moved the image by {moved:.1e})");
+    assert!(moved > 1e-3, "the dab shows");
+    assert_eq!(d, 0.0);
+    // A small dab (a few points of one strand, its gather and resolve over a few rows), again
+    // against a restart.
+    let strand = scene.hair.strand_range(scene.hair.strand_count() / 2);
+    let small: Vec<u32> = (strand.start as u32 + 4..strand.start as u32 + 7).collect();
+    for &i in &small {
+        sigma_a[i as usize] = [0.05, 0.1, 0.4];
+    }
+    for r in [&mut live, &mut restarted] {
+        r.set_absorption_points_deferred(&ctx, &sigma_a, &small)
+            .expect("absorption");
+    }
+    let before_small = live.read_frame(&ctx).expect("read");
+    assert!(live.repaint_points(&small));
+    refine_all(&mut live, &ctx);
+    restarted.restart();
+    refine_all(&mut restarted, &ctx);
+    let (got, want) = (
+        live.read_frame(&ctx).expect("read"),
+        restarted.read_frame(&ctx).expect("read"),
+    );
+    let moved = difference(&before_small, &got);
+    println!("a small dab moved the image by {moved:.1e}");
+    assert!(moved > 0.0, "the small dab shows");
+    assert_eq!(difference(&want, &got), 0.0, "a small dab's repaint");
+    // Still refining: refused.
+    live.set_camera(&ctx, &scene.camera);
+    assert!(!live.repaint_points(&changed));
+}
+
 /// A fiber thickness change (`set_thickness_scale`) rebuilds the volume and grid and converges to the
 /// frame of a renderer made with the scaled hair, exactly; thicker fibers darken the shadowed hair.
 #[test]

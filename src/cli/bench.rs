@@ -441,7 +441,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 let b =
                     super::bench_brush::brush_run(&ctx, &mut renderer, &hair, &sigma_a, args.dabs)?;
                 eprintln!(
-                    "{} brush: {} dabs of {:.0} px, {:.2} ms CPU per dab (max {:.2}), {:.0} points each, visible after {:.0} ms (max {:.0}); picker {:.0} ms",
+                    "{} brush: {} dabs of {:.0} px, {:.2} ms CPU per dab (max {:.2}), {:.0} points each, visible after {:.0} ms (max {:.0}, {} dabs that changed points); picker {:.0} ms",
                     scene.name,
                     b.dabs,
                     b.radius_px,
@@ -450,7 +450,12 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     b.points_per_dab_mean,
                     b.visible_ms_median,
                     b.visible_ms_max,
+                    b.visible_dabs,
                     b.picker_ms
+                );
+                eprintln!(
+                    "{} brush: after the stroke, converged in {:.0} ms; volume, grid and multiple scattering followed in {:.0} ms (single scattering kept: {})",
+                    scene.name, b.stroke_converged_ms, b.follow_up_ms, b.follow_up_kept_single
                 );
                 Some(b)
             } else {

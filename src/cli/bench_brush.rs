@@ -26,9 +26,35 @@ pub struct BrushReport {
     pub cpu_ms_median: f64,
     pub cpu_ms_max: f64,
     pub points_per_dab_mean: f64,
-    /// From the dab to its preview being complete (the dab visible), milliseconds.
+    /// From the dab to its preview being complete, or its repaint of the converged image (the dab
+    /// visible), milliseconds, over the dabs that changed points.
+    pub visible_dabs: usize,
+    /// Their median and largest.
     pub visible_ms_median: f64,
     pub visible_ms_max: f64,
+    /// After the stroke: the full image with the new colour converged (single scattering at the new
+    /// absorption, the volume and grid of before), milliseconds from the last dab.
+    pub stroke_converged_ms: f64,
+    /// Then the stroke's shadow and multiple-scattering effects: the volume and the grid's forward
+    /// terms rebuilt, multiple scattering shaded again, until converged (milliseconds), and whether
+    /// the segments kept their single scattering meanwhile.
+    pub follow_up_ms: f64,
+    pub follow_up_kept_single: bool,
+}
+
+/// Refines until converged.
+fn converge(ctx: &GpuContext, renderer: &mut Renderer) -> anyhow::Result<()> {
+    loop {
+        let p = renderer.refine(ctx)?;
+        if p.converged {
+            return Ok(());
+        }
+        if p.submitted.is_some() || p.busy {
+            ctx.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+        }
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -101,7 +127,10 @@ pub fn brush_run(
             sigma[i as usize] = effective(base[i as usize], layer.points[i as usize]);
         }
         renderer.set_absorption_points_deferred(ctx, &sigma, &changed)?;
-        renderer.restart();
+        // As the editor: the converged image repaints the dab's segments, or restarts.
+        if !renderer.repaint_points(&changed) {
+            renderer.restart();
+        }
         cpu.push(t.elapsed().as_secs_f64() * 1e3);
         points += changed.len();
         // Refine until the dab shows (its preview, or the full image without one).
@@ -116,9 +145,28 @@ pub fn brush_run(
                     .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
             }
         }
-        visible.push(t.elapsed().as_secs_f64() * 1e3);
+        // A dab that changed no point (off the hair, or where the stroke has saturated) has nothing
+        // to show.
+        if !changed.is_empty() {
+            visible.push(t.elapsed().as_secs_f64() * 1e3);
+        }
     }
+    // The stroke ends: the image converges with the new colour, then (as the editor does once it
+    // shows) the volume and grid follow.
+    let t = Instant::now();
+    converge(ctx, renderer)?;
+    let stroke_converged_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let mut follow_up_kept_single = false;
+    if renderer.rebuild_stale_volume() {
+        follow_up_kept_single = renderer.keeps_single_scattering();
+        converge(ctx, renderer)?;
+    }
+    let follow_up_ms = t.elapsed().as_secs_f64() * 1e3;
     Ok(BrushReport {
+        stroke_converged_ms,
+        follow_up_ms,
+        follow_up_kept_single,
         dabs,
         radius_px: radius,
         picker_ms,
@@ -127,6 +175,7 @@ pub fn brush_run(
         cpu_ms_max: cpu.iter().copied().fold(0.0, f64::max),
         cpu_ms_median: median(cpu),
         points_per_dab_mean: points as f64 / dabs.max(1) as f64,
+        visible_dabs: visible.len(),
         visible_ms_max: visible.iter().copied().fold(0.0, f64::max),
         visible_ms_median: median(visible),
     })

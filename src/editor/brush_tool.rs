@@ -199,6 +199,10 @@ impl EditorApp {
         let Some(s) = self.stroke.take() else {
             return;
         };
+        if let Some(live) = &mut self.live {
+            // The volume and grid may follow now, whatever the stroke left.
+            live.painting = false;
+        }
         let Some(layer) = &self.session.paint_layer else {
             return;
         };

@@ -227,6 +227,9 @@ pub struct LiveScene {
     /// A dab changed the absorption while a preview was under way: the refinement restarts when
     /// it is done (a restart per dab would never let a preview finish).
     pub(super) paint_restart: bool,
+    /// A stroke is under way (its dabs repaint the converged image; the volume and grid follow
+    /// once it ends).
+    pub(super) painting: bool,
     view: Option<ViewSettings>,
     tables: Option<Job<Tables>>,
     /// The parameters of the tables being built.
@@ -334,6 +337,7 @@ impl LiveScene {
             paint_file: None,
             picking: Default::default(),
             paint_restart: false,
+            painting: false,
             thickness_scale: session.look.thickness_scale,
             applied: Applied {
                 look: session.look,
@@ -708,7 +712,7 @@ impl LiveScene {
         // With tables on the way, the volume waits for them: they rebuild the grid too.
         let tables_waiting =
             self.wanted_tables.is_some() || self.tables.is_some() || self.held_tables.is_some();
-        if shown && !tables_waiting && self.renderer.rebuild_stale_volume() {
+        if shown && !tables_waiting && !self.painting && self.renderer.rebuild_stale_volume() {
             self.restarted_as_refinement();
         }
         let progress = self.renderer.refine(&self.ctx)?;

@@ -94,7 +94,13 @@ impl LiveScene {
         self.renderer
             .set_absorption_points_deferred(&self.ctx, &self.sigma_a, changed)?;
         self.note_paint(session);
-        if self.renderer.preview_under_way() {
+        // The volume and grid wait for the stroke's end (a rebuild between dabs would take the
+        // converged image the next dab repaints).
+        self.painting = true;
+        if self.renderer.repaint_points(changed) {
+            // Converged: the dab's segments alone are shaded again, at full resolution.
+            self.restarted();
+        } else if self.renderer.preview_under_way() {
             self.paint_restart = true;
         } else {
             self.renderer.restart();
@@ -107,6 +113,7 @@ impl LiveScene {
     /// themselves (a deferred rebuild once the image shows), and every table reads each point's own
     /// absorption, so the points' mean (kept for the look's uniform) changes no table.
     pub fn paint_finished(&mut self, _session: &Session) -> Result<(), LiveError> {
+        self.painting = false;
         self.mean_sigma_a = mean_absorption(&self.sigma_a);
         Ok(())
     }

@@ -14,7 +14,8 @@
 use super::brush::{Brush, Touch};
 use crate::hair::Hair;
 use crate::render::camera::CameraUniform;
-use glam::{Mat4, Vec3, Vec4};
+pub use crate::render::camera::{Projected, project};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Screen cell size of the buckets, pixels.
@@ -49,29 +50,6 @@ impl ViewDepth {
         }
         best.is_finite().then_some(best)
     }
-}
-
-/// A point on screen: pixel coordinates (0.5 = a pixel centre, y down) and view depth.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Projected {
-    pub x: f32,
-    pub y: f32,
-    pub depth: f32,
-}
-
-/// Projects `p` with the camera (None behind the eye).
-pub fn project(c: &CameraUniform, p: Vec3) -> Option<Projected> {
-    let m = Mat4::from_cols_array_2d(&c.view_proj);
-    let clip = m * Vec4::new(p.x, p.y, p.z, 1.0);
-    if clip.w <= 1e-6 {
-        return None;
-    }
-    let (nx, ny) = (clip.x / clip.w, clip.y / clip.w);
-    Some(Projected {
-        x: 0.5 * (nx + 1.0) * c.size[0] as f32,
-        y: 0.5 * (1.0 - ny) * c.size[1] as f32,
-        depth: (p - Vec3::from(c.eye)).dot(Vec3::from(c.forward)),
-    })
 }
 
 /// Whether a projected point lies in the footprint region of a dab at `centre` (pixels) of radius

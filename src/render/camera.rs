@@ -177,6 +177,29 @@ pub struct CameraUniform {
 
 const _: () = assert!(std::mem::size_of::<CameraUniform>() == 176);
 
+/// A point on screen: pixel coordinates (0.5 = a pixel centre, y down) and view depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projected {
+    pub x: f32,
+    pub y: f32,
+    pub depth: f32,
+}
+
+/// Projects `p` with the camera (None behind the eye).
+pub fn project(c: &CameraUniform, p: Vec3) -> Option<Projected> {
+    let m = Mat4::from_cols_array_2d(&c.view_proj);
+    let clip = m * Vec4::new(p.x, p.y, p.z, 1.0);
+    if clip.w <= 1e-6 {
+        return None;
+    }
+    let (nx, ny) = (clip.x / clip.w, clip.y / clip.w);
+    Some(Projected {
+        x: 0.5 * (nx + 1.0) * c.size[0] as f32,
+        y: 0.5 * (1.0 - ny) * c.size[1] as f32,
+        depth: (p - Vec3::from(c.eye)).dot(Vec3::from(c.forward)),
+    })
+}
+
 /// The ray through pixel coordinates (x, y) (twin of `pixel_ray` in `shaders/camera.wgsl`).
 pub fn pixel_ray(c: &CameraUniform, x: f32, y: f32) -> (Vec3, Vec3) {
     let inv = Mat4::from_cols_array_2d(&c.inv_view_proj);

@@ -27,6 +27,7 @@
 
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
+use super::segment_shading::last_light_batch;
 use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
@@ -80,6 +81,9 @@ pub enum WorkUnit {
     PreviewVisibility { first: u32, count: u32 },
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
+    /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over the
+    /// `segments` segments at the changed points; the last batch gathers and resolves the image.
+    Repaint { batch: u32, segments: u32 },
 }
 
 /// The images a display pass reads: the frame's, and a preview under the frame's first `sharp_rows`
@@ -124,6 +128,10 @@ enum Stage {
         batch: u32,
         row: u32,
         band: u32,
+    },
+    /// A dab's segments under frame batch `batch` (then the next batch, or converged).
+    Repaint {
+        batch: u32,
     },
     Converged,
 }
@@ -396,7 +404,7 @@ impl Refinement {
             WorkUnit::Volume { .. } | WorkUnit::VolumeResolve => 1,
             WorkUnit::ShadowGrid { .. } => 2,
             WorkUnit::Visibility { .. } => 3,
-            WorkUnit::Shade { .. } => 4,
+            WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
         let seconds = elapsed.as_secs_f64();
@@ -433,7 +441,8 @@ impl Refinement {
             }
             WorkUnit::VolumeResolve
             | WorkUnit::Visibility { .. }
-            | WorkUnit::PreviewVisibility { .. } => {}
+            | WorkUnit::PreviewVisibility { .. }
+            | WorkUnit::Repaint { .. } => {}
         }
     }
 
@@ -527,6 +536,71 @@ impl Renderer {
         self.single_kept = keep;
     }
 
+    /// A brush dab on an image converged by segment: the segments that join the changed points
+    /// `changed` are shaded again under every light (one [`WorkUnit::Repaint`] per light batch) and
+    /// the image is gathered from the segments, in place of a restart. The dab shows at full
+    /// resolution after work on its segments alone; every other segment's radiance depends on its
+    /// own points only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
+    /// False, nothing planned, when the image is not converged by segment: the caller restarts.
+    pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
+        let r = &self.refinement;
+        let repainting = matches!(r.stage, Stage::Repaint { .. });
+        let ready = self.by_segment
+            && self.segment_targets.is_some()
+            && self.visibility_valid
+            && !r.preview_owed
+            && (r.stage == Stage::Converged || repainting)
+            && self.shading_pass.frame_batches().next().is_some();
+        if !ready {
+            return false;
+        }
+        let mut segments = std::mem::take(&mut self.repaint);
+        if !repainting {
+            segments.clear();
+        }
+        for &i in changed {
+            // The segment from point i, and the one to it (from i - 1, in the same strand).
+            for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
+                if let Ok(k) = self.segment_first.binary_search(&p) {
+                    segments.push(k as u32);
+                }
+            }
+        }
+        segments.sort_unstable();
+        segments.dedup();
+        if !segments.is_empty() {
+            // From the first batch again (a repaint part-way redoes its segments with the others').
+            self.refinement.stage = Stage::Repaint { batch: 0 };
+        }
+        self.repaint_rows = self.rows_covered(&segments);
+        self.repaint = segments;
+        true
+    }
+
+    /// The image rows where `segments` may leave fragments: their ends' projections, widened by
+    /// the ribbon's half width (at least `min_width_px`) and a pixel; every row when an end lies
+    /// behind the eye or the frame is a tile.
+    fn rows_covered(&self, segments: &[u32]) -> std::ops::Range<u32> {
+        let height = self.settings.height;
+        let cam = self.view_camera();
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for &k in segments {
+            let first = self.segment_first[k as usize] as usize;
+            for p in &self.point_data[first..first + 2] {
+                let at = glam::Vec3::new(p[0], p[1], p[2]);
+                let Some(q) = super::camera::project(&cam, at).filter(|_| self.tile.is_none())
+                else {
+                    return 0..height;
+                };
+                let width = (p[3] / (q.depth * cam.pixel_angle)).max(cam.min_width_px);
+                lo = lo.min(q.y - 0.5 * width - 1.0);
+                hi = hi.max(q.y + 0.5 * width + 1.0);
+            }
+        }
+        let clamp = |y: f32| (y.max(0.0) as u32).min(height);
+        clamp(lo.floor())..clamp(hi.ceil())
+    }
+
     /// Whether the refinement under way shades multiple scattering alone, keeping the segments'
     /// single scattering ([`Renderer::set_tables`] after the image converged).
     pub fn keeps_single_scattering(&self) -> bool {
@@ -610,6 +684,10 @@ impl Renderer {
                 let after = batch + 1 > first_pass
                     || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
                 after.then_some(ImageReady::Full)
+            }
+            WorkUnit::Repaint { batch, .. } => {
+                let batches = self.shading_pass.frame_batches().count() as u32;
+                (batch + 1 >= batches).then_some(ImageReady::Full)
             }
             _ => None,
         };
@@ -1031,6 +1109,17 @@ impl Renderer {
                     rows,
                 })
             }
+            Stage::Repaint { batch } => {
+                self.refinement.stage = if batch + 1 < batches {
+                    Stage::Repaint { batch: batch + 1 }
+                } else {
+                    Stage::Converged
+                };
+                Some(WorkUnit::Repaint {
+                    batch,
+                    segments: self.repaint.len() as u32,
+                })
+            }
             Stage::Converged => None,
         }
     }
@@ -1127,6 +1216,33 @@ impl Renderer {
                 ShadingPass::clear(enc, &self.targets, self.segment_targets.as_ref());
                 self.converged_rows = 0;
                 self.encode_resolve(device, enc, 0..self.settings.height, (true, true));
+            }
+            WorkUnit::Repaint { batch, .. } => {
+                let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
+                    return;
+                };
+                if batch == 0
+                    && let Some(s) = &self.segment_targets
+                {
+                    let list: &[u8] = bytemuck::cast_slice(&self.repaint);
+                    ctx.queue.write_buffer(&s.work_list, 0, list);
+                    let count = self.repaint.len() as u32;
+                    ctx.queue
+                        .write_buffer(&s.work_count, 0, bytemuck::bytes_of(&count));
+                }
+                // The gather and resolve over the rows the segments cover.
+                let rows = self.repaint_rows.clone();
+                let b = ShadeBatch {
+                    row0: rows.start,
+                    rows: rows.len() as u32,
+                    ..*b
+                };
+                let inputs = self.shading_inputs();
+                self.shading_pass
+                    .encode_repaint(device, enc, &inputs, &self.targets, &b);
+                if last_light_batch(&b) && !rows.is_empty() {
+                    self.encode_resolve(device, enc, rows, (false, false));
+                }
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {

@@ -326,6 +326,14 @@ pub struct Renderer {
     /// from the last converged pass still holds (a change that reaches only the forward and
     /// dual-scattering terms: new tables, a deferred absorption's volume).
     pub(super) single_kept: bool,
+    /// Each segment's first point, in segment order (the brush's repaint finds the segments at the
+    /// points a dab changed: [`Renderer::repaint_points`]).
+    pub(super) segment_first: Vec<u32>,
+    /// The segments a planned repaint shades again (sorted), and the image rows they cover.
+    pub(super) repaint: Vec<u32>,
+    pub(super) repaint_rows: std::ops::Range<u32>,
+    /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
+    pub(super) point_data: Vec<[f32; 4]>,
     pub(super) timer: Option<PassTimer>,
     pub(super) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
@@ -581,6 +589,10 @@ impl Renderer {
             volume_absorption_old: false,
             shadow_grid_dirty: true,
             single_kept: false,
+            segment_first: super::shade::segment_starts(hair),
+            repaint: Vec::new(),
+            repaint_rows: 0..0,
+            point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
             refinement: Refinement::default(),
@@ -938,6 +950,7 @@ impl Renderer {
         let points = GpuHair::point_data(hair, thickness_scale);
         ctx.queue
             .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
+        self.point_data = points;
         // The ribbons' width changed: the visibility passes draw them again.
         self.invalidate_visibility();
         Ok(())

@@ -156,6 +156,19 @@ impl SegmentShadingPass {
             pixels,
             timestamps,
         );
+        self.encode_listed(device, encoder, inputs, segments, batch);
+    }
+
+    /// One light batch over the segments already listed in `work_list` (`work_count` of them: a
+    /// repaint's, written by the caller): the dispatch's size and the shading, no claim.
+    pub fn encode_listed(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        segments: &SegmentTargets,
+        batch: &wgpu::Buffer,
+    ) {
         let dispatch = bind(
             device,
             &self.dispatch,

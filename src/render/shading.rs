@@ -312,4 +312,29 @@ impl ShadingPass {
             timestamps,
         );
     }
+
+    /// A repaint's light batch: the segments listed in the segment targets' work list (written by
+    /// the caller) shaded again, no claim; after the frame's last light batch, rows
+    /// `batch.row0 .. + batch.rows` of the components gathered from the segments.
+    pub fn encode_repaint(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        batch: &ShadeBatch,
+    ) {
+        let Some(segments) = inputs.segment_targets else {
+            return;
+        };
+        let uniform = batch_uniform(device, batch);
+        self.segments
+            .encode_listed(device, encoder, inputs, segments, &uniform);
+        if last_light_batch(batch) {
+            let size = (targets.width, batch.rows);
+            self.segments.encode_gather(
+                device, encoder, inputs, targets, segments, &uniform, size, None,
+            );
+        }
+    }
 }
