@@ -454,8 +454,12 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     b.picker_ms
                 );
                 eprintln!(
-                    "{} brush: after the stroke, converged in {:.0} ms; volume, grid and multiple scattering followed in {:.0} ms (single scattering kept: {})",
-                    scene.name, b.stroke_converged_ms, b.follow_up_ms, b.follow_up_kept_single
+                    "{} brush: after the stroke, converged in {:.0} ms; volume, grid and multiple scattering followed in {:.0} ms (single scattering kept: {}; per pass {:.0?})",
+                    scene.name,
+                    b.stroke_converged_ms,
+                    b.follow_up_ms,
+                    b.follow_up_kept_single,
+                    b.follow_up_pass_ms
                 );
                 Some(b)
             } else {

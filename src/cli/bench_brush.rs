@@ -11,6 +11,7 @@ use strandlight::paint::brush::{Stroke, effective, eumelanin_unit};
 use strandlight::paint::pick::{Picker, ViewDepth};
 use strandlight::paint::{Brush, PaintLayer};
 use strandlight::render::Renderer;
+use strandlight::render::progressive::UNIT_PASSES;
 
 #[derive(Serialize)]
 pub struct BrushReport {
@@ -40,6 +41,8 @@ pub struct BrushReport {
     /// the segments kept their single scattering meanwhile.
     pub follow_up_ms: f64,
     pub follow_up_kept_single: bool,
+    /// The follow-up's time per pass (units' submission to completion), milliseconds.
+    pub follow_up_pass_ms: std::collections::BTreeMap<&'static str, f64>,
 }
 
 /// Refines until converged.
@@ -158,15 +161,21 @@ pub fn brush_run(
     let stroke_converged_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
     let mut follow_up_kept_single = false;
+    let mut follow_up_pass_ms = std::collections::BTreeMap::new();
     if renderer.rebuild_stale_volume() {
         follow_up_kept_single = renderer.keeps_single_scattering();
         converge(ctx, renderer)?;
+        let stats = renderer.refine_stats();
+        for (name, d) in UNIT_PASSES.iter().zip(stats.pass_time) {
+            follow_up_pass_ms.insert(*name, d.as_secs_f64() * 1e3);
+        }
     }
     let follow_up_ms = t.elapsed().as_secs_f64() * 1e3;
     Ok(BrushReport {
         stroke_converged_ms,
         follow_up_ms,
         follow_up_kept_single,
+        follow_up_pass_ms,
         dabs,
         radius_px: radius,
         picker_ms,
