@@ -128,9 +128,15 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
     return vec3<f32>(w * a);
 }
 
+// The dual terms' quadrature segments (twin: dual_response.rs): half the single-scattering
+// quadrature's, at least 2 (the renderer's 4 give 2: three integrand evaluations where five were).
+fn dual_quadrature_segments(m: u32) -> u32 {
+    return max(m / 2u, 2u);
+}
+
 // linear_quadrature of fast_response.rs over dual_integrand (parabolas on paired segments).
 fn dual_quadrature(p: FastHairParams, d: DualIntegrand, mu: f32, l: f32) -> vec3<f32> {
-    let m = p.quadrature_segments;
+    let m = dual_quadrature_segments(p.quadrature_segments);
     var out = vec3<f32>(0.0);
     var x0 = quadrature_sample(0u, m, mu, l);
     var f0 = dual_integrand(p, d, x0);
