@@ -199,10 +199,6 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     assert!(difference(&b, &c) > 1e-3, "the new eta changed the image");
 }
 
-/// Without multiple scattering nothing reads the volume's absorption: a deferred absorption change
-/// (the editor's dye and melanin edits) shades at once, rebuilds no volume or grid, and converges to
-/// the image of a renderer that rebuilt both. With multiple scattering the volume waits for
-/// `rebuild_stale_volume`, and then the image is the new absorption's.
 /// A renderer of `scene` with its settings, look and camera, on `hair` with `sigma_a`.
 fn bob_renderer(
     ctx: &GpuContext,
@@ -225,6 +221,11 @@ fn bob_renderer(
     .expect("renderer")
 }
 
+/// Without multiple scattering nothing reads the volume's absorption: a deferred absorption change
+/// (the editor's dye and melanin edits) shades at once, rebuilds no volume or grid, and converges to
+/// the image of a renderer that rebuilt both. With multiple scattering the volume waits for
+/// `rebuild_stale_volume`, which keeps the converged single scattering, and then the image is the new
+/// absorption's.
 #[test]
 fn deferred_absorption_rebuilds_only_what_reads_it() {
     let ctx = context();
@@ -384,20 +385,38 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     println!("repaint against a restart {d:.1e} (the dab moved the image by {moved:.1e})");
     assert!(moved > 1e-3, "the dab shows");
     assert_eq!(d, 0.0);
-    // A small dab (a few points of one strand, its gather and resolve over a few rows), again
-    // against a restart.
-    let strand = scene.hair.strand_range(scene.hair.strand_count() / 2);
-    let small: Vec<u32> = (strand.start as u32 + 4..strand.start as u32 + 7).collect();
-    for &i in &small {
-        sigma_a[i as usize] = [0.05, 0.1, 0.4];
-    }
-    for r in [&mut live, &mut restarted] {
+    // Two small dabs (a few points of one strand each, gathered and resolved over the rows they
+    // cover), the second while the first's repaint is under way: it waits for it, then repaints;
+    // again against a restart.
+    let before_small = live.read_frame(&ctx).expect("read");
+    let mut dab = |r: &mut Renderer, strand: usize| {
+        let range = scene.hair.strand_range(strand);
+        let small: Vec<u32> = (range.start as u32 + 4..range.start as u32 + 7).collect();
+        for &i in &small {
+            sigma_a[i as usize] = [0.05, 0.1, 0.4];
+        }
         r.set_absorption_points_deferred(&ctx, &sigma_a, &small)
             .expect("absorption");
-    }
-    let before_small = live.read_frame(&ctx).expect("read");
-    assert!(live.repaint_points(&small));
-    refine_all(&mut live, &ctx);
+        small
+    };
+    let middle = scene.hair.strand_count() / 2;
+    let first = dab(&mut live, middle);
+    assert!(live.repaint_points(&first));
+    let p = live.refine(&ctx).expect("refine");
+    assert!(matches!(
+        p.submitted,
+        Some(WorkUnit::Repaint { batch: 0, .. })
+    ));
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+    let second = dab(&mut live, middle + 1);
+    assert!(live.repaint_points(&second));
+    let units = refine_all(&mut live, &ctx);
+    println!("the second dab's repaint after the first's: {units:?}");
+    assert_eq!(units.len(), 2 * batches - 1);
+    dab(&mut restarted, middle);
+    dab(&mut restarted, middle + 1);
     restarted.restart();
     refine_all(&mut restarted, &ctx);
     let (got, want) = (

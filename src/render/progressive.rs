@@ -525,13 +525,18 @@ impl Renderer {
     /// converged and shaded by segment, the segments keep their single scattering and the plan shades
     /// multiple scattering alone ([`Renderer::keeps_single_scattering`]).
     pub(super) fn refine_multiple_only(&mut self, change: impl FnOnce(&mut Self)) {
-        // Kept already (a plan shading multiple scattering alone, its single scattering untouched),
-        // or converged.
-        let keep = self.single_kept
-            || (self.by_segment
-                && self.settings.multiple_scattering
-                && self.refinement.stage == Stage::Converged
-                && !self.refinement.preview_owed);
+        // Converged, or kept already (a plan shading multiple scattering alone, its single
+        // scattering untouched); not in the middle of a repaint (its segments part-way).
+        let keep = match self.refinement.stage {
+            Stage::Converged => {
+                self.by_segment
+                    && self.settings.multiple_scattering
+                    && !self.refinement.preview_owed
+                    && self.repaint_pending.is_empty()
+            }
+            Stage::Repaint { .. } => false,
+            _ => self.single_kept,
+        };
         self.restart_as_refinement(change);
         self.single_kept = keep;
     }
@@ -544,20 +549,16 @@ impl Renderer {
     /// False, nothing planned, when the image is not converged by segment: the caller restarts.
     pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
         let r = &self.refinement;
-        let repainting = matches!(r.stage, Stage::Repaint { .. });
         let ready = self.by_segment
             && self.segment_targets.is_some()
             && self.visibility_valid
             && !r.preview_owed
-            && (r.stage == Stage::Converged || repainting)
+            && matches!(r.stage, Stage::Converged | Stage::Repaint { .. })
             && self.shading_pass.frame_batches().next().is_some();
         if !ready {
             return false;
         }
-        let mut segments = std::mem::take(&mut self.repaint);
-        if !repainting {
-            segments.clear();
-        }
+        let mut segments = Vec::new();
         for &i in changed {
             // The segment from point i, and the one to it (from i - 1, in the same strand).
             for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
@@ -566,15 +567,36 @@ impl Renderer {
                 }
             }
         }
+        if segments.is_empty() {
+            return true;
+        }
+        // The repaint writes its segments' single scattering: nothing is kept across it.
+        self.single_kept = false;
+        match self.refinement.stage {
+            Stage::Repaint { batch } if batch > 0 => {
+                // Under way: these follow once it ends (starting it again at every dab would never
+                // let it finish while the pointer moves).
+                self.repaint_pending.extend(segments);
+            }
+            stage => {
+                // Converged, or planned and not started: one repaint of them all.
+                if stage != Stage::Converged {
+                    segments.append(&mut self.repaint);
+                }
+                segments.append(&mut self.repaint_pending);
+                self.start_repaint(segments);
+            }
+        }
+        true
+    }
+
+    /// Plans the repaint of `segments` from the first light batch.
+    fn start_repaint(&mut self, mut segments: Vec<u32>) {
         segments.sort_unstable();
         segments.dedup();
-        if !segments.is_empty() {
-            // From the first batch again (a repaint part-way redoes its segments with the others').
-            self.refinement.stage = Stage::Repaint { batch: 0 };
-        }
         self.repaint_rows = self.rows_covered(&segments);
         self.repaint = segments;
-        true
+        self.refinement.stage = Stage::Repaint { batch: 0 };
     }
 
     /// The image rows where `segments` may leave fragments: their ends' projections, widened by
@@ -604,7 +626,7 @@ impl Renderer {
     /// Whether the refinement under way shades multiple scattering alone, keeping the segments'
     /// single scattering ([`Renderer::set_tables`] after the image converged).
     pub fn keeps_single_scattering(&self) -> bool {
-        self.single_kept
+        self.single_kept && self.refinement.stage != Stage::Converged
     }
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
@@ -633,6 +655,8 @@ impl Renderer {
         } else {
             self.main_stage()
         };
+        // Whatever the new plan shades, it shades whole: no repaint waits.
+        self.repaint_pending.clear();
         let r = &mut self.refinement;
         r.preview_started = false;
         r.preview_new_view = false;
@@ -1120,7 +1144,15 @@ impl Renderer {
                     segments: self.repaint.len() as u32,
                 })
             }
-            Stage::Converged => None,
+            Stage::Converged => {
+                // Dabs that came during a repaint.
+                if self.repaint_pending.is_empty() {
+                    return None;
+                }
+                let pending = std::mem::take(&mut self.repaint_pending);
+                self.start_repaint(pending);
+                self.next_unit(device)
+            }
         }
     }
 

@@ -42,7 +42,8 @@ pub const REFERENCE_VARIANT: ModelVariant = ModelVariant {
     ..ModelVariant::XU
 };
 
-/// Quadrature segments of the reference's dual-scattering responses (the renderer uses Xu's m = 4).
+/// Quadrature segments of the reference's responses (the renderer uses Xu's m = 4); its dual terms
+/// integrate with half of them ([`crate::scattering::dual_response::dual_quadrature_segments`]: 8).
 pub const REFERENCE_QUADRATURE_SEGMENTS: u32 = 16;
 
 /// What dual scattering needs besides the hair parameters.

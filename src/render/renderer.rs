@@ -318,6 +318,9 @@ pub struct Renderer {
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
     pub(super) volume_stale: bool,
+    /// The stale volume's density changed too (a deferred thickness change): its rebuild changes the
+    /// grid's transmittance, which single scattering reads.
+    pub(super) volume_stale_density: bool,
     /// The volume holds an old absorption that nothing reads now (multiple scattering off): rebuilt
     /// when multiple scattering is turned on.
     pub(super) volume_absorption_old: bool,
@@ -332,6 +335,8 @@ pub struct Renderer {
     /// The segments a planned repaint shades again (sorted), and the image rows they cover.
     pub(super) repaint: Vec<u32>,
     pub(super) repaint_rows: std::ops::Range<u32>,
+    /// Segments of dabs that came while a repaint was under way: repainted after it.
+    pub(super) repaint_pending: Vec<u32>,
     /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
     pub(super) point_data: Vec<[f32; 4]>,
     pub(super) timer: Option<PassTimer>,
@@ -586,12 +591,14 @@ impl Renderer {
             requested_fragments,
             converged_rows: u32::MAX,
             volume_stale: false,
+            volume_stale_density: false,
             volume_absorption_old: false,
             shadow_grid_dirty: true,
             single_kept: false,
             segment_first: super::shade::segment_starts(hair),
             repaint: Vec::new(),
             repaint_rows: 0..0,
+            repaint_pending: Vec::new(),
             point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
@@ -886,10 +893,15 @@ impl Renderer {
         if !self.volume_stale {
             return false;
         }
-        // The change itself is on screen (shaded with the old volume): no new preview. The
-        // volume's density, and so the grid's transmittance, stays: a converged image keeps its
-        // single scattering (shaded at the new absorption already).
-        self.refine_multiple_only(|r| r.mark_volume_dirty());
+        // The change itself is on screen (shaded with the old volume): no new preview. After an
+        // absorption change the volume's density, and so the grid's transmittance, stays: a converged
+        // image keeps its single scattering (shaded at the new absorption already). A thickness
+        // change's density shadows single scattering too.
+        if self.volume_stale_density {
+            self.restart_as_refinement(|r| r.mark_volume_dirty());
+        } else {
+            self.refine_multiple_only(|r| r.mark_volume_dirty());
+        }
         true
     }
 
@@ -1000,6 +1012,7 @@ impl Renderer {
         }
         if self.settings.shadows && self.light_count > 0 {
             self.volume_stale = true;
+            self.volume_stale_density = true;
             self.restart_refinement();
         } else {
             self.mark_volume_dirty();
@@ -1046,6 +1059,7 @@ impl Renderer {
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
         self.volume_stale = false;
+        self.volume_stale_density = false;
         self.volume_absorption_old = false;
         self.mark_shadow_grid_dirty();
     }
