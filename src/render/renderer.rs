@@ -1374,6 +1374,9 @@ impl Renderer {
         }
         ctx.queue.submit([enc.finish()]);
         self.refinement.complete_frame();
+        // The whole frame is shaded: no dab waits for a repaint, nothing is kept.
+        self.repaint_pending.clear();
+        self.single_kept = false;
     }
 
     /// Rebuilds the whole shadow grid alone and waits for it: wall-clock seconds (benchmarks). On lavapipe
