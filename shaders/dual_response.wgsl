@@ -137,43 +137,22 @@ fn dual_quadrature_segments(m: u32) -> u32 {
 // linear_quadrature of fast_response.rs over dual_integrand (parabolas on paired segments).
 fn dual_quadrature(p: FastHairParams, d: DualIntegrand, mu: f32, l: f32) -> vec3<f32> {
     let m = dual_quadrature_segments(p.quadrature_segments);
-    var out = vec3<f32>(0.0);
-    var x0 = quadrature_sample(0u, m, mu, l);
-    var f0 = dual_integrand(p, d, x0);
-    var s = 1u;
-    loop {
-        if (s > m) {
-            break;
-        }
-        let x1 = quadrature_sample(s, m, mu, l);
-        let f1 = dual_integrand(p, d, x1);
-        if (s < m) {
-            let x2 = quadrature_sample(s + 1u, m, mu, l);
-            let f2 = dual_integrand(p, d, x2);
-            if (x2 > x0 && x1 > x0 && x2 > x1) {
-                out = out + quadrature_parabola_pair(x0, x1, x2, f0, f1, f2, mu, l);
-            } else if (x2 > x0) {
-                out = out + quadrature_linear_piece(x0, x2, f0, f2, mu, l);
-            }
-            x0 = x2;
-            f0 = f2;
-            s = s + 2u;
-            continue;
-        }
-        out = out + quadrature_linear_piece(x0, x1, f0, f1, mu, l);
-        x0 = x1;
-        f0 = f1;
-        s = s + 1u;
+    var q = quadrature_start(mu, l);
+    for (var s = 1u; s < m; s++) {
+        let x = quadrature_sample(s, m, mu, l);
+        quadrature_node(&q, s, m, x, dual_integrand(p, d, x));
     }
-    return out;
+    quadrature_end(&q, m);
+    return q.out;
 }
 
 // M_t^G per unit light power (Xu Eq. 27).
 fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32) -> vec3<f32> {
     let sigma = forward_spread(sigma_f2, light.lambda);
-    let longitudinal = longitudinal_lobe(p.longitudinal, theta_o, p.alpha[lobe], p.beta[lobe]);
-    let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal.mu, 2.0 * SQRT_2 * p.beta[lobe]);
-    let c = g.x / (2.0 * PI * sigma * 2.0 * p.beta[lobe] * max(cos(light.theta), 1e-3));
+    let beta = lobe_component(p.beta, lobe);
+    let longitudinal = longitudinal_lobe(p.longitudinal, theta_o, lobe_component(p.alpha, lobe), beta);
+    let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal.mu, 2.0 * SQRT_2 * beta);
+    let c = g.x / (2.0 * PI * sigma * 2.0 * beta * max(cos(light.theta), 1e-3));
     if (c < 1e-30) {
         return vec3<f32>(0.0);
     }

@@ -197,39 +197,74 @@ fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
     return ratio * outer_integrand(params, lobe, light, theta_o, phi_o, longitudinal, ti);
 }
 
-fn quadrature_linear_piece(x0: f32, x1: f32, f0: vec3<f32>, f1: vec3<f32>, mu: f32, lambda: f32) -> vec3<f32> {
-    var out = vec3<f32>(0.0);
-    if (x1 <= x0) {
-        return out;
-    }
-    let i = gaussian_linear_moments(x0, x1, mu, lambda);
-    for (var c = 0u; c < 3u; c++) {
-        let c1 = (f1[c] - f0[c]) / (x1 - x0);
-        let c0 = f0[c] - c1 * x0;
-        out[c] = (c0 + c1 * mu) * i.x + c1 * i.y;
-    }
-    return out;
+// The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
+// fed in order; each even node closes the pair of segments before it with their parabola, a last odd
+// node (m odd) its linear segment. One call site of the integrand per quadrature keeps the shading
+// shaders small: inlined at every call site, three per quadrature and one per lobe, they took lavapipe
+// seconds to compile.
+struct Quadrature {
+    mu: f32,
+    l: f32,
+    x0: f32,
+    f0: vec3<f32>,
+    x1: f32,
+    f1: vec3<f32>,
+    out: vec3<f32>,
 }
 
-// The parabola through (x0, f0), (x1, f1), (x2, f2) per channel against g(x; mu, l) over [x0, x2]: Newton form
-// in y = x - mu, the Gaussian's moments computed once for the three channels.
-fn quadrature_parabola_pair(x0: f32, x1: f32, x2: f32, f0: vec3<f32>, f1: vec3<f32>, f2: vec3<f32>, mu: f32, l: f32) -> vec3<f32> {
-    let m = gaussian_quadratic_moments(x0, x2, mu, l);
-    var out = vec3<f32>(0.0);
-    for (var c = 0u; c < 3u; c++) {
-        let q1 = (f1[c] - f0[c]) / (x1 - x0);
-        let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
-        let y0 = x0 - mu;
-        let y1 = x1 - mu;
-        out[c] = (f0[c] - q1 * y0 + q2 * y0 * y1) * m.x + (q1 - q2 * (y0 + y1)) * m.y + q2 * m.z;
+// Node 0, the pole -pi/2. Every integrand of the quadratures carries the longitudinal factor's
+// cos(theta_i) clamped at 0 (longitudinal_factor), which is 0 at both ends in f32 (cos(FRAC_PI_2) < 0):
+// the ends are not evaluated (lavapipe runs both sides of a branch, so an early return there saved
+// nothing), only the m - 1 inner nodes, and quadrature_end closes the rule at +pi/2.
+fn quadrature_start(mu: f32, l: f32) -> Quadrature {
+    return Quadrature(mu, l, -FRAC_PI_2, vec3<f32>(0.0), 0.0, vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+fn quadrature_end(q: ptr<function, Quadrature>, m: u32) {
+    quadrature_node(q, m, m, FRAC_PI_2, vec3<f32>(0.0));
+}
+
+fn quadrature_node(q: ptr<function, Quadrature>, s: u32, m: u32, x: f32, f: vec3<f32>) {
+    let odd = (s & 1u) == 1u;
+    if (s > 0u && odd && s < m) {
+        // The middle of a pair: kept until its end.
+        (*q).x1 = x;
+        (*q).f1 = f;
+        return;
     }
-    return out;
+    let x0 = (*q).x0;
+    let f0 = (*q).f0;
+    if (s > 0u && x > x0) {
+        // The pair's parabola through (x0, x1, x) when its middle lies strictly inside, else the line
+        // from x0 (the last node of an odd m, or a pair whose middle was clipped onto an end): one set
+        // of moments either way, the line being the parabola with q2 = 0 (Newton form in y = x - mu).
+        let x1 = (*q).x1;
+        let pair = !odd && x1 > x0 && x > x1;
+        let mo = gaussian_quadratic_moments(x0, x, (*q).mu, (*q).l);
+        let y0 = x0 - (*q).mu;
+        var q1 = (f - f0) / (x - x0);
+        var q2 = vec3<f32>(0.0);
+        var y1 = 0.0;
+        if (pair) {
+            q1 = ((*q).f1 - f0) / (x1 - x0);
+            q2 = ((f - (*q).f1) / (x - x1) - q1) / (x - x0);
+            y1 = x1 - (*q).mu;
+        }
+        (*q).out = (*q).out + (f0 - q1 * y0 + q2 * (y0 * y1)) * mo.x + (q1 - q2 * (y0 + y1)) * mo.y + q2 * mo.z;
+    }
+    (*q).x0 = x;
+    (*q).f0 = f;
+}
+
+// Component t of v (a select chain: a dynamic index into a vector spills to memory on lavapipe).
+fn lobe_component(v: vec4<f32>, t: u32) -> f32 {
+    return select(select(v.z, v.y, t == 1u), v.x, t == 0u);
 }
 
 // M_t for lobe t (0 = R, 1 = TT, 2 = TRT), RGB (Xu Eq. 11 by Sec. 4.2.2, parabolas on paired segments).
 fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
-    let alpha = params.alpha[lobe];
-    let beta = params.beta[lobe];
+    let alpha = lobe_component(params.alpha, lobe);
+    let beta = lobe_component(params.beta, lobe);
     let longitudinal = longitudinal_lobe(params.longitudinal, theta_o, alpha, beta);
     let lambda_m = 2.0 * SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
@@ -238,35 +273,11 @@ fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
         return vec3<f32>(0.0);
     }
     let m = params.quadrature_segments;
-    let mu = w.peak;
-    let l = w.lambda;
-    var out = vec3<f32>(0.0);
-    var x0 = quadrature_sample(0u, m, mu, l);
-    var f0 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x0);
-    var s = 1u;
-    loop {
-        if (s > m) {
-            break;
-        }
-        let x1 = quadrature_sample(s, m, mu, l);
-        let f1 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x1);
-        if (s < m) {
-            let x2 = quadrature_sample(s + 1u, m, mu, l);
-            let f2 = weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x2);
-            if (x2 > x0 && x1 > x0 && x2 > x1) {
-                out = out + quadrature_parabola_pair(x0, x1, x2, f0, f1, f2, mu, l);
-            } else if (x2 > x0) {
-                out = out + quadrature_linear_piece(x0, x2, f0, f2, mu, l);
-            }
-            x0 = x2;
-            f0 = f2;
-            s = s + 2u;
-            continue;
-        }
-        out = out + quadrature_linear_piece(x0, x1, f0, f1, mu, l);
-        x0 = x1;
-        f0 = f1;
-        s = s + 1u;
+    var q = quadrature_start(w.peak, w.lambda);
+    for (var s = 1u; s < m; s++) {
+        let x = quadrature_sample(s, m, q.mu, q.l);
+        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x));
     }
-    return max(scale * out, vec3<f32>(0.0));
+    quadrature_end(&q, m);
+    return max(scale * q.out, vec3<f32>(0.0));
 }

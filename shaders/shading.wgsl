@@ -87,6 +87,8 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
         let k = sh.transmittance * l.rgb;
+        // Each lobe's response is called from one place (its lobe a constant: lavapipe runs every
+        // branch of a lobe chosen at run time), the local term from one loop below.
         if (single) {
             out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
             out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
@@ -101,16 +103,23 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
             var global = vec3<f32>(0.0);
             var local = vec3<f32>(0.0);
             var local_direct = vec3<f32>(0.0);
-            if (sh.transmittance > 0.0) {
-                local_direct = local_response(p, light, o.x, o.y, 0.0, sh.depth_behind);
-            }
-            if (any(sh.transmittance_f > vec3<f32>(sh.transmittance))) {
+            let lit = sh.transmittance > 0.0;
+            let scattered = any(sh.transmittance_f > vec3<f32>(sh.transmittance));
+            if (scattered) {
                 global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
-                if (s2 == 0.0 && sh.transmittance > 0.0) {
-                    local = local_direct;
+            }
+            // Part 0 the direct light's local term (no spread), part 1 the scattered light's.
+            let spread_apart = scattered && !(s2 == 0.0 && lit);
+            for (var part = select(1u, 0u, lit); part < select(1u, 2u, spread_apart); part++) {
+                let v = local_response(p, light, o.x, o.y, select(0.0, s2, part == 1u), sh.depth_behind);
+                if (part == 0u) {
+                    local_direct = v;
                 } else {
-                    local = local_response(p, light, o.x, o.y, s2, sh.depth_behind);
+                    local = v;
                 }
+            }
+            if (scattered && !spread_apart) {
+                local = local_direct;
             }
             let ms = dual_scattering_components(p, sh.transmittance, sh.transmittance_f, local_direct, global, local);
             let power = srbf_integral(l.lambda) * l.rgb;
@@ -206,16 +215,31 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
             t = vec3<f32>(grid_shadow(shadow_grid, a.position, j).transmittance, grid_shadow(shadow_grid, mid.position, j).transmittance, grid_shadow(shadow_grid, b.position, j).transmittance);
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
-        let ra = l.rgb * srbf_response_lobe(pa, 0u, light, o.x, o.y);
-        let tta = l.rgb * srbf_response_lobe(pa, 1u, light, o.x, o.y);
-        let trta = l.rgb * srbf_response_lobe(pa, 2u, light, o.x, o.y);
-        var rb = ra;
-        var ttb = tta;
-        var trtb = trta;
-        if (painted) {
-            rb = l.rgb * srbf_response_lobe(pb, 0u, light, o.x, o.y);
-            ttb = l.rgb * srbf_response_lobe(pb, 1u, light, o.x, o.y);
-            trtb = l.rgb * srbf_response_lobe(pb, 2u, light, o.x, o.y);
+        var ra = zero; var tta = zero; var trta = zero;
+        var rb = zero; var ttb = zero; var trtb = zero;
+        // End a's responses, then end b's when its absorption differs: one call site per lobe.
+        for (var e = 0u; e < select(1u, 2u, painted); e++) {
+            var pe = pa;
+            if (e == 1u) {
+                pe = pb;
+            }
+            let r = l.rgb * srbf_response_lobe(pe, 0u, light, o.x, o.y);
+            let tt = l.rgb * srbf_response_lobe(pe, 1u, light, o.x, o.y);
+            let trt = l.rgb * srbf_response_lobe(pe, 2u, light, o.x, o.y);
+            if (e == 0u) {
+                ra = r;
+                tta = tt;
+                trta = trt;
+            } else {
+                rb = r;
+                ttb = tt;
+                trtb = trt;
+            }
+        }
+        if (!painted) {
+            rb = ra;
+            ttb = tta;
+            trtb = trta;
         }
         r0 = r0 + t.x * ra; r1 = r1 + t.y * between_ends(ra, rb, 0.5); r2 = r2 + t.z * rb;
         tt0 = tt0 + t.x * tta; tt1 = tt1 + t.y * between_ends(tta, ttb, 0.5); tt2 = tt2 + t.z * ttb;

@@ -434,3 +434,38 @@ fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
         "d'Eon M: worst |integral - 1| {worst_norm:.1e}; f32 twin worst relative difference {worst_twin:.1e}"
     );
 }
+
+/// The quadratures evaluate their integrands at the m - 1 inner nodes only, taking them as 0 at the
+/// poles (linear_quadrature): every integrand carries the longitudinal factor, whose clamped
+/// cos(theta_i) is exactly 0 at +-pi/2 in f32, for both longitudinal functions, any tilt, width and
+/// outgoing inclination (the pole reflection included).
+#[test]
+fn the_longitudinal_factor_vanishes_at_the_poles() {
+    use strandlight::scattering::fast_response::LongitudinalLobe;
+    let mut checked = 0;
+    for longitudinal in [0u32, 1] {
+        for beta_deg in [0.5f32, 2.0, 5.0, 10.0, 20.0, 40.0] {
+            for alpha_deg in [-10.0f32, -3.0, 0.0, 3.0, 10.0] {
+                for k in 0..=36 {
+                    let theta_o =
+                        -std::f32::consts::FRAC_PI_2 + std::f32::consts::PI * k as f32 / 36.0;
+                    let l = LongitudinalLobe::new(
+                        longitudinal,
+                        theta_o,
+                        alpha_deg.to_radians(),
+                        beta_deg.to_radians(),
+                    );
+                    for pole in [-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2] {
+                        let f = l.factor(pole);
+                        assert!(
+                            f == 0.0,
+                            "factor {f} at {pole} (model {longitudinal}, beta {beta_deg}, alpha {alpha_deg}, theta_o {theta_o})"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    println!("the longitudinal factor is 0 at both poles in {checked} cases");
+}

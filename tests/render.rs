@@ -375,12 +375,21 @@ fn fidelity(
     shadow_settings.iter().map(|&shadows| {
         let mut s = scene(1500, 96, 64, shadows, Preset::Brown);
         s.settings.segment_shading = false;
+        let t = std::time::Instant::now();
         let (_, frame) = render(ctx, luts, &s, lights);
+        let t_fragment = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
         let reference = reference(&s, &frame, env, lights.yaw);
+        let t_reference = t.elapsed().as_secs_f64();
         let e_fragment = relative_rmse(&frame, &reference);
         // The same K-buffer shaded by segment (the default): what shading segments once costs.
         s.settings.segment_shading = true;
+        let t = std::time::Instant::now();
         let (r, by_segment) = render(ctx, luts, &s, lights);
+        println!(
+            "{name}, shadows {shadows}: renders {t_fragment:.1} s / {:.1} s, reference {t_reference:.1} s",
+            t.elapsed().as_secs_f64()
+        );
         assert!(r.shades_segments(), "{name}: the view shades per fragment");
         let e = relative_rmse(&by_segment, &reference);
         let mean = |f: &Frame| {

@@ -18,9 +18,7 @@
 //! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
 
 use super::azimuthal_table::{AzimuthalTable, inner_integral_blended};
-use super::circular_gaussian::{
-    bessel_i0_scaled, gaussian_linear_moments, gaussian_quadratic_moments,
-};
+use super::circular_gaussian::{bessel_i0_scaled, gaussian_quadratic_moments};
 use super::fast_azimuthal::{LobeFit, Rgb32, eta_star_mean, inner_integral_r, trt_lobes, tt_lobe};
 use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
@@ -73,55 +71,89 @@ pub fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
 /// linearly on every segment. Here segments are taken in pairs and f is interpolated by the parabola
 /// through each pair's three samples (the paper's suggested "higher order polynomial"); a last unpaired
 /// segment (m odd) stays linear. f contains cos^2(theta_i), which vanishes quadratically at the ends
-/// +-pi/2: near the poles the linear rule was off by up to 12% from m = 200.
+/// +-pi/2: near the poles the linear rule was off by up to 12% from m = 200. f must vanish at the ends
+/// (every integrand carries the longitudinal factor's clamped cos(theta_i)): it is evaluated at the
+/// m - 1 inner samples only.
 pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) -> Rgb32) -> Rgb32 {
-    let mut out = [0.0; 3];
-    let mut x0 = quadrature_sample(0, m, mu, lambda);
-    let mut f0 = f(x0);
-    let mut s = 1;
-    while s <= m {
-        let pair = s < m;
-        let x1 = quadrature_sample(s, m, mu, lambda);
-        let f1 = f(x1);
-        if pair {
-            let x2 = quadrature_sample(s + 1, m, mu, lambda);
-            let f2 = f(x2);
-            if x2 > x0 && x1 > x0 && x2 > x1 {
-                let m = gaussian_quadratic_moments(x0, x2, mu, lambda);
-                for c in 0..3 {
-                    // Newton form in y = x - mu: p = f0 + q1 (x - x0) + q2 (x - x0)(x - x1).
-                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
-                    let q2 = ((f2[c] - f1[c]) / (x2 - x1) - q1) / (x2 - x0);
-                    let (y0, y1) = (x0 - mu, x1 - mu);
-                    let d = [f0[c] - q1 * y0 + q2 * y0 * y1, q1 - q2 * (y0 + y1), q2];
-                    out[c] += d[0] * m[0] + d[1] * m[1] + d[2] * m[2];
-                }
-            } else if x2 > x0 {
-                add_linear(&mut out, x0, x2, f0, f2, mu, lambda);
-            }
-            x0 = x2;
-            f0 = f2;
-            s += 2;
-            continue;
-        }
-        add_linear(&mut out, x0, x1, f0, f1, mu, lambda);
-        x0 = x1;
-        f0 = f1;
-        s += 1;
+    let mut q = Quadrature::start(mu, lambda);
+    for s in 1..m {
+        let x = quadrature_sample(s, m, mu, lambda);
+        q.node(s, m, x, f(x));
     }
-    out
+    q.end(m);
+    q.out
 }
 
-fn add_linear(out: &mut Rgb32, x0: f32, x1: f32, f0: Rgb32, f1: Rgb32, mu: f32, lambda: f32) {
-    if x1 <= x0 {
-        return;
+/// [`linear_quadrature`] node by node (twin of WGSL's `Quadrature`, `quadrature_start` and
+/// `quadrature_node`): nodes s = 0..=m are fed in order; each even node closes the pair of segments
+/// before it with their parabola, a last odd node (m odd) its linear segment. The shaders call their
+/// integrands from one place per quadrature this way (each call site is inlined: three per
+/// quadrature took lavapipe seconds to compile).
+#[derive(Clone, Copy, Debug)]
+pub struct Quadrature {
+    pub mu: f32,
+    pub lambda: f32,
+    x0: f32,
+    f0: Rgb32,
+    x1: f32,
+    f1: Rgb32,
+    pub out: Rgb32,
+}
+
+impl Quadrature {
+    /// Node 0, the pole -pi/2. Every integrand of the quadratures carries the longitudinal factor's
+    /// cos(theta_i) clamped at 0 ([`LongitudinalLobe::factor`]), which is 0 at both ends in f32
+    /// (cos(FRAC_PI_2) < 0): the ends are not evaluated, only the m - 1 inner nodes, and [`Self::end`]
+    /// closes the rule at +pi/2.
+    pub fn start(mu: f32, lambda: f32) -> Self {
+        Self {
+            mu,
+            lambda,
+            x0: -FRAC_PI_2,
+            f0: [0.0; 3],
+            x1: 0.0,
+            f1: [0.0; 3],
+            out: [0.0; 3],
+        }
     }
-    let [i0, i1] = gaussian_linear_moments(x0, x1, mu, lambda);
-    for c in 0..3 {
-        // f ~ c0 + c1 x on [x0, x1].
-        let c1 = (f1[c] - f0[c]) / (x1 - x0);
-        let c0 = f0[c] - c1 * x0;
-        out[c] += (c0 + c1 * mu) * i0 + c1 * i1;
+
+    /// Node m, the pole +pi/2 (f = 0 there).
+    pub fn end(&mut self, m: u32) {
+        self.node(m, m, FRAC_PI_2, [0.0; 3]);
+    }
+
+    /// Node s of m at x with f(x).
+    pub fn node(&mut self, s: u32, m: u32, x: f32, f: Rgb32) {
+        let odd = s & 1 == 1;
+        if s > 0 && odd && s < m {
+            // The middle of a pair: kept until its end.
+            self.x1 = x;
+            self.f1 = f;
+            return;
+        }
+        let (x0, f0) = (self.x0, self.f0);
+        if s > 0 && x > x0 {
+            // The pair's parabola through (x0, x1, x) when its middle lies strictly inside, else the
+            // line from x0 (the last node of an odd m, or a pair whose middle was clipped onto an
+            // end): the line is the parabola with q2 = 0 (Newton form in y = x - mu).
+            let (x1, f1, mu) = (self.x1, self.f1, self.mu);
+            let pair = !odd && x1 > x0 && x > x1;
+            let mo = gaussian_quadratic_moments(x0, x, mu, self.lambda);
+            let y0 = x0 - mu;
+            for c in 0..3 {
+                let (q1, q2, y1) = if pair {
+                    let q1 = (f1[c] - f0[c]) / (x1 - x0);
+                    (q1, ((f[c] - f1[c]) / (x - x1) - q1) / (x - x0), x1 - mu)
+                } else {
+                    ((f[c] - f0[c]) / (x - x0), 0.0, 0.0)
+                };
+                self.out[c] += (f0[c] - q1 * y0 + q2 * (y0 * y1)) * mo[0]
+                    + (q1 - q2 * (y0 + y1)) * mo[1]
+                    + q2 * mo[2];
+            }
+        }
+        self.x0 = x;
+        self.f0 = f;
     }
 }
 
