@@ -128,7 +128,7 @@ fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
     let w = longitudinal_factor(longitudinal, theta_i);
-    // The quadrature's end nodes sit at the poles, where cos(theta_i) (and so w) vanishes.
+    // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if (w == 0.0) {
         return vec3<f32>(0.0);
     }
@@ -200,8 +200,8 @@ fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
 // The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
 // fed in order; each even node closes the pair of segments before it with their parabola, a last odd
 // node (m odd) its linear segment. One call site of the integrand per quadrature keeps the shading
-// shaders small: inlined at every call site, three per quadrature and one per lobe, they took lavapipe
-// seconds to compile.
+// shaders small: every call is inlined, and three call sites per quadrature made the segment kernel
+// take lavapipe 7 s to compile.
 struct Quadrature {
     mu: f32,
     l: f32,
@@ -213,9 +213,11 @@ struct Quadrature {
 }
 
 // Node 0, the pole -pi/2. Every integrand of the quadratures carries the longitudinal factor's
-// cos(theta_i) clamped at 0 (longitudinal_factor), which is 0 at both ends in f32 (cos(FRAC_PI_2) < 0):
-// the ends are not evaluated (lavapipe runs both sides of a branch, so an early return there saved
-// nothing), only the m - 1 inner nodes, and quadrature_end closes the rule at +pi/2.
+// cos(theta_i) clamped at 0 (longitudinal_factor), so the integrand vanishes at both ends (exactly in
+// the Rust twin, where cos(FRAC_PI_2) < 0 in f32; a GPU's cos, accurate to 2^-11, could only have added
+// a spurious value there): the ends are not evaluated (an early return there had not saved the
+// integrands' table reads on lavapipe), only the m - 1 inner nodes, and quadrature_end closes the rule
+// at +pi/2.
 fn quadrature_start(mu: f32, l: f32) -> Quadrature {
     return Quadrature(mu, l, -FRAC_PI_2, vec3<f32>(0.0), 0.0, vec3<f32>(0.0), vec3<f32>(0.0));
 }

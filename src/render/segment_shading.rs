@@ -75,6 +75,7 @@ impl SegmentTargets {
 }
 
 /// The four pipelines.
+#[derive(Clone)]
 pub struct SegmentShadingPass {
     claim: wgpu::ComputePipeline,
     dispatch: wgpu::ComputePipeline,

@@ -84,8 +84,8 @@ pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) ->
     q.out
 }
 
-/// [`linear_quadrature`] node by node (twin of WGSL's `Quadrature`, `quadrature_start` and
-/// `quadrature_node`): nodes s = 0..=m are fed in order; each even node closes the pair of segments
+/// [`linear_quadrature`] node by node (twin of WGSL's `Quadrature`, `quadrature_start`,
+/// `quadrature_node` and `quadrature_end`): nodes s = 0..=m are fed in order; each even node closes the pair of segments
 /// before it with their parabola, a last odd node (m odd) its linear segment. The shaders call their
 /// integrands from one place per quadrature this way (each call site is inlined: three per
 /// quadrature took lavapipe seconds to compile).
@@ -102,9 +102,9 @@ pub struct Quadrature {
 
 impl Quadrature {
     /// Node 0, the pole -pi/2. Every integrand of the quadratures carries the longitudinal factor's
-    /// cos(theta_i) clamped at 0 ([`LongitudinalLobe::factor`]), which is 0 at both ends in f32
-    /// (cos(FRAC_PI_2) < 0): the ends are not evaluated, only the m - 1 inner nodes, and [`Self::end`]
-    /// closes the rule at +pi/2.
+    /// cos(theta_i) clamped at 0 ([`LongitudinalLobe::factor`]), exactly 0 at both ends in f32
+    /// (cos(FRAC_PI_2) < 0; tested in `tests/fast_model.rs`): the ends are not evaluated, only the
+    /// m - 1 inner nodes, and [`Self::end`] closes the rule at +pi/2.
     pub fn start(mu: f32, lambda: f32) -> Self {
         Self {
             mu,
@@ -297,7 +297,7 @@ pub fn outer_integrand(
     let theta_d = 0.5 * (theta_o - theta_i);
     let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
     let w = longitudinal.factor(theta_i);
-    // The quadrature's end nodes sit at the poles, where cos(theta_i) (and so w) vanishes.
+    // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if w == 0.0 {
         return [0.0; 3];
     }
