@@ -76,39 +76,6 @@ pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub summary: AdapterSummary,
-    /// Pipelines made once for this device and shared by every renderer on it (clones share it).
-    pub pipelines: PipelineCache,
-}
-
-/// Pipelines shared by the renderers of one device, one value per type: the shading kernels take
-/// lavapipe ~1 s to build and llvmpipe compiles each pipeline object again at its first dispatch, so
-/// a second renderer (a scene the editor opens, a test's next frame) reuses the first one's.
-#[derive(Clone, Default)]
-pub struct PipelineCache(
-    Arc<
-        std::sync::Mutex<
-            std::collections::HashMap<std::any::TypeId, Arc<dyn std::any::Any + Send + Sync>>,
-        >,
-    >,
-);
-
-impl PipelineCache {
-    /// The cached value of type `T`, made by `make` the first time (under the lock: two renderers
-    /// built at once compile once).
-    pub fn get_or_make<T: std::any::Any + Send + Sync + Clone>(
-        &self,
-        make: impl FnOnce() -> T,
-    ) -> T {
-        // A panic while making a value leaves nothing behind to protect: the poison is ignored.
-        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        let id = std::any::TypeId::of::<T>();
-        if let Some(v) = map.get(&id).and_then(|v| v.downcast_ref::<T>()) {
-            return v.clone();
-        }
-        let v = make();
-        map.insert(id, Arc::new(v.clone()));
-        v
-    }
 }
 
 impl GpuContext {
@@ -156,7 +123,6 @@ impl GpuContext {
             device,
             queue,
             summary,
-            pipelines: PipelineCache::default(),
         })
     }
 
@@ -174,7 +140,6 @@ impl GpuContext {
             device,
             queue,
             summary,
-            pipelines: PipelineCache::default(),
         }
     }
 

@@ -8,4 +8,4 @@ pub mod fiber_density;
 pub mod forward;
 pub mod shaders;
 
-pub use context::{GpuContext, GpuError, GpuOptions, PipelineCache};
+pub use context::{GpuContext, GpuError, GpuOptions};

@@ -573,7 +573,7 @@ impl Renderer {
             pyramid_pass: DensityPyramidPass::new(device),
             shadow_grid_pass: ShadowGridPass::new(device),
             visibility_pass: VisibilityPass::new(device, settings.samples),
-            shading_pass: ShadingPass::new(ctx),
+            shading_pass: ShadingPass::new(device),
             segment_targets: settings
                 .segment_shading
                 .then(|| {

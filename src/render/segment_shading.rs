@@ -75,7 +75,6 @@ impl SegmentTargets {
 }
 
 /// The four pipelines.
-#[derive(Clone)]
 pub struct SegmentShadingPass {
     claim: wgpu::ComputePipeline,
     dispatch: wgpu::ComputePipeline,

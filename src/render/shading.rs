@@ -100,26 +100,6 @@ pub struct ShadingPass {
     batches: Vec<(ShadeBatch, wgpu::Buffer)>,
 }
 
-/// The shading module's pipelines, made once per device ([`crate::gpu::PipelineCache`]).
-#[derive(Clone)]
-struct ShadingKernels {
-    pipeline: wgpu::ComputePipeline,
-    segments: SegmentShadingPass,
-}
-
-impl ShadingKernels {
-    fn new(device: &wgpu::Device) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("shading"),
-            source: wgpu::ShaderSource::Wgsl(shaders::shading_module().into()),
-        });
-        Self {
-            pipeline: compute_pipeline(device, &module, "shade"),
-            segments: SegmentShadingPass::new(device, &module),
-        }
-    }
-}
-
 fn batch_uniform(device: &wgpu::Device, b: &ShadeBatch) -> wgpu::Buffer {
     crate::gpu::context::buffer_init(
         device,
@@ -130,15 +110,15 @@ fn batch_uniform(device: &wgpu::Device, b: &ShadeBatch) -> wgpu::Buffer {
 }
 
 impl ShadingPass {
-    /// The pass, its kernels shared with every other renderer on `ctx`'s device.
-    pub fn new(ctx: &crate::gpu::GpuContext) -> Self {
-        let kernels = ctx
-            .pipelines
-            .get_or_make(|| ShadingKernels::new(&ctx.device));
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shading"),
+            source: wgpu::ShaderSource::Wgsl(shaders::shading_module().into()),
+        });
         Self {
-            pipeline: kernels.pipeline,
-            segments: kernels.segments,
-            occluder: OccluderPass::new(&ctx.device),
+            pipeline: compute_pipeline(device, &module, "shade"),
+            segments: SegmentShadingPass::new(device, &module),
+            occluder: OccluderPass::new(device),
             batches: Vec::new(),
         }
     }
