@@ -65,18 +65,6 @@ fn erf_approx(x: f32) -> f32 {
     return sign(x) * (1.0 - poly * exp(-a * a));
 }
 
-// integral_a^b (c0 + c1 x) g(x; mu, lambda) dx, g = exp(-(x - mu)^2 / lambda^2).
-fn gaussian_linear_integral(a: f32, b: f32, mu: f32, lambda: f32, c0: f32, c1: f32) -> f32 {
-    let i = gaussian_linear_moments(a, b, mu, lambda);
-    return (c0 + c1 * mu) * i.x + c1 * i.y;
-}
-
-// (integral g, integral (x - mu) g) over [a, b]: gaussian_linear_integral's moments, once per segment.
-fn gaussian_linear_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec2<f32> {
-    let ua = (a - mu) / lambda;
-    let ub = (b - mu) / lambda;
-    return vec2<f32>(0.5 * SQRT_PI * lambda * (erf_approx(ub) - erf_approx(ua)), 0.5 * lambda * lambda * (exp(-ua * ua) - exp(-ub * ub)));
-}
 
 // integral_a^b y^k g(x; mu, lambda) dx (k = 0, 1, 2; y = x - mu), once per segment pair.
 fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec3<f32> {

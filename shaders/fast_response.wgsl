@@ -258,15 +258,10 @@ fn quadrature_node(q: ptr<function, Quadrature>, s: u32, m: u32, x: f32, f: vec3
     (*q).f0 = f;
 }
 
-// Component t of v (a select chain: a dynamic index into a vector spills to memory on lavapipe).
-fn lobe_component(v: vec4<f32>, t: u32) -> f32 {
-    return select(select(v.z, v.y, t == 1u), v.x, t == 0u);
-}
-
 // M_t for lobe t (0 = R, 1 = TT, 2 = TRT), RGB (Xu Eq. 11 by Sec. 4.2.2, parabolas on paired segments).
 fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
-    let alpha = lobe_component(params.alpha, lobe);
-    let beta = lobe_component(params.beta, lobe);
+    let alpha = params.alpha[lobe];
+    let beta = params.beta[lobe];
     let longitudinal = longitudinal_lobe(params.longitudinal, theta_o, alpha, beta);
     let lambda_m = 2.0 * SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
