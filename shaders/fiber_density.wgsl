@@ -129,8 +129,10 @@ fn neighbour_absorption(v: u32) -> vec3<f32> {
 
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let v = id.x + id.y * groups.x * 64u;
-    if (v >= info.dims.x * info.dims.y * info.dims.z) {
+    // Voxels [range.first, range.first + range.count) (progressive refinement resolves in parts).
+    let i = id.x + id.y * groups.x * 64u;
+    let v = range.first + i;
+    if (i >= range.count || v >= info.dims.x * info.dims.y * info.dims.z) {
         return;
     }
     var s: array<f32, 11>;

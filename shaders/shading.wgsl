@@ -272,6 +272,44 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// Where a frame's segment shading lies, for progressive refinement's bands (twin:
+// src/render/row_segments.rs, `row_segments`): per image row, the segments whose topmost kept
+// fragment lies in it, which are exactly the segments a band of rows claims when the bands run from
+// the top. `mark_first_rows` leaves height - that row in each visible segment's `segment_batches`
+// entry (cleared before and after: the claims' own use of it), `count_first_rows` adds them up.
+@group(0) @binding(29) var<storage, read_write> row_segments: array<atomic<u32>>;
+
+@compute @workgroup_size(8, 8)
+fn mark_first_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= camera.size.x || id.y >= camera.size.y) {
+        return;
+    }
+    let pixel = id.y * camera.size.x + id.x;
+    for (var s = 0u; s < batch.slots; s++) {
+        let f = fragments[pixel * batch.slots + s];
+        if (f.x == 0u) {
+            break;
+        }
+        // The fragments claim_segments claims.
+        if (bitcast<f32>(f.y) > 0.0) {
+            atomicMax(&segment_batches[f.x - 1u], camera.size.y - id.y);
+        }
+    }
+}
+
+// One invocation per segment, in rows of 65535 workgroups of 64.
+@compute @workgroup_size(64)
+fn count_first_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    let seg = id.x + id.y * 65535u * 64u;
+    if (seg >= arrayLength(&segment_batches)) {
+        return;
+    }
+    let v = atomicLoad(&segment_batches[seg]);
+    if (v > 0u && v <= camera.size.y) {
+        atomicAdd(&row_segments[camera.size.y - v], 1u);
+    }
+}
+
 // The indirect dispatch of `shade_segments`: one invocation per listed segment (its single scattering)
 // (none with FLAG_SINGLE_KEPT) and with multiple scattering a second (its midpoint's), in workgroups of
 // 64, as rows of at most 65535 workgroups.

@@ -301,7 +301,12 @@ fn rebuilds_before_first_image(
         }
         if matches!(
             live.progress.and_then(|p| p.submitted),
-            Some(WorkUnit::ShadowGrid { .. } | WorkUnit::Volume { .. } | WorkUnit::VolumeResolve)
+            Some(
+                WorkUnit::ShadowGrid { .. }
+                    | WorkUnit::Volume { .. }
+                    | WorkUnit::VolumeResolve { .. }
+                    | WorkUnit::DensityPyramid
+            )
         ) {
             rebuilds += 1;
         }

@@ -108,11 +108,12 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let count = |f: &dyn Fn(&WorkUnit) -> bool| units.iter().filter(|u| f(u)).count();
     let grid = count(&|u| matches!(u, WorkUnit::ShadowGrid { .. }));
     let deposits = count(&|u| matches!(u, WorkUnit::Volume { .. }));
-    assert_eq!(count(&|u| *u == WorkUnit::VolumeResolve), 1);
+    let resolves = count(&|u| matches!(u, WorkUnit::VolumeResolve { .. }));
+    assert_eq!(count(&|u| *u == WorkUnit::DensityPyramid), 1);
     let shade = count(&|u| matches!(u, WorkUnit::Shade { .. }));
     let d = difference(&a, &b);
     println!(
-        "first frame: {} units ({deposits} volume deposits, {grid} shadow-grid ranges, {shade} shading bands); difference to render_frame {d:.1e}",
+        "first frame: {} units ({deposits} volume deposits, {resolves} resolves, {grid} shadow-grid ranges, {shade} shading bands); difference to render_frame {d:.1e}",
         units.len()
     );
     assert!(matches!(
@@ -141,9 +142,10 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     );
     assert!(matches!(units.first(), Some(WorkUnit::Visibility { .. })));
     assert!(
-        units
-            .iter()
-            .all(|u| matches!(u, WorkUnit::Visibility { .. } | WorkUnit::Shade { .. })),
+        units.iter().all(|u| matches!(
+            u,
+            WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } | WorkUnit::Shade { .. }
+        )),
         "a camera move rebuilds nothing"
     );
     assert_eq!(d, 0.0);
@@ -254,9 +256,10 @@ fn deferred_absorption_rebuilds_only_what_reads_it() {
         live.set_params_deferred(&ctx, &scene.look);
         let units = refine_all(&mut live, &ctx);
         assert!(
-            units
-                .iter()
-                .all(|u| matches!(u, WorkUnit::Visibility { .. } | WorkUnit::Shade { .. })),
+            units.iter().all(|u| matches!(
+                u,
+                WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } | WorkUnit::Shade { .. }
+            )),
             "the first image rebuilds nothing"
         );
         if multiple {
@@ -484,9 +487,10 @@ fn thickness_change_equals_a_renderer_made_with_the_scaled_hair() {
     assert!(live.volume_stale());
     let units = refine_all(&mut live, &ctx);
     assert!(
-        units
-            .iter()
-            .all(|u| matches!(u, WorkUnit::Visibility { .. } | WorkUnit::Shade { .. })),
+        units.iter().all(|u| matches!(
+            u,
+            WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } | WorkUnit::Shade { .. }
+        )),
         "the first image rebuilds nothing"
     );
     assert!(live.rebuild_stale_volume());
@@ -753,4 +757,69 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
     let a = whole.read_frame(&ctx).expect("read");
     let b = progressive.read_frame(&ctx).expect("read");
     assert_eq!(difference(&a, &b), 0.0);
+}
+
+/// The planner's per-row counts of the segments a band lists (read back after the visibility pass)
+/// are the K-buffer's counted on the CPU, after render_frame and after a camera move's progressive
+/// visibility pass.
+#[test]
+fn bands_are_sized_by_the_segments_their_rows_list() {
+    use strandlight::render::row_segments::row_segments;
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let scene = common::bob_scene(400, 96, 64, Preset::Brown.params(), true);
+    let mut r = Renderer::new(
+        &ctx,
+        scene.settings.clone(),
+        &luts,
+        &scene.hair,
+        &scene.sigma_a,
+        &scene.look,
+        &lights,
+        &scene.camera,
+    )
+    .expect("renderer");
+    assert!(r.shades_segments(), "the bob is shaded by segment");
+    r.render_frame(&ctx);
+    let frame = r.read_frame(&ctx).expect("read");
+    r.refine(&ctx).expect("poll");
+    let expected = row_segments(&frame);
+    let listed: u32 = expected.iter().sum();
+    println!(
+        "{} visible segments over {} rows, at most {} in a row",
+        listed,
+        expected.len(),
+        expected.iter().max().unwrap_or(&0)
+    );
+    assert!(listed > 100, "the bob is in view");
+    assert_eq!(
+        r.row_segments(),
+        Some(&expected[..]),
+        "render_frame's counts"
+    );
+
+    let camera = Camera {
+        yaw: scene.camera.yaw + 60.0,
+        ..scene.camera
+    };
+    r.set_camera(&ctx, &camera);
+    assert_eq!(r.row_segments(), None, "a camera move forgets them");
+    r.set_unit_budget(Duration::from_millis(5));
+    let units = refine_all(&mut r, &ctx);
+    let frame = r.read_frame(&ctx).expect("read");
+    assert_eq!(
+        r.row_segments(),
+        Some(&row_segments(&frame)[..]),
+        "the progressive visibility's counts"
+    );
+    let bands = units
+        .iter()
+        .filter(|u| matches!(u, WorkUnit::Shade { batch: 0, .. }))
+        .count();
+    println!(
+        "after the move: {} units, {bands} bands of the first light batch",
+        units.len()
+    );
+    assert!(bands >= 2, "the frame was shaded in bands");
 }

@@ -171,7 +171,16 @@ impl FiberDensityPass {
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let all = 0..hair.segment_count;
-        self.record(device, encoder, hair, target, Some(all), true, timestamps);
+        let voxels = 0..target.grid.voxel_count() as u32;
+        self.record(
+            device,
+            encoder,
+            hair,
+            target,
+            Some(all),
+            Some(voxels),
+            timestamps,
+        );
     }
 
     /// Deposits segments `segments` (clearing the sums first when the range starts at 0): a part of
@@ -184,22 +193,24 @@ impl FiberDensityPass {
         target: &GpuFiberDensity,
         segments: std::ops::Range<u32>,
     ) {
-        self.record(device, encoder, hair, target, Some(segments), false, None);
+        self.record(device, encoder, hair, target, Some(segments), None, None);
     }
 
-    /// Resolves every voxel from the deposited sums.
+    /// Resolves voxels `voxels` (of [`GpuFiberDensity`]'s grid, in index order) from the deposited
+    /// sums (after every segment was deposited).
     pub fn encode_resolve(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         hair: &GpuHair,
         target: &GpuFiberDensity,
+        voxels: std::ops::Range<u32>,
     ) {
-        self.record(device, encoder, hair, target, None, true, None);
+        self.record(device, encoder, hair, target, None, Some(voxels), None);
     }
 
     /// One compute pass: the deposit of `segments` (after clearing the sums when they start at 0)
-    /// and, with `resolve`, the voxels' resolve.
+    /// and the resolve of voxels `resolve`.
     #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
@@ -208,26 +219,34 @@ impl FiberDensityPass {
         hair: &GpuHair,
         target: &GpuFiberDensity,
         segments: Option<std::ops::Range<u32>>,
-        resolve: bool,
+        resolve: Option<std::ops::Range<u32>>,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         if segments.as_ref().is_some_and(|r| r.start == 0) {
             encoder.clear_buffer(&target.sums, 0, None);
         }
-        let range = segments.as_ref().map(|r| {
+        let range_buffer = |label, r: &std::ops::Range<u32>| {
             super::context::buffer_init(
                 device,
-                "deposit range",
+                label,
                 bytemuck::cast_slice(&[r.start, r.end.saturating_sub(r.start), 0, 0]),
                 wgpu::BufferUsages::STORAGE,
             )
-        });
-        let bind = |pipeline: &wgpu::ComputePipeline, range: Option<&wgpu::Buffer>| {
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: target.info.as_entire_binding(),
-            }];
-            if let Some(range) = range {
+        };
+        let range = segments.as_ref().map(|r| range_buffer("deposit range", r));
+        let voxels = resolve.as_ref().map(|r| range_buffer("resolve range", r));
+        let bind = |pipeline: &wgpu::ComputePipeline, range: &wgpu::Buffer, deposit: bool| {
+            let mut entries = vec![
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: target.info.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: range.as_entire_binding(),
+                },
+            ];
+            if deposit {
                 entries.extend([
                     wgpu::BindGroupEntry {
                         binding: 1,
@@ -240,10 +259,6 @@ impl FiberDensityPass {
                     wgpu::BindGroupEntry {
                         binding: 3,
                         resource: hair.segments.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: range.as_entire_binding(),
                     },
                 ]);
             } else {
@@ -272,14 +287,14 @@ impl FiberDensityPass {
         });
         if let (Some(r), Some(range)) = (&segments, &range) {
             pass.set_pipeline(&self.deposit);
-            pass.set_bind_group(0, &bind(&self.deposit, Some(range)), &[]);
+            pass.set_bind_group(0, &bind(&self.deposit, range, true), &[]);
             let (x, y) = dispatch_2d(r.end.saturating_sub(r.start));
             pass.dispatch_workgroups(x, y, 1);
         }
-        if resolve {
+        if let (Some(r), Some(voxels)) = (&resolve, &voxels) {
             pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &bind(&self.resolve, None), &[]);
-            let (x, y) = dispatch_2d(target.grid.voxel_count() as u32);
+            pass.set_bind_group(0, &bind(&self.resolve, voxels, false), &[]);
+            let (x, y) = dispatch_2d(r.end.saturating_sub(r.start));
             pass.dispatch_workgroups(x, y, 1);
         }
     }

@@ -14,6 +14,7 @@ pub mod reference;
 pub mod reference_lights;
 pub mod renderer;
 pub mod resolve;
+pub mod row_segments;
 pub mod scene;
 pub mod segment_shading;
 pub mod shade;

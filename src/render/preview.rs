@@ -57,9 +57,17 @@ pub(super) struct Preview {
     pub camera: wgpu::Buffer,
     /// The visibility pass has drawn the current camera (a parameter change reuses it).
     pub visible: bool,
+    /// Its K-buffer's visible segments per row ([`super::row_segments`]) and their read-back.
+    pub row_segments: Option<Vec<u32>>,
+    pub row_readback: Option<super::row_segments::RowSegmentsReadback>,
 }
 
 impl Preview {
+    /// Whether its targets are the preview of a `width` x `height` image at its divisor.
+    pub fn fits(&self, width: u32, height: u32) -> bool {
+        Self::size(width, height, self.factor) == (self.targets.width, self.targets.height)
+    }
+
     /// The preview size of a `width` x `height` image at divisor `factor`.
     pub fn size(width: u32, height: u32, factor: u32) -> (u32, u32) {
         let f = factor.max(1);
@@ -99,11 +107,19 @@ impl Renderer {
             PreviewMode::Off => 1,
             PreviewMode::Fixed(f) => f.max(1),
             PreviewMode::Auto if first < 2 => 1,
-            PreviewMode::Auto => self
-                .refinement
-                .preview_auto_factor
-                .unwrap_or(first)
-                .clamp(2, MAX_PREVIEW_FACTOR),
+            // A preview whose visibility shows this view keeps its divisor: a new one would draw
+            // its visibility again (S1 on lavapipe: ~0.3 s, more than its shading), so the adapted
+            // divisor waits for the next camera move.
+            PreviewMode::Auto => match &self.preview {
+                Some(p) if p.visible && p.fits(self.settings.width, self.settings.height) => {
+                    p.factor
+                }
+                _ => self
+                    .refinement
+                    .preview_auto_factor
+                    .unwrap_or(first)
+                    .clamp(2, MAX_PREVIEW_FACTOR),
+            },
         }
     }
 
@@ -137,6 +153,8 @@ impl Renderer {
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
                 visible: false,
+                row_segments: None,
+                row_readback: None,
             });
             self.refinement.preview_bands_reset();
         }
@@ -159,6 +177,7 @@ impl Renderer {
     /// The camera, the image size or the fibres' width changed: both visibility passes must run again.
     pub(super) fn invalidate_visibility(&mut self) {
         self.visibility_valid = false;
+        self.forget_row_segments();
         if let Some(p) = &mut self.preview {
             p.visible = false;
         }
@@ -192,6 +211,9 @@ impl Renderer {
         );
         if last && let Some(p) = &mut self.preview {
             p.visible = true;
+        }
+        if last {
+            self.encode_preview_row_segments(&ctx.device, enc);
         }
     }
 

@@ -44,11 +44,20 @@ pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
+/// A voxel resolved (lavapipe, two cores: 100-180 ns).
+const GUESS_VOXEL_S: f64 = 200e-9;
 /// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
 const GUESS_SEGMENT_S: f64 = 1e-6;
 /// A segment drawn into the K-buffer (lavapipe, two cores: S0's preview drew 30000 segments in one
 /// 406 ms unit, the shader's compilation included, when this guess was the ribbons' 1 us).
 const GUESS_VISIBILITY_SEGMENT_S: f64 = 8e-6;
+/// A visible segment under one light, shaded by segment (lavapipe, two cores: 2.7 us on S1).
+const GUESS_SEGMENT_LIGHT_S: f64 = 10e-6;
+/// A pixel of a shading unit's rows (the claim, gather and resolve; lavapipe, two cores: ~0.7 us
+/// on S1).
+const GUESS_PIXEL_S: f64 = 0.5e-6;
+/// A shading unit listing fewer segments does not update the cost per segment.
+const MIN_MEASURED_SEGMENTS: u64 = 64;
 /// The row width and the lights of that guess.
 const GUESS_ROW_PIXELS: f64 = 720.0;
 const GUESS_ROW_LIGHTS: f64 = 16.0;
@@ -65,14 +74,21 @@ fn slot_bands(slot: u32) -> usize {
 pub enum WorkUnit {
     /// The fiber-density deposit of segments [first, first + count) (the first part clears the sums).
     Volume { first: u32, count: u32 },
-    /// The fiber density's resolve per voxel and its pyramid, after every segment was deposited.
-    VolumeResolve,
+    /// The fiber density's resolve of voxels [first, first + count), after every segment was
+    /// deposited (the whole volume took 90-100 ms on S1 on lavapipe).
+    VolumeResolve { first: u32, count: u32 },
+    /// The resolved density's pyramid.
+    DensityPyramid,
     /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
     /// The visibility pass over segments [first, first + count) (the first part clears the targets;
     /// count 0 when the camera, size and fibres are those it last drew); the last part clears the
-    /// components and resolves the image.
+    /// components.
     Visibility { first: u32, count: u32 },
+    /// After the visibility pass: rows [row0, row0 + rows) of the image resolved before any light
+    /// shaded them (the background and the head's coverage; the whole image took 50-60 ms on S1 on
+    /// lavapipe).
+    Backdrop { row0: u32, rows: u32 },
     /// Frame batch `batch` (its lights, at its K-buffer slot when shading fragments) over rows
     /// [row0, row0 + rows).
     Shade { batch: u32, row0: u32, rows: u32 },
@@ -117,10 +133,20 @@ enum Stage {
     Volume {
         first: u32,
     },
+    /// The density's resolve from voxel `first`.
+    Resolve {
+        first: u32,
+    },
+    /// The resolved density's pyramid.
+    Pyramid,
     ShadowGrid,
     /// The frame's visibility from segment `first`.
     Visibility {
         first: u32,
+    },
+    /// The image's resolve before shading, from `row`.
+    Backdrop {
+        row: u32,
     },
     /// Frame batch `batch` from `row`; `band`: the rows of the band the first pass shades under
     /// every light batch (0: size a new band).
@@ -246,6 +272,9 @@ pub struct Refinement {
     /// Seconds per shadow-grid entry and per deposited segment (None: not measured yet).
     grid_cost: Option<f64>,
     volume_cost: Option<f64>,
+    /// Seconds per voxel resolved, and per row of the image's resolve before shading.
+    resolve_cost: Option<f64>,
+    backdrop_cost: Option<f64>,
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
     /// The same for the preview's visibility.
@@ -255,6 +284,13 @@ pub struct Refinement {
     /// the preview's (costs per row of all lights).
     bands: [Bands; MAX_SLOTS],
     preview_bands: Bands,
+    /// The frame's visible segments per row, topmost row (None: not read back for this view yet);
+    /// shading by segment, a band's cost is about its rows' count times `segment_cost` per light
+    /// ([`super::row_segments`]).
+    pub(super) row_segments: Option<Vec<u32>>,
+    /// Measured seconds per listed segment and light of a shading unit, and per pixel of its rows.
+    segment_cost: Option<f64>,
+    pixel_cost: Option<f64>,
     /// Items of the last grid unit.
     grid_last: u32,
     in_flight: Option<InFlight>,
@@ -286,10 +322,15 @@ impl Default for Refinement {
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
             volume_cost: None,
+            resolve_cost: None,
+            backdrop_cost: None,
             visibility_cost: None,
             preview_visibility_cost: None,
             bands: Default::default(),
             preview_bands: Bands::default(),
+            row_segments: None,
+            segment_cost: None,
+            pixel_cost: None,
             grid_last: 1,
             in_flight: None,
             stats: RefineStats::default(),
@@ -386,7 +427,11 @@ impl Refinement {
         }
         self.preview_bands = Bands::default();
         // A segment's fragments go with the image's width.
-        for c in [&mut self.visibility_cost, &mut self.preview_visibility_cost] {
+        for c in [
+            &mut self.visibility_cost,
+            &mut self.preview_visibility_cost,
+            &mut self.backdrop_cost,
+        ] {
             *c = c.map(|c| c * ratio.max(1e-6));
         }
     }
@@ -394,16 +439,34 @@ impl Refinement {
     /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
     /// measurement, so one slow unit does not halve the next ones); `batch`: a shading unit's
     /// K-buffer slot and light count.
-    fn measured(&mut self, unit: WorkUnit, elapsed: Duration, batch: Option<(u32, u32)>) {
+    /// `listed`: the segments a shading unit (the frame's or the preview's) listed, when counted,
+    /// and its pixels.
+    fn measured(
+        &mut self,
+        unit: WorkUnit,
+        elapsed: Duration,
+        batch: Option<(u32, u32)>,
+        listed: Option<(u64, u64)>,
+    ) {
+        if std::env::var_os("SL_UNIT_LOG").is_some() {
+            eprintln!(
+                "UNIT {:7.1} ms {:?} {:?}",
+                elapsed.as_secs_f64() * 1e3,
+                unit,
+                batch
+            );
+        }
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
             self.stats.longest_unit = Some(unit);
         }
         let pass = match unit {
             WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. } => 0,
-            WorkUnit::Volume { .. } | WorkUnit::VolumeResolve => 1,
+            WorkUnit::Volume { .. } | WorkUnit::VolumeResolve { .. } | WorkUnit::DensityPyramid => {
+                1
+            }
             WorkUnit::ShadowGrid { .. } => 2,
-            WorkUnit::Visibility { .. } => 3,
+            WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } => 3,
             WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
@@ -415,11 +478,15 @@ impl Refinement {
             }
             WorkUnit::Shade { row0, rows, .. } => {
                 let (slot, lights) = batch.unwrap_or((0, 1));
-                self.bands[slot_bands(slot)].measured(row0, rows, seconds / lights.max(1) as f64);
+                let per_light = seconds / lights.max(1) as f64;
+                self.bands[slot_bands(slot)].measured(row0, rows, per_light);
+                self.segments_measured(seconds, lights, listed);
             }
             WorkUnit::Preview { row0, rows } => {
                 self.preview_shading += elapsed;
-                self.preview_bands.measured(row0, rows, seconds)
+                self.preview_bands.measured(row0, rows, seconds);
+                let lights = batch.map_or(1, |b| b.1);
+                self.segments_measured(seconds, lights, listed);
             }
             WorkUnit::Volume { count, .. } => {
                 let per = seconds / count.max(1) as f64;
@@ -439,11 +506,67 @@ impl Refinement {
                         .map_or(per, |o| 0.5 * (o + per)),
                 );
             }
-            WorkUnit::VolumeResolve
+            WorkUnit::Backdrop { rows, .. } => {
+                let per = seconds / rows.max(1) as f64;
+                self.backdrop_cost = Some(self.backdrop_cost.map_or(per, |o| 0.5 * (o + per)));
+            }
+            WorkUnit::VolumeResolve { count, .. } => {
+                let per = seconds / count.max(1) as f64;
+                self.resolve_cost = Some(self.resolve_cost.map_or(per, |o| 0.5 * (o + per)));
+            }
+            WorkUnit::DensityPyramid
             | WorkUnit::Visibility { .. }
             | WorkUnit::PreviewVisibility { .. }
             | WorkUnit::Repaint { .. } => {}
         }
+    }
+
+    /// A shading unit under `lights` lights took `seconds` over `listed` = (segments, pixels): a
+    /// unit of a few segments measures the cost per pixel (the claim, gather and resolve), the
+    /// others the cost per segment and light past it.
+    fn segments_measured(&mut self, seconds: f64, lights: u32, listed: Option<(u64, u64)>) {
+        let Some((segments, pixels)) = listed else {
+            return;
+        };
+        let ema = |old: Option<f64>, new: f64| Some(old.map_or(new, |o| 0.5 * (o + new)));
+        if segments < MIN_MEASURED_SEGMENTS {
+            if pixels > 0 {
+                self.pixel_cost = ema(self.pixel_cost, seconds / pixels as f64);
+            }
+            return;
+        }
+        let fixed = pixels as f64 * self.pixel_cost.unwrap_or(0.0);
+        let per = (seconds - fixed).max(0.5 * seconds) / (lights.max(1) as u64 * segments) as f64;
+        self.segment_cost = ema(self.segment_cost, per);
+    }
+
+    /// Rows of a band from `row` (of `height`, `width` pixels a row) under `lights` lights by
+    /// `counts`, the segments each row lists: as many as `budget` seconds hold at the measured costs
+    /// per segment and light and per pixel; at least one, whole workgroups (8 rows) where the
+    /// budget allows.
+    fn segment_band_rows(
+        &self,
+        counts: &[u32],
+        (row, height, width): (u32, u32, u32),
+        lights: u32,
+        budget: f64,
+    ) -> u32 {
+        let cost = self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S) * lights.max(1) as f64;
+        let row_cost = self.pixel_cost.unwrap_or(GUESS_PIXEL_S) * width as f64;
+        let (mut t, mut n) = (0.0, 0u32);
+        for r in row..height {
+            let c = counts.get(r as usize).copied().unwrap_or(0) as f64 * cost + row_cost;
+            if n > 0 && t + c > budget {
+                break;
+            }
+            t += c;
+            n += 1;
+        }
+        let mut n = n.max(1);
+        if n >= 8 && n < height - row {
+            n -= n % 8;
+        }
+        n
     }
 
     /// A new grid buffer (zeros, not a light's values): every group counts as unbuilt until swept,
@@ -676,6 +799,7 @@ impl Renderer {
         ctx.device
             .poll(wgpu::PollType::Poll)
             .map_err(|e| RenderError::Gpu(format!("polling: {e}")))?;
+        self.receive_row_segments();
         let Some(f) = &self.refinement.in_flight else {
             return Ok(None);
         };
@@ -691,9 +815,11 @@ impl Renderer {
         self.refinement.in_flight = None;
         let batch = match unit {
             WorkUnit::Shade { batch, .. } => self.batch_shape(batch),
+            WorkUnit::Preview { .. } => Some((0, self.light_count)),
             _ => None,
         };
-        self.refinement.measured(unit, elapsed, batch);
+        let listed = self.listed_segments(unit);
+        self.refinement.measured(unit, elapsed, batch, listed);
         let ready = match unit {
             WorkUnit::Preview { row0, rows } => {
                 let height = self.preview.as_ref().map_or(0, |p| p.targets.height);
@@ -756,6 +882,7 @@ impl Renderer {
             });
         self.encode_unit(ctx, &mut enc, unit);
         ctx.queue.submit([enc.finish()]);
+        self.request_row_segments();
         let done = Arc::new(Mutex::new(None));
         let flag = done.clone();
         ctx.queue.on_submitted_work_done(move || {
@@ -1022,8 +1149,8 @@ impl Renderer {
                 let segments = self.hair.segment_count;
                 let r = &mut self.refinement;
                 if first >= segments && first > 0 {
-                    r.stage = Stage::ShadowGrid;
-                    return Some(WorkUnit::VolumeResolve);
+                    r.stage = Stage::Resolve { first: 0 };
+                    return self.next_unit(device);
                 }
                 // Segments cost about the same each: sized by the budget alone (no doubling from
                 // a small first unit).
@@ -1037,6 +1164,23 @@ impl Renderer {
                     first: first + count,
                 };
                 Some(WorkUnit::Volume { first, count })
+            }
+            Stage::Resolve { first } => {
+                let voxels = self.volume.grid.voxel_count() as u32;
+                let r = &mut self.refinement;
+                let count = r.items(r.resolve_cost, GUESS_VOXEL_S, u32::MAX / 2, voxels - first);
+                r.stage = if first + count >= voxels {
+                    Stage::Pyramid
+                } else {
+                    Stage::Resolve {
+                        first: first + count,
+                    }
+                };
+                Some(WorkUnit::VolumeResolve { first, count })
+            }
+            Stage::Pyramid => {
+                self.refinement.stage = Stage::ShadowGrid;
+                Some(WorkUnit::DensityPyramid)
             }
             Stage::ShadowGrid => {
                 if grid_needed && let Some(unit) = self.grid_unit(self.grid_entries_for(0)) {
@@ -1057,6 +1201,17 @@ impl Renderer {
                     Stage::Visibility {
                         first: first + count,
                     }
+                } else {
+                    Stage::Backdrop { row: 0 }
+                };
+                Some(WorkUnit::Visibility { first, count })
+            }
+            Stage::Backdrop { row } => {
+                let r = &mut self.refinement;
+                let guess = GUESS_PIXEL_S * self.settings.width as f64;
+                let rows = r.items(r.backdrop_cost, guess, u32::MAX / 2, height - row);
+                r.stage = if row + rows < height {
+                    Stage::Backdrop { row: row + rows }
                 } else if batches == 0 {
                     Stage::Converged
                 } else {
@@ -1066,7 +1221,7 @@ impl Renderer {
                         band: 0,
                     }
                 };
-                Some(WorkUnit::Visibility { first, count })
+                Some(WorkUnit::Backdrop { row0: row, rows })
             }
             Stage::Shade { batch, row, band } => {
                 if grid_needed
@@ -1076,6 +1231,8 @@ impl Renderer {
                     return Some(unit);
                 }
                 let first_pass = self.first_pass_batches();
+                let by_segment = self.by_segment;
+                let width = self.settings.width;
                 let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
                 let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
@@ -1086,7 +1243,16 @@ impl Renderer {
                     let k = slot_bands(slot);
                     let prior: &[f64] = if k > 0 { &r.bands[0].row_cost } else { &[] };
                     let guess = GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS;
-                    let rows = r.bands[k].rows(row, height, budget, guess, prior);
+                    let by_counts = r
+                        .row_segments
+                        .as_deref()
+                        .filter(|_| k == 0 && by_segment)
+                        .map(|c| {
+                            let total = r.budget.as_secs_f64();
+                            r.segment_band_rows(c, (row, height, width), lights as u32, total)
+                        });
+                    let rows = by_counts
+                        .unwrap_or_else(|| r.bands[k].rows(row, height, budget, guess, prior));
                     r.bands[k].last = rows;
                     rows
                 };
@@ -1156,6 +1322,34 @@ impl Renderer {
         }
     }
 
+    /// The segments a frame or preview shading unit listed, by the counts (None: not counted, or
+    /// not by segment; a kept single scattering's units cost less and are not counted either).
+    fn listed_segments(&self, unit: WorkUnit) -> Option<(u64, u64)> {
+        let (counts, row0, rows, width) = match unit {
+            WorkUnit::Shade { batch, row0, rows } if !self.single_kept => {
+                let slot = self.batch_shape(batch).map_or(0, |b| b.0);
+                let counts = self
+                    .refinement
+                    .row_segments
+                    .as_deref()
+                    .filter(|_| slot == 0)?;
+                (counts, row0, rows, self.settings.width)
+            }
+            WorkUnit::Preview { row0, rows } => {
+                let p = self.preview.as_ref()?;
+                (p.row_segments.as_deref()?, row0, rows, p.targets.width)
+            }
+            _ => return None,
+        };
+        if !self.by_segment {
+            return None;
+        }
+        let end = (row0 + rows).min(counts.len() as u32) as usize;
+        let start = (row0 as usize).min(end);
+        let segments = counts[start..end].iter().map(|&n| n as u64).sum();
+        Some((segments, (end - start) as u64 * width as u64))
+    }
+
     /// Rows of a preview band from `row` (of `height`).
     fn preview_rows(&mut self, row: u32, height: u32) -> u32 {
         // Before the preview is measured: the frame's cost of a row under every light batch, scaled
@@ -1179,7 +1373,18 @@ impl Renderer {
         // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
         // unit saved), even past a shorter unit budget.
         let budget = preview_target(r.budget).as_secs_f64();
-        let rows = r.preview_bands.rows(row, height, budget, guess, &[]);
+        let counts = self
+            .preview
+            .as_ref()
+            .and_then(|p| p.row_segments.as_deref());
+        let rows = match counts.filter(|_| by_segment) {
+            // Counted, the bands keep to the unit budget (a UI frame waits behind a unit).
+            Some(c) => {
+                let size = (row, height, width.ceil() as u32);
+                r.segment_band_rows(c, size, lights as u32, r.budget.as_secs_f64())
+            }
+            None => r.preview_bands.rows(row, height, budget, guess, &[]),
+        };
         r.preview_bands.last = rows;
         rows
     }
@@ -1200,9 +1405,12 @@ impl Renderer {
                     first..first + count,
                 );
             }
-            WorkUnit::VolumeResolve => {
+            WorkUnit::VolumeResolve { first, count } => {
+                let voxels = first..first + count;
                 self.density_pass
-                    .encode_resolve(device, enc, &self.hair, &self.volume);
+                    .encode_resolve(device, enc, &self.hair, &self.volume, voxels);
+            }
+            WorkUnit::DensityPyramid => {
                 self.pyramid_pass
                     .encode(device, enc, &self.volume, &self.pyramid, None);
                 self.volume_dirty = false;
@@ -1245,9 +1453,12 @@ impl Renderer {
                 }
                 // The last part: the image's visibility is whole; the components restart.
                 self.visibility_valid = true;
+                self.encode_row_segments(device, enc);
                 ShadingPass::clear(enc, &self.targets, self.segment_targets.as_ref());
                 self.converged_rows = 0;
-                self.encode_resolve(device, enc, 0..self.settings.height, (true, true));
+            }
+            WorkUnit::Backdrop { row0, rows } => {
+                self.encode_resolve(device, enc, row0..row0 + rows, (true, true));
             }
             WorkUnit::Repaint { batch, .. } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {

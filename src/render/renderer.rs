@@ -337,6 +337,8 @@ pub struct Renderer {
     pub(super) repaint_rows: std::ops::Range<u32>,
     /// Segments of dabs that came while a repaint was under way: repainted after it.
     pub(super) repaint_pending: Vec<u32>,
+    /// The visible segments per row, read back after the frame's visibility (band sizes).
+    pub(super) row_readback: Option<super::row_segments::RowSegmentsReadback>,
     /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
     pub(super) point_data: Vec<[f32; 4]>,
     pub(super) timer: Option<PassTimer>,
@@ -599,6 +601,7 @@ impl Renderer {
             repaint: Vec::new(),
             repaint_rows: 0..0,
             repaint_pending: Vec::new(),
+            row_readback: None,
             point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
@@ -1347,6 +1350,9 @@ impl Renderer {
             0..self.hair.segment_count,
             timer.and_then(|t| t.render_writes("visibility")),
         );
+        let mut readback = self.row_readback.take();
+        self.encode_row_segments_into(device, &mut enc, &mut readback);
+        self.row_readback = readback;
         let inputs = self.shading_inputs();
         self.shading_pass.encode(
             device,
@@ -1373,6 +1379,7 @@ impl Renderer {
             t.resolve(&mut enc);
         }
         ctx.queue.submit([enc.finish()]);
+        self.request_row_segments();
         self.refinement.complete_frame();
         // The whole frame is shaded: no dab waits for a repaint, nothing is kept.
         self.repaint_pending.clear();

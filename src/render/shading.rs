@@ -5,6 +5,7 @@
 //! K-buffer slot within a batch, added to the component buffers.
 
 use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
+use super::row_segments::{RowSegmentsInputs, RowSegmentsPass, RowSegmentsReadback};
 use super::segment_shading::{SegmentShadingPass, SegmentTargets, last_light_batch};
 use super::targets::FrameTargets;
 use crate::gpu::context::{bind_entries, compute_pipeline};
@@ -96,6 +97,7 @@ impl<'a> ShadingInputs<'a> {
 pub struct ShadingPass {
     pipeline: wgpu::ComputePipeline,
     segments: SegmentShadingPass,
+    rows: RowSegmentsPass,
     occluder: OccluderPass,
     batches: Vec<(ShadeBatch, wgpu::Buffer)>,
 }
@@ -118,6 +120,7 @@ impl ShadingPass {
         Self {
             pipeline: compute_pipeline(device, &module, "shade"),
             segments: SegmentShadingPass::new(device, &module),
+            rows: RowSegmentsPass::new(device, &module),
             occluder: OccluderPass::new(device),
             batches: Vec::new(),
         }
@@ -137,6 +140,36 @@ impl ShadingPass {
             .iter()
             .map(|b| (*b, batch_uniform(device, b)))
             .collect();
+    }
+
+    /// The visible segments per row of `targets`' K-buffer (the frame's or the preview's, seen by
+    /// `camera`) into `readback`, copied for reading ([`super::row_segments`]). Leaves the
+    /// segments' claims cleared.
+    pub fn encode_row_segments(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &wgpu::Buffer,
+        targets: &FrameTargets,
+        segments: &SegmentTargets,
+        readback: &mut RowSegmentsReadback,
+    ) {
+        let layout = ShadeBatch {
+            slots: targets.kbuffer.k,
+            ..Zeroable::zeroed()
+        };
+        let batch = batch_uniform(device, &layout);
+        let rows = RowSegmentsInputs {
+            camera,
+            batch: &batch,
+            fragments: &targets.kbuffer.fragments,
+            segments,
+            segment_count: (segments.batches.size() / 4) as u32,
+            height: readback.height(),
+        };
+        self.rows
+            .encode(device, encoder, &rows, targets.width, &readback.counts);
+        readback.encode_copy(device, encoder);
     }
 
     /// The batches `encode` dispatches, in order.
