@@ -11,6 +11,11 @@ struct Camera {
     size: vec2<u32>,
     near: f32,
     far: f32,
+    // Ribbons drawn this many times as wide (a thinned preview); 1 otherwise.
+    width_scale: f32,
+    _p0: f32,
+    _p1: f32,
+    _p2: f32,
 }
 
 // A visibility sample's value: -(triangle + 1) for the occluder, 0 for nothing (twin of

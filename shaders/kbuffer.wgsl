@@ -62,7 +62,7 @@ struct RibbonQuad {
 // Half the ribbon's width in pixels at view depth `depth` for a fiber of diameter `diameter` (cm):
 // the true width, or camera.min_width_px pixels when that is wider.
 fn half_width_px(diameter: f32, depth: f32) -> f32 {
-    return max(0.5 * diameter / (camera.pixel_angle * depth), 0.5 * camera.min_width_px);
+    return camera.width_scale * max(0.5 * diameter / (camera.pixel_angle * depth), 0.5 * camera.min_width_px);
 }
 
 // The part of the segment a..b in front of the near plane (moved in by a thousandth of it): an end
@@ -211,8 +211,19 @@ struct FragmentIn {
 
 @vertex
 fn vs_fragments(@builtin(vertex_index) vi: u32) -> FragmentIn {
-    let seg = vi / 6u;
-    let corner = vi % 6u;
+    return ribbon_vertex(vi / 6u, vi % 6u);
+}
+
+// A subset of the segments (a thinned preview: every k-th strand's), listed.
+@group(0) @binding(11) var<storage, read> subset: array<u32>;
+
+@vertex
+fn vs_fragments_subset(@builtin(vertex_index) vi: u32) -> FragmentIn {
+    return ribbon_vertex(subset[vi / 6u], vi % 6u);
+}
+
+// Corner `corner` (of six) of segment `seg`'s ribbon.
+fn ribbon_vertex(seg: u32, corner: u32) -> FragmentIn {
     // Two triangles: (0, -), (1, -), (0, +) and (0, +), (1, -), (1, +).
     let along = corner == 1u || corner == 4u || corner == 5u;
     let side = select(-1.0, 1.0, corner == 2u || corner == 3u || corner == 5u);

@@ -125,6 +125,8 @@ impl Camera {
             size: [width, height],
             near,
             far,
+            width_scale: 1.0,
+            _pad: [0.0; 3],
         }
     }
 }
@@ -173,9 +175,13 @@ pub struct CameraUniform {
     pub size: [u32; 2],
     pub near: f32,
     pub far: f32,
+    /// Ribbons are drawn this many times as wide (a thinned preview draws every k-th strand k times
+    /// as wide: the same coverage from a k-th of the segments); 1 otherwise.
+    pub width_scale: f32,
+    pub _pad: [f32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<CameraUniform>() == 176);
+const _: () = assert!(std::mem::size_of::<CameraUniform>() == 192);
 
 /// A point on screen: pixel coordinates (0.5 = a pixel centre, y down) and view depth.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -135,7 +135,7 @@ pub struct RibbonQuad {
 
 /// Half the ribbon's width in pixels (twin of `half_width_px`).
 pub fn half_width_px(c: &CameraUniform, diameter: f32, depth: f32) -> f32 {
-    (0.5 * diameter / (c.pixel_angle * depth)).max(0.5 * c.min_width_px)
+    c.width_scale * (0.5 * diameter / (c.pixel_angle * depth)).max(0.5 * c.min_width_px)
 }
 
 /// The part of the segment a..b in front of the near plane, moved in by a thousandth of it (twin of
@@ -521,7 +521,49 @@ impl KBufferTargets {
 /// The raster pass (fragments into the K-buffer) and the composite.
 pub struct KBufferPass {
     raster: wgpu::RenderPipeline,
+    /// The raster pass over a listed subset of the segments ([`SegmentSubset`]).
+    raster_subset: wgpu::RenderPipeline,
     composite: wgpu::ComputePipeline,
+}
+
+/// Segments to draw in place of all of them: a thinned preview's, every k-th strand's (drawn k times
+/// as wide by the camera's `width_scale`).
+pub struct SegmentSubset {
+    pub list: wgpu::Buffer,
+    pub count: u32,
+    /// k: one strand of every `stride` is listed.
+    pub stride: u32,
+}
+
+impl SegmentSubset {
+    /// The segments of every `stride`-th strand of a hair whose strands have `segments` segments
+    /// each, in the hair's segment order (None when nothing would be listed).
+    pub fn new(device: &wgpu::Device, segments: &[u32], stride: u32) -> Option<Self> {
+        let list = strided_segments(segments, stride);
+        (!list.is_empty()).then(|| Self {
+            list: crate::gpu::context::buffer_init(
+                device,
+                "segment subset",
+                bytemuck::cast_slice(&list),
+                wgpu::BufferUsages::STORAGE,
+            ),
+            count: list.len() as u32,
+            stride,
+        })
+    }
+}
+
+/// The segment indices of every `stride`-th strand, given each strand's segment count.
+pub fn strided_segments(segments: &[u32], stride: u32) -> Vec<u32> {
+    let mut first = 0u32;
+    let mut list = Vec::new();
+    for (s, &n) in segments.iter().enumerate() {
+        if s % stride.max(1) as usize == 0 {
+            list.extend(first..first + n);
+        }
+        first += n;
+    }
+    list
 }
 
 impl KBufferPass {
@@ -530,44 +572,48 @@ impl KBufferPass {
             label: Some("k-buffer"),
             source: wgpu::ShaderSource::Wgsl(shaders::kbuffer_module().into()),
         });
-        let raster = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("k-buffer raster"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fragments"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_fragments"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: wgpu::TextureFormat::R8Unorm,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = |entry: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("k-buffer raster"),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_fragments"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::R8Unorm,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::empty(),
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
         Self {
-            raster,
+            raster: pipeline("vs_fragments"),
+            raster_subset: pipeline("vs_fragments_subset"),
             composite: compute_pipeline(device, &module, "composite"),
         }
     }
 
     /// Draws segments `range` into the K-buffer (clearing it first when `clear`), and composites it
     /// when the range reaches the last segment; `occluder_depth` is the occluder's multisampled depth
-    /// and whether an occluder was drawn into it. The order segments arrive in does not matter.
+    /// and whether an occluder was drawn into it. The order segments arrive in does not matter. With
+    /// `subset`, `range` indexes its list.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -579,6 +625,7 @@ impl KBufferPass {
         kb: &KBufferTargets,
         range: std::ops::Range<u32>,
         clear: bool,
+        subset: Option<&SegmentSubset>,
         timestamps: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         if clear {
@@ -587,20 +634,29 @@ impl KBufferPass {
         }
         let info = kb.info(device, occluder);
         let shared = inputs(camera, hair, &info, occluder_depth);
-        let end = range.end.min(hair.segment_count);
+        let total = subset.map_or(hair.segment_count, |s| s.count);
+        let end = range.end.min(total);
         if end > range.start {
             let mut entries = shared.clone();
             entries.extend([entry(5, &kb.keys), entry(6, &kb.sums)]);
+            let raster = match subset {
+                Some(s) => {
+                    entries.push(entry(11, &s.list));
+                    &self.raster_subset
+                }
+                None => &self.raster,
+            };
             self.encode_raster(
                 device,
                 encoder,
+                raster,
                 &entries,
                 kb,
                 6 * range.start..6 * end,
                 timestamps,
             );
         }
-        if range.end >= hair.segment_count {
+        if range.end >= total {
             let mut entries = shared;
             entries.extend([
                 entry(7, &kb.keys),
@@ -613,10 +669,12 @@ impl KBufferPass {
     }
 
     /// The raster pass over `vertices` (six a segment).
+    #[allow(clippy::too_many_arguments)]
     fn encode_raster(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
+        raster: &wgpu::RenderPipeline,
         entries: &[wgpu::BindGroupEntry],
         kb: &KBufferTargets,
         vertices: std::ops::Range<u32>,
@@ -624,7 +682,7 @@ impl KBufferPass {
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("k-buffer raster"),
-            layout: &self.raster.get_bind_group_layout(0),
+            layout: &raster.get_bind_group_layout(0),
             entries,
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -643,7 +701,7 @@ impl KBufferPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.raster);
+        pass.set_pipeline(raster);
         pass.set_bind_group(0, &bind, &[]);
         pass.draw(vertices, 0..1);
     }
@@ -700,6 +758,14 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every second strand's segments, in the hair's segment order.
+    #[test]
+    fn strided_segments_list_every_kth_strand() {
+        assert_eq!(strided_segments(&[2, 3, 1, 4, 2], 2), vec![0, 1, 5, 10, 11]);
+        assert_eq!(strided_segments(&[2, 3], 1), vec![0, 1, 2, 3, 4]);
+        assert!(strided_segments(&[], 4).is_empty());
+    }
 
     /// The edges' Green's-theorem terms against the clipped polygon's area, over ribbons of every
     /// direction, width and taper around a pixel (some thinner than 1e-3 pixel, some covering it).

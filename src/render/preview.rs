@@ -8,7 +8,7 @@
 
 use super::camera::CameraUniform;
 use super::frame::Frame;
-use super::kbuffer::Tail;
+use super::kbuffer::{SegmentSubset, Tail};
 use super::renderer::{RenderError, Renderer};
 use super::shading::{
     FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
@@ -39,14 +39,22 @@ pub enum PreviewMode {
 /// start.
 pub const PREVIEW_TARGET: Duration = Duration::from_millis(150);
 
-/// The preview's time target under a unit budget: twice the budget (one unit instead of several is a
-/// UI frame sooner per unit saved), at most [`PREVIEW_TARGET`] (the editor's 80 ms units on a software
-/// GPU give 150 ms; 30 ms units on a hardware one, 60 ms).
+/// The preview's time target under a unit budget (its shading, which the automatic divisor adapts
+/// to): twice the budget, at most [`PREVIEW_TARGET`] (the editor's 40 ms units on a software GPU give
+/// 80 ms; 30 ms units on a hardware one, 60 ms). Before its rows' segments are counted, a preview
+/// band may take this long (one unit instead of two is a UI frame sooner); counted, its bands keep
+/// to the unit budget.
 pub fn preview_target(budget: Duration) -> Duration {
     (2 * budget).min(PREVIEW_TARGET).max(budget)
 }
 /// Pixels of the first automatic preview, before its time is measured.
 pub const PREVIEW_PIXELS: u32 = 6_000;
+/// A preview at this divisor or coarser is thinned ([`Renderer::preview_subset`]).
+pub const THIN_PREVIEW_FACTOR: u32 = 8;
+/// A thinned preview draws one strand in this many, as wide as all of them.
+pub const PREVIEW_STRAND_STRIDE: u32 = 4;
+/// Hairs with fewer strands are never thinned (the gaps would show).
+pub const THIN_PREVIEW_STRANDS: usize = 4000;
 /// The coarsest preview (a divisor).
 pub const MAX_PREVIEW_FACTOR: u32 = 16;
 
@@ -63,11 +71,6 @@ pub(super) struct Preview {
 }
 
 impl Preview {
-    /// Whether its targets are the preview of a `width` x `height` image at its divisor.
-    pub fn fits(&self, width: u32, height: u32) -> bool {
-        Self::size(width, height, self.factor) == (self.targets.width, self.targets.height)
-    }
-
     /// The preview size of a `width` x `height` image at divisor `factor`.
     pub fn size(width: u32, height: u32, factor: u32) -> (u32, u32) {
         let f = factor.max(1);
@@ -107,19 +110,11 @@ impl Renderer {
             PreviewMode::Off => 1,
             PreviewMode::Fixed(f) => f.max(1),
             PreviewMode::Auto if first < 2 => 1,
-            // A preview whose visibility shows this view keeps its divisor: a new one would draw
-            // its visibility again (S1 on lavapipe: ~0.3 s, more than its shading), so the adapted
-            // divisor waits for the next camera move.
-            PreviewMode::Auto => match &self.preview {
-                Some(p) if p.visible && p.fits(self.settings.width, self.settings.height) => {
-                    p.factor
-                }
-                _ => self
-                    .refinement
-                    .preview_auto_factor
-                    .unwrap_or(first)
-                    .clamp(2, MAX_PREVIEW_FACTOR),
-            },
+            PreviewMode::Auto => self
+                .refinement
+                .preview_auto_factor
+                .unwrap_or(first)
+                .clamp(2, MAX_PREVIEW_FACTOR),
         }
     }
 
@@ -162,11 +157,34 @@ impl Renderer {
     }
 
     /// The preview's camera: the frame's view at the preview's size, its least fibre width (when the
-    /// settings ask for one) the frame's in the scene (a preview pixel's 1/factor).
+    /// settings ask for one) the frame's in the scene (a preview pixel's 1/factor); a thinned
+    /// preview's ribbons as wide as the strands each stands for.
     fn preview_camera(&self, factor: u32) -> CameraUniform {
         let (w, h) = Preview::size(self.settings.width, self.settings.height, factor);
-        self.camera_view
-            .uniform(w, h, self.settings.min_width_px / factor as f32)
+        let mut c = self
+            .camera_view
+            .uniform(w, h, self.settings.min_width_px / factor as f32);
+        if let Some(s) = self.preview_subset(factor) {
+            c.width_scale = s.stride as f32;
+        }
+        c
+    }
+
+    /// The strands a preview at divisor `factor` draws, when it is thinned: one in
+    /// [`PREVIEW_STRAND_STRIDE`] at [`THIN_PREVIEW_FACTOR`] or coarser, of a hair with at least
+    /// [`THIN_PREVIEW_STRANDS`] strands. A preview pixel then spans 8 x 8 or more of the frame's and
+    /// its visibility pass (nearly all of a new view's preview time) draws a quarter of the segments.
+    pub(super) fn preview_subset(&self, factor: u32) -> Option<&SegmentSubset> {
+        self.preview_strands
+            .as_ref()
+            .filter(|_| factor >= THIN_PREVIEW_FACTOR)
+    }
+
+    /// The segments the preview's visibility pass draws.
+    pub(super) fn preview_draw_count(&self) -> u32 {
+        let factor = self.preview.as_ref().map_or(1, |p| p.factor);
+        self.preview_subset(factor)
+            .map_or(self.hair.segment_count, |s| s.count)
     }
 
     /// Whether the preview's visibility shows the current camera.
@@ -178,6 +196,10 @@ impl Renderer {
     pub(super) fn invalidate_visibility(&mut self) {
         self.visibility_valid = false;
         self.forget_row_segments();
+        // The preview draws its visibility anyway: a divisor that waited for it applies.
+        if let Some(f) = self.refinement.preview_deferred_factor.take() {
+            self.refinement.preview_auto_factor = Some(f);
+        }
         if let Some(p) = &mut self.preview {
             p.visible = false;
         }
@@ -198,7 +220,7 @@ impl Renderer {
             ctx.queue
                 .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
         }
-        let last = range.end >= self.hair.segment_count;
+        let last = range.end >= self.preview_draw_count();
         self.visibility_pass.encode(
             &ctx.device,
             enc,
@@ -207,6 +229,7 @@ impl Renderer {
             self.occluder.as_ref().map(|o| &o.gpu),
             &p.targets,
             range,
+            self.preview_subset(p.factor),
             None,
         );
         if last && let Some(p) = &mut self.preview {
@@ -311,7 +334,20 @@ impl Renderer {
         } else {
             f
         };
-        self.refinement.preview_auto_factor = Some(next);
+        // A new divisor draws the preview's visibility again. Where it still shows this view, the
+        // change waits for the next camera move unless the shading it saves the next preview
+        // outweighs that redraw (a finer divisor, which costs more, always waits).
+        let visible = self.preview.as_ref().is_some_and(|p| p.visible);
+        let r = &self.refinement;
+        let redraw =
+            r.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draw_count() as f64;
+        let saving = preview_time.as_secs_f64() * (1.0 - (f as f64 / next as f64).powi(2));
+        if next != f && visible && saving <= redraw {
+            self.refinement.preview_deferred_factor = Some(next);
+        } else {
+            self.refinement.preview_auto_factor = Some(next);
+            self.refinement.preview_deferred_factor = None;
+        }
     }
 
     /// The last preview as drawn (None: no preview made yet) with the current camera at its size

@@ -46,6 +46,10 @@ const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
 /// A voxel resolved (lavapipe, two cores: 100-180 ns).
 const GUESS_VOXEL_S: f64 = 200e-9;
+/// The fewest voxels a resolve unit and rows a backdrop unit hold (a unit's fixed cost, which a tiny
+/// budget cannot hold, would otherwise shrink them to one of each).
+const MIN_RESOLVE_VOXELS: u32 = 16_384;
+const MIN_BACKDROP_ROWS: u32 = 8;
 /// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
 const GUESS_SEGMENT_S: f64 = 1e-6;
 /// A segment drawn into the K-buffer (lavapipe, two cores: S0's preview drew 30000 segments in one
@@ -278,7 +282,7 @@ pub struct Refinement {
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
     /// The same for the preview's visibility.
-    preview_visibility_cost: Option<f64>,
+    pub(super) preview_visibility_cost: Option<f64>,
     /// The frame's shading bands per K-buffer slot (costs per light: the front slot shades every
     /// covered pixel, the others only where more fragments lie, cheaper), and
     /// the preview's (costs per row of all lights).
@@ -303,6 +307,8 @@ pub struct Refinement {
     pub(super) preview_owed: bool,
     /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
     pub(super) preview_auto_factor: Option<u32>,
+    /// An adapted divisor that waits for the preview's next visibility pass (a camera move).
+    pub(super) preview_deferred_factor: Option<u32>,
     /// Rows of the full image that the first pass has finished under every light since the restart.
     sharp_rows: u32,
     /// A preview unit was submitted since the restart, whether it drew a new view, and the time its
@@ -338,6 +344,7 @@ impl Default for Refinement {
             restarts: 0,
             preview_owed: false,
             preview_auto_factor: None,
+            preview_deferred_factor: None,
             sharp_rows: 0,
             preview_started: false,
             preview_new_view: false,
@@ -448,14 +455,6 @@ impl Refinement {
         batch: Option<(u32, u32)>,
         listed: Option<(u64, u64)>,
     ) {
-        if std::env::var_os("SL_UNIT_LOG").is_some() {
-            eprintln!(
-                "UNIT {:7.1} ms {:?} {:?}",
-                elapsed.as_secs_f64() * 1e3,
-                unit,
-                batch
-            );
-        }
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
             self.stats.longest_unit = Some(unit);
@@ -926,14 +925,18 @@ impl Renderer {
     }
 
     /// Whether the frame's view depth holds the current camera's visibility: the visibility pass and
-    /// the resolve after it ran and finished (the brush picks hair from it).
+    /// the resolve after it (its backdrop units, which write the depth) ran and finished (the brush
+    /// picks hair from it).
     pub fn view_depth_ready(&self) -> bool {
+        let r = &self.refinement;
         self.visibility_valid
-            && !self
-                .refinement
-                .in_flight
-                .as_ref()
-                .is_some_and(|f| matches!(f.unit, WorkUnit::Visibility { .. }))
+            && !matches!(r.stage, Stage::Backdrop { .. })
+            && !r.in_flight.as_ref().is_some_and(|f| {
+                matches!(
+                    f.unit,
+                    WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. }
+                )
+            })
     }
 
     /// Starts reading the frame's view depth back (see [`Renderer::view_depth_ready`]) with the
@@ -1090,7 +1093,11 @@ impl Renderer {
     /// per segment (drawing costs about the same per segment whatever the resolution).
     fn visibility_part(&self, first: u32, preview: bool) -> u32 {
         let r = &self.refinement;
-        let remaining = self.hair.segment_count.saturating_sub(first);
+        let drawn = match preview {
+            true => self.preview_draw_count(),
+            false => self.hair.segment_count,
+        };
+        let remaining = drawn.saturating_sub(first);
         // Before the frame's first part is measured: the preview's cost per segment times its
         // divisor (fragments go with the resolution), or the guess.
         let factor = self.preview.as_ref().map_or(1.0, |p| p.factor as f64);
@@ -1123,7 +1130,7 @@ impl Renderer {
                     return self.next_unit(device);
                 }
                 let count = self.visibility_part(first, true);
-                self.refinement.stage = if first + count >= self.hair.segment_count {
+                self.refinement.stage = if first + count >= self.preview_draw_count() {
                     Stage::Preview { row: 0 }
                 } else {
                     Stage::PreviewVisibility {
@@ -1168,7 +1175,10 @@ impl Renderer {
             Stage::Resolve { first } => {
                 let voxels = self.volume.grid.voxel_count() as u32;
                 let r = &mut self.refinement;
-                let count = r.items(r.resolve_cost, GUESS_VOXEL_S, u32::MAX / 2, voxels - first);
+                let count = r
+                    .items(r.resolve_cost, GUESS_VOXEL_S, u32::MAX / 2, voxels - first)
+                    .max(MIN_RESOLVE_VOXELS)
+                    .min(voxels - first);
                 r.stage = if first + count >= voxels {
                     Stage::Pyramid
                 } else {
@@ -1209,7 +1219,10 @@ impl Renderer {
             Stage::Backdrop { row } => {
                 let r = &mut self.refinement;
                 let guess = GUESS_PIXEL_S * self.settings.width as f64;
-                let rows = r.items(r.backdrop_cost, guess, u32::MAX / 2, height - row);
+                let rows = r
+                    .items(r.backdrop_cost, guess, u32::MAX / 2, height - row)
+                    .max(MIN_BACKDROP_ROWS)
+                    .min(height - row);
                 r.stage = if row + rows < height {
                     Stage::Backdrop { row: row + rows }
                 } else if batches == 0 {
@@ -1445,6 +1458,7 @@ impl Renderer {
                         self.occluder.as_ref().map(|o| &o.gpu),
                         &self.targets,
                         first..first + count,
+                        None,
                         None,
                     );
                 }

@@ -337,6 +337,9 @@ pub struct Renderer {
     pub(super) repaint_rows: std::ops::Range<u32>,
     /// Segments of dabs that came while a repaint was under way: repainted after it.
     pub(super) repaint_pending: Vec<u32>,
+    /// Every [`super::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
+    /// preview draws (None for a hair of few strands).
+    pub(super) preview_strands: Option<super::kbuffer::SegmentSubset>,
     /// The visible segments per row, read back after the frame's visibility (band sizes).
     pub(super) row_readback: Option<super::row_segments::RowSegmentsReadback>,
     /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
@@ -602,6 +605,15 @@ impl Renderer {
             repaint_rows: 0..0,
             repaint_pending: Vec::new(),
             row_readback: None,
+            preview_strands: (hair.strand_count() >= super::preview::THIN_PREVIEW_STRANDS)
+                .then(|| {
+                    let segments: Vec<u32> = (0..hair.strand_count())
+                        .map(|s| hair.strand_range(s).len().saturating_sub(1) as u32)
+                        .collect();
+                    let stride = super::preview::PREVIEW_STRAND_STRIDE;
+                    super::kbuffer::SegmentSubset::new(&ctx.device, &segments, stride)
+                })
+                .flatten(),
             point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
@@ -1348,6 +1360,7 @@ impl Renderer {
             self.occluder.as_ref().map(|o| &o.gpu),
             &self.targets,
             0..self.hair.segment_count,
+            None,
             timer.and_then(|t| t.render_writes("visibility")),
         );
         let mut readback = self.row_readback.take();

@@ -2,7 +2,7 @@
 //! (`shaders/visibility.wgsl`), then the hair's fragments into the K-buffer, which reads that depth
 //! ([`super::kbuffer`]), and after the last segment the K-buffer's composite.
 
-use super::kbuffer::KBufferPass;
+use super::kbuffer::{KBufferPass, SegmentSubset};
 use super::occluder::GpuOccluder;
 use super::targets::{DEPTH_FORMAT, FrameTargets, VISIBILITY_FORMAT};
 use crate::gpu::fiber_density::GpuHair;
@@ -78,7 +78,8 @@ impl VisibilityPass {
     /// Draws segments `range` (all of them for a whole frame; progressive refinement's bounded units
     /// draw parts): the range starting at 0 clears the targets and draws the occluder first; the range
     /// reaching the last segment ends with the K-buffer's composite. The K-buffer does not depend on
-    /// the order the segments are drawn in.
+    /// the order the segments are drawn in. With `subset`, its listed segments stand for the hair
+    /// (`range` indexes the list).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -89,6 +90,7 @@ impl VisibilityPass {
         occluder: Option<&GpuOccluder>,
         targets: &FrameTargets,
         range: std::ops::Range<u32>,
+        subset: Option<&SegmentSubset>,
         timestamps: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let clear = range.start == 0;
@@ -104,6 +106,7 @@ impl VisibilityPass {
             &targets.kbuffer,
             range,
             clear,
+            subset,
             timestamps,
         );
     }
