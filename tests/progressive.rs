@@ -335,8 +335,9 @@ fn tables_after_convergence_shade_multiple_scattering_alone() {
 }
 
 /// A brush dab on the converged image (`repaint_points`): only the segments at the changed points are
-/// shaded again (one `Repaint` unit per light batch), and the image equals the one a restart
-/// converges to; on an image still refining the dab is refused (the caller restarts).
+/// shaded again (`Repaint` units light batch by light batch, each batch in parts sized to the
+/// budget), and the image equals the one a restart converges to; on an image still refining the dab
+/// is refused (the caller restarts).
 #[test]
 fn a_dab_repaints_its_segments_and_equals_a_restart() {
     let ctx = context();
@@ -365,14 +366,35 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     live.set_absorption_points_deferred(&ctx, &sigma_a, &changed)
         .expect("absorption");
     assert!(live.repaint_points(&changed));
+    // A budget far below a batch's cost: every batch in parts of the fewest segments a part holds.
+    live.set_unit_budget(Duration::from_micros(100));
     let units = refine_all(&mut live, &ctx);
     println!("repaint of {} points: {units:?}", changed.len());
     let batches = lights.len().div_ceil(16);
-    assert_eq!(units.len(), batches);
-    assert!(
+    assert!(units.len() >= 2 * batches, "each batch in parts");
+    for b in 0..batches as u32 {
+        let parts: Vec<(u32, u32)> = units
+            .iter()
+            .filter_map(|u| match *u {
+                WorkUnit::Repaint {
+                    batch,
+                    first,
+                    segments,
+                } if batch == b && segments > 0 => Some((first, segments)),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            parts.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0) && parts[0].0 == 0,
+            "batch {b}'s parts follow each other from the first segment: {parts:?}"
+        );
+    }
+    assert_eq!(
+        units.len(),
         units
             .iter()
-            .all(|u| matches!(u, WorkUnit::Repaint { segments, .. } if *segments > 0))
+            .filter(|u| matches!(u, WorkUnit::Repaint { .. }))
+            .count()
     );
     let got = live.read_frame(&ctx).expect("read");
     // The same dab through a restart.
@@ -769,17 +791,7 @@ fn bands_are_sized_by_the_segments_their_rows_list() {
     let luts = Luts::default_tables();
     let lights = sunny_lights();
     let scene = common::bob_scene(400, 96, 64, Preset::Brown.params(), true);
-    let mut r = Renderer::new(
-        &ctx,
-        scene.settings.clone(),
-        &luts,
-        &scene.hair,
-        &scene.sigma_a,
-        &scene.look,
-        &lights,
-        &scene.camera,
-    )
-    .expect("renderer");
+    let mut r = bob_renderer(&ctx, &luts, &scene, &scene.hair, &scene.sigma_a, &lights);
     assert!(r.shades_segments(), "the bob is shaded by segment");
     r.render_frame(&ctx);
     let frame = r.read_frame(&ctx).expect("read");

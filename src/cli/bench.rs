@@ -55,7 +55,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub no_preview: bool,
     /// Progressive refinement's time budget per unit, milliseconds (default: the editor's for the
-    /// adapter, 40 on a software GPU, 30 on a hardware one).
+    /// adapter, 35 on a software GPU, 30 on a hardware one).
     #[arg(long)]
     pub unit_budget_ms: Option<f64>,
     /// Brush dabs painted after the progressive run (one stroke across the hair, each dab refined

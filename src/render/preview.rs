@@ -4,7 +4,8 @@
 //! unshadowed). Its own small frame targets and camera (shaded by segment, it writes the frame's
 //! segment buffers, which the frame's visibility unit clears before the frame shades), so the
 //! converged image is still `render_frame`'s. In [`PreviewMode::Auto`] the resolution divisor adapts so that the
-//! preview takes about [`PREVIEW_TARGET`].
+//! preview's shading takes about [`preview_target`] of the unit budget. A coarse preview of dense
+//! hair draws a quarter of the strands (`Renderer::preview_subset`).
 
 use super::camera::CameraUniform;
 use super::frame::Frame;
@@ -40,8 +41,8 @@ pub enum PreviewMode {
 pub const PREVIEW_TARGET: Duration = Duration::from_millis(150);
 
 /// The preview's time target under a unit budget (its shading, which the automatic divisor adapts
-/// to): twice the budget, at most [`PREVIEW_TARGET`] (the editor's 40 ms units on a software GPU give
-/// 80 ms; 30 ms units on a hardware one, 60 ms). Before its rows' segments are counted, a preview
+/// to): twice the budget, at most [`PREVIEW_TARGET`] (the editor's 35 ms units on a software GPU give
+/// 70 ms; 30 ms units on a hardware one, 60 ms). Before its rows' segments are counted, a preview
 /// band may take this long (one unit instead of two is a UI frame sooner); counted, its bands keep
 /// to the unit budget.
 pub fn preview_target(budget: Duration) -> Duration {
@@ -49,7 +50,7 @@ pub fn preview_target(budget: Duration) -> Duration {
 }
 /// Pixels of the first automatic preview, before its time is measured.
 pub const PREVIEW_PIXELS: u32 = 6_000;
-/// A preview at this divisor or coarser is thinned ([`Renderer::preview_subset`]).
+/// A preview at this divisor or coarser is thinned (`Renderer::preview_subset`).
 pub const THIN_PREVIEW_FACTOR: u32 = 8;
 /// A thinned preview draws one strand in this many, as wide as all of them.
 pub const PREVIEW_STRAND_STRIDE: u32 = 4;
@@ -91,6 +92,8 @@ impl Renderer {
     /// automatic divisor scales with the image's side so the preview keeps its cost.
     pub(super) fn resized_preview(&mut self, width: u32, height: u32) {
         self.preview = None;
+        // Adapted at the old size.
+        self.refinement.preview_deferred_factor = None;
         let old = self.settings.width as f64 * self.settings.height as f64;
         let new = width as f64 * height as f64;
         if let Some(f) = &mut self.refinement.preview_auto_factor {
@@ -182,7 +185,11 @@ impl Renderer {
 
     /// The segments the preview's visibility pass draws.
     pub(super) fn preview_draw_count(&self) -> u32 {
-        let factor = self.preview.as_ref().map_or(1, |p| p.factor);
+        self.preview_draws_at(self.preview.as_ref().map_or(1, |p| p.factor))
+    }
+
+    /// The segments a preview at divisor `factor` draws.
+    fn preview_draws_at(&self, factor: u32) -> u32 {
         self.preview_subset(factor)
             .map_or(self.hair.segment_count, |s| s.count)
     }
@@ -318,7 +325,7 @@ impl Renderer {
     }
 
     /// A preview of this change took `preview_time` (its units): the automatic divisor moves
-    /// towards [`PREVIEW_TARGET`] (time goes with the pixels, the square of the divisor).
+    /// towards [`preview_target`] (time goes with the pixels, the square of the divisor).
     pub(super) fn adapt_preview(&mut self, preview_time: Duration) {
         if self.preview_mode != PreviewMode::Auto {
             return;
@@ -334,15 +341,17 @@ impl Renderer {
         } else {
             f
         };
-        // A new divisor draws the preview's visibility again. Where it still shows this view, the
-        // change waits for the next camera move unless the shading it saves the next preview
-        // outweighs that redraw (a finer divisor, which costs more, always waits).
+        // A new divisor draws the preview's visibility again. Where it still shows this view and
+        // the preview is not far over its target, the change waits for the next camera move unless
+        // the shading it saves the next preview outweighs that redraw (a finer divisor, which costs
+        // more, waits).
         let visible = self.preview.as_ref().is_some_and(|p| p.visible);
         let r = &self.refinement;
         let redraw =
-            r.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draw_count() as f64;
-        let saving = preview_time.as_secs_f64() * (1.0 - (f as f64 / next as f64).powi(2));
-        if next != f && visible && saving <= redraw {
+            r.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draws_at(next) as f64;
+        let seconds = preview_time.as_secs_f64();
+        let saving = seconds * (1.0 - (f as f64 / next as f64).powi(2));
+        if next != f && visible && saving <= redraw && seconds <= 1.5 * target {
             self.refinement.preview_deferred_factor = Some(next);
         } else {
             self.refinement.preview_auto_factor = Some(next);
@@ -352,7 +361,8 @@ impl Renderer {
 
     /// The last preview as drawn (None: no preview made yet) with the current camera at its size
     /// (the one it was drawn with unless the camera moved since; tests: the CPU twin shades its
-    /// fragments).
+    /// fragments). A thinned preview's camera has its `width_scale`: its K-buffer holds only the
+    /// listed strands' fragments (`Renderer::preview_subset`).
     pub fn read_preview(
         &self,
         ctx: &GpuContext,

@@ -101,9 +101,15 @@ pub enum WorkUnit {
     PreviewVisibility { first: u32, count: u32 },
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
-    /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over the
-    /// `segments` segments at the changed points; the last batch gathers and resolves the image.
-    Repaint { batch: u32, segments: u32 },
+    /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over
+    /// `segments` of the segments at the changed points, from the `first`-th (in parts sized to the
+    /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part); the last
+    /// batch's last part gathers and resolves the image.
+    Repaint {
+        batch: u32,
+        first: u32,
+        segments: u32,
+    },
 }
 
 /// The images a display pass reads: the frame's, and a preview under the frame's first `sharp_rows`
@@ -159,9 +165,11 @@ enum Stage {
         row: u32,
         band: u32,
     },
-    /// A dab's segments under frame batch `batch` (then the next batch, or converged).
+    /// A dab's segments from the `first`-th under frame batch `batch` (then its next part, the
+    /// next batch, or converged).
     Repaint {
         batch: u32,
+        first: u32,
     },
     Converged,
 }
@@ -279,6 +287,8 @@ pub struct Refinement {
     /// Seconds per voxel resolved, and per row of the image's resolve before shading.
     resolve_cost: Option<f64>,
     backdrop_cost: Option<f64>,
+    /// Rows of the last backdrop unit.
+    backdrop_last: u32,
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
     /// The same for the preview's visibility.
@@ -330,6 +340,7 @@ impl Default for Refinement {
             volume_cost: None,
             resolve_cost: None,
             backdrop_cost: None,
+            backdrop_last: MIN_BACKDROP_ROWS,
             visibility_cost: None,
             preview_visibility_cost: None,
             bands: Default::default(),
@@ -664,7 +675,8 @@ impl Renderer {
     }
 
     /// A brush dab on an image converged by segment: the segments that join the changed points
-    /// `changed` are shaded again under every light (one [`WorkUnit::Repaint`] per light batch) and
+    /// `changed` are shaded again under every light ([`WorkUnit::Repaint`] units, light batch by light
+    /// batch, each in parts sized to the budget) and
     /// the image is gathered from the segments, in place of a restart. The dab shows at full
     /// resolution after work on its segments alone; every other segment's radiance depends on its
     /// own points only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
@@ -695,7 +707,7 @@ impl Renderer {
         // The repaint writes its segments' single scattering: nothing is kept across it.
         self.single_kept = false;
         match self.refinement.stage {
-            Stage::Repaint { batch } if batch > 0 => {
+            Stage::Repaint { batch, first } if batch > 0 || first > 0 => {
                 // Under way: these follow once it ends (starting it again at every dab would never
                 // let it finish while the pointer moves).
                 self.repaint_pending.extend(segments);
@@ -718,7 +730,7 @@ impl Renderer {
         segments.dedup();
         self.repaint_rows = self.rows_covered(&segments);
         self.repaint = segments;
-        self.refinement.stage = Stage::Repaint { batch: 0 };
+        self.refinement.stage = Stage::Repaint { batch: 0, first: 0 };
     }
 
     /// The image rows where `segments` may leave fragments: their ends' projections, widened by
@@ -834,9 +846,14 @@ impl Renderer {
                     || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
                 after.then_some(ImageReady::Full)
             }
-            WorkUnit::Repaint { batch, .. } => {
+            WorkUnit::Repaint {
+                batch,
+                first,
+                segments,
+            } => {
                 let batches = self.shading_pass.frame_batches().count() as u32;
-                (batch + 1 >= batches).then_some(ImageReady::Full)
+                let last = first + segments >= self.repaint.len() as u32;
+                (batch + 1 >= batches && last).then_some(ImageReady::Full)
             }
             _ => None,
         };
@@ -1219,10 +1236,17 @@ impl Renderer {
             Stage::Backdrop { row } => {
                 let r = &mut self.refinement;
                 let guess = GUESS_PIXEL_S * self.settings.width as f64;
+                // At most twice the last, from a few workgroups' rows (rows with hair cost more than
+                // the background's, and the cost per row measured in one sitting can double in the
+                // next when a table worker shares the cores).
+                if row == 0 {
+                    r.backdrop_last = 2 * MIN_BACKDROP_ROWS;
+                }
                 let rows = r
-                    .items(r.backdrop_cost, guess, u32::MAX / 2, height - row)
+                    .items(r.backdrop_cost, guess, r.backdrop_last, height - row)
                     .max(MIN_BACKDROP_ROWS)
                     .min(height - row);
+                r.backdrop_last = rows;
                 r.stage = if row + rows < height {
                     Stage::Backdrop { row: row + rows }
                 } else if batches == 0 {
@@ -1312,15 +1336,33 @@ impl Renderer {
                     rows,
                 })
             }
-            Stage::Repaint { batch } => {
-                self.refinement.stage = if batch + 1 < batches {
-                    Stage::Repaint { batch: batch + 1 }
+            Stage::Repaint { batch, first } => {
+                let total = self.repaint.len() as u32;
+                let lights = self.batch_shape(batch).map_or(1, |b| b.1).max(1) as f64;
+                let r = &mut self.refinement;
+                let per = r.segment_cost.map(|c| c * lights);
+                let remaining = total.saturating_sub(first);
+                let count = r
+                    .items(per, GUESS_SEGMENT_LIGHT_S * lights, u32::MAX / 2, remaining)
+                    .max(MIN_MEASURED_SEGMENTS as u32)
+                    .min(remaining);
+                r.stage = if first + count < total {
+                    Stage::Repaint {
+                        batch,
+                        first: first + count,
+                    }
+                } else if batch + 1 < batches {
+                    Stage::Repaint {
+                        batch: batch + 1,
+                        first: 0,
+                    }
                 } else {
                     Stage::Converged
                 };
                 Some(WorkUnit::Repaint {
                     batch,
-                    segments: self.repaint.len() as u32,
+                    first,
+                    segments: count,
                 })
             }
             Stage::Converged => {
@@ -1351,6 +1393,9 @@ impl Renderer {
             WorkUnit::Preview { row0, rows } => {
                 let p = self.preview.as_ref()?;
                 (p.row_segments.as_deref()?, row0, rows, p.targets.width)
+            }
+            WorkUnit::Repaint { segments, .. } if !self.single_kept => {
+                return Some((segments as u64, 0));
             }
             _ => return None,
         };
@@ -1474,19 +1519,24 @@ impl Renderer {
             WorkUnit::Backdrop { row0, rows } => {
                 self.encode_resolve(device, enc, row0..row0 + rows, (true, true));
             }
-            WorkUnit::Repaint { batch, .. } => {
+            WorkUnit::Repaint {
+                batch,
+                first,
+                segments,
+            } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
                     return;
                 };
-                if batch == 0
-                    && let Some(s) = &self.segment_targets
-                {
-                    let list: &[u8] = bytemuck::cast_slice(&self.repaint);
-                    ctx.queue.write_buffer(&s.work_list, 0, list);
-                    let count = self.repaint.len() as u32;
+                let end = (first + segments).min(self.repaint.len() as u32);
+                let part = &self.repaint[(first.min(end)) as usize..end as usize];
+                if let Some(s) = &self.segment_targets {
+                    ctx.queue
+                        .write_buffer(&s.work_list, 0, bytemuck::cast_slice(part));
+                    let count = part.len() as u32;
                     ctx.queue
                         .write_buffer(&s.work_count, 0, bytemuck::bytes_of(&count));
                 }
+                let last_part = end as usize >= self.repaint.len();
                 // The gather and resolve over the rows the segments cover.
                 let rows = self.repaint_rows.clone();
                 let b = ShadeBatch {
@@ -1495,9 +1545,15 @@ impl Renderer {
                     ..*b
                 };
                 let inputs = self.shading_inputs();
-                self.shading_pass
-                    .encode_repaint(device, enc, &inputs, &self.targets, &b);
-                if last_light_batch(&b) && !rows.is_empty() {
+                self.shading_pass.encode_repaint(
+                    device,
+                    enc,
+                    &inputs,
+                    &self.targets,
+                    &b,
+                    last_part,
+                );
+                if last_part && last_light_batch(&b) && !rows.is_empty() {
                     self.encode_resolve(device, enc, rows, (false, false));
                 }
             }

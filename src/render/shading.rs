@@ -347,8 +347,9 @@ impl ShadingPass {
     }
 
     /// A repaint's light batch: the segments listed in the segment targets' work list (written by
-    /// the caller) shaded again, no claim; after the frame's last light batch, rows
-    /// `batch.row0 .. + batch.rows` of the components gathered from the segments.
+    /// the caller) shaded again, no claim; with `gather`, after the frame's last light batch, rows
+    /// `batch.row0 .. + batch.rows` of the components gathered from the segments (a repaint's last
+    /// part).
     pub fn encode_repaint(
         &self,
         device: &wgpu::Device,
@@ -356,6 +357,7 @@ impl ShadingPass {
         inputs: &ShadingInputs,
         targets: &FrameTargets,
         batch: &ShadeBatch,
+        gather: bool,
     ) {
         let Some(segments) = inputs.segment_targets else {
             return;
@@ -363,7 +365,7 @@ impl ShadingPass {
         let uniform = batch_uniform(device, batch);
         self.segments
             .encode_listed(device, encoder, inputs, segments, &uniform);
-        if last_light_batch(batch) {
+        if gather && last_light_batch(batch) {
             let size = (targets.width, batch.rows);
             self.segments.encode_gather(
                 device, encoder, inputs, targets, segments, &uniform, size, None,
