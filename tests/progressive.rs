@@ -368,8 +368,18 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     assert!(live.repaint_points(&changed));
     // A budget far below a batch's cost: every batch in parts of the fewest segments a part holds.
     live.set_unit_budget(Duration::from_micros(100));
-    let units = refine_all(&mut live, &ctx);
+    let events = refine_events(&mut live, &ctx);
+    let units: Vec<WorkUnit> = events.iter().filter_map(|e| e.0).collect();
     println!("repaint of {} points: {units:?}", changed.len());
+    // The full image is ready once, after the last batch's last part.
+    let ready: Vec<usize> = (0..events.len())
+        .filter(|&i| events[i].1 == Some(ImageReady::Full))
+        .collect();
+    let last_unit = events.iter().rposition(|e| e.0.is_some());
+    assert!(
+        ready.len() == 1 && last_unit.is_some_and(|u| ready[0] > u),
+        "one full image, after the last part: ready at {ready:?}, last unit at {last_unit:?}"
+    );
     let batches = lights.len().div_ceil(16);
     assert!(units.len() >= 2 * batches, "each batch in parts");
     for b in 0..batches as u32 {

@@ -180,6 +180,8 @@ struct InFlight {
     done: Arc<Mutex<Option<Instant>>>,
     /// The restart it was planned under ([`Refinement::restarts`]).
     restart: u64,
+    /// A repaint's part that ends its list (a dab's new repaint may replace the list meanwhile).
+    repaint_end: bool,
 }
 
 /// What refinement has measured since its last restart.
@@ -524,10 +526,14 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.resolve_cost = Some(self.resolve_cost.map_or(per, |o| 0.5 * (o + per)));
             }
+            // Its last part's gather and resolve ride along: an overstatement.
+            WorkUnit::Repaint { .. } => {
+                let lights = batch.map_or(1, |b| b.1);
+                self.segments_measured(seconds, lights, listed);
+            }
             WorkUnit::DensityPyramid
             | WorkUnit::Visibility { .. }
-            | WorkUnit::PreviewVisibility { .. }
-            | WorkUnit::Repaint { .. } => {}
+            | WorkUnit::PreviewVisibility { .. } => {}
         }
     }
 
@@ -821,11 +827,17 @@ impl Renderer {
         let Some(t) = done else {
             return Ok(None);
         };
-        let (unit, elapsed, restart) =
-            (f.unit, t.saturating_duration_since(f.submitted), f.restart);
+        let (unit, elapsed, restart, repaint_end) = (
+            f.unit,
+            t.saturating_duration_since(f.submitted),
+            f.restart,
+            f.repaint_end,
+        );
         self.refinement.in_flight = None;
         let batch = match unit {
-            WorkUnit::Shade { batch, .. } => self.batch_shape(batch),
+            WorkUnit::Shade { batch, .. } | WorkUnit::Repaint { batch, .. } => {
+                self.batch_shape(batch)
+            }
             WorkUnit::Preview { .. } => Some((0, self.light_count)),
             _ => None,
         };
@@ -846,14 +858,9 @@ impl Renderer {
                     || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
                 after.then_some(ImageReady::Full)
             }
-            WorkUnit::Repaint {
-                batch,
-                first,
-                segments,
-            } => {
+            WorkUnit::Repaint { batch, .. } => {
                 let batches = self.shading_pass.frame_batches().count() as u32;
-                let last = first + segments >= self.repaint.len() as u32;
-                (batch + 1 >= batches && last).then_some(ImageReady::Full)
+                (batch + 1 >= batches && repaint_end).then_some(ImageReady::Full)
             }
             _ => None,
         };
@@ -916,6 +923,8 @@ impl Renderer {
             submitted: Instant::now(),
             done,
             restart: self.refinement.restarts,
+            repaint_end: matches!(unit, WorkUnit::Repaint { first, segments, .. }
+                if (first + segments) as usize >= self.repaint.len()),
         });
         self.refinement.stats.units += 1;
         Ok(self.progress(Some(unit), false, ready))
