@@ -68,6 +68,12 @@ const GUESS_ROW_LIGHTS: f64 = 16.0;
 /// K-buffer slots with their own shading bands (the slots behind the fourth share the last).
 const MAX_SLOTS: usize = 4;
 
+/// A cost estimate after a measurement: the mean of the last estimate and the measurement (so one slow
+/// unit does not halve the next ones), or the measurement when there was none.
+fn ema(old: Option<f64>, new: f64) -> Option<f64> {
+    Some(old.map_or(new, |o| 0.5 * (o + new)))
+}
+
 /// The bands of K-buffer slot `slot`.
 fn slot_bands(slot: u32) -> usize {
     (slot as usize).min(MAX_SLOTS - 1)
@@ -252,7 +258,7 @@ impl Bands {
     /// A band of `rows` rows from `row0` took `elapsed` seconds.
     fn measured(&mut self, row0: u32, rows: u32, elapsed: f64) {
         let per = elapsed / rows.max(1) as f64;
-        self.cost = Some(self.cost.map_or(per, |o| 0.5 * (o + per)));
+        self.cost = ema(self.cost, per);
         let end = (row0 + rows) as usize;
         if self.row_cost.len() < end {
             self.row_cost.resize(end, 0.0);
@@ -486,7 +492,7 @@ impl Refinement {
         match unit {
             WorkUnit::ShadowGrid { count, .. } => {
                 let per = seconds / count.max(1) as f64;
-                self.grid_cost = Some(self.grid_cost.map_or(per, |o| 0.5 * (o + per)));
+                self.grid_cost = ema(self.grid_cost, per);
             }
             WorkUnit::Shade { row0, rows, .. } => {
                 let (slot, lights) = batch.unwrap_or((0, 1));
@@ -502,29 +508,26 @@ impl Refinement {
             }
             WorkUnit::Volume { count, .. } => {
                 let per = seconds / count.max(1) as f64;
-                self.volume_cost = Some(self.volume_cost.map_or(per, |o| 0.5 * (o + per)));
+                self.volume_cost = ema(self.volume_cost, per);
             }
             // The clear, composite and resolve of the last part ride along: an overstatement. The
             // frame's and the preview's apart: a segment leaves fragments in proportion to the
             // image's resolution.
             WorkUnit::Visibility { count, .. } if count > 0 => {
                 let per = seconds / count as f64;
-                self.visibility_cost = Some(self.visibility_cost.map_or(per, |o| 0.5 * (o + per)));
+                self.visibility_cost = ema(self.visibility_cost, per);
             }
             WorkUnit::PreviewVisibility { count, .. } if count > 0 => {
                 let per = seconds / count as f64;
-                self.preview_visibility_cost = Some(
-                    self.preview_visibility_cost
-                        .map_or(per, |o| 0.5 * (o + per)),
-                );
+                self.preview_visibility_cost = ema(self.preview_visibility_cost, per);
             }
             WorkUnit::Backdrop { rows, .. } => {
                 let per = seconds / rows.max(1) as f64;
-                self.backdrop_cost = Some(self.backdrop_cost.map_or(per, |o| 0.5 * (o + per)));
+                self.backdrop_cost = ema(self.backdrop_cost, per);
             }
             WorkUnit::VolumeResolve { count, .. } => {
                 let per = seconds / count.max(1) as f64;
-                self.resolve_cost = Some(self.resolve_cost.map_or(per, |o| 0.5 * (o + per)));
+                self.resolve_cost = ema(self.resolve_cost, per);
             }
             // Its last part's gather and resolve ride along: an overstatement.
             WorkUnit::Repaint { .. } => {
@@ -544,7 +547,6 @@ impl Refinement {
         let Some((segments, pixels)) = listed else {
             return;
         };
-        let ema = |old: Option<f64>, new: f64| Some(old.map_or(new, |o| 0.5 * (o + new)));
         if segments < MIN_MEASURED_SEGMENTS {
             if pixels > 0 {
                 self.pixel_cost = ema(self.pixel_cost, seconds / pixels as f64);
