@@ -89,7 +89,18 @@ fn circular_gaussian_energy(kappa: f32) -> f32 {
     return TAU * bessel_i0_scaled(kappa);
 }
 
-// kappa whose period integral is `ratio` (Newton on ln(2 pi I0s) in ln kappa).
+// Newton's start (kappa_newton_start): wide lobes by I0s(k) ~ e^-k (1 + k^2 / 4), narrow ones by
+// ratio ~ sqrt(2 pi / kappa) (1 + 1 / (8 kappa)).
+fn kappa_newton_start(ratio: f32) -> f32 {
+    let x = ratio / TAU;
+    if (x > 0.45) {
+        let k = -log(x);
+        return k + log(1.0 + 0.25 * k * k);
+    }
+    return TAU / (ratio * ratio) + 0.25;
+}
+
+// kappa whose period integral is `ratio` (two Newton steps on ln(2 pi I0s) in ln kappa).
 fn circular_gaussian_kappa_for_ratio(ratio: f32) -> f32 {
     let kappa_min = 1e-4;
     let kappa_max = 1e8;
@@ -100,8 +111,8 @@ fn circular_gaussian_kappa_for_ratio(ratio: f32) -> f32 {
         return kappa_max;
     }
     let goal = log(ratio);
-    var s = log(clamp(TAU / (ratio * ratio), kappa_min, kappa_max));
-    for (var it = 0; it < 8; it++) {
+    var s = log(clamp(kappa_newton_start(ratio), kappa_min, kappa_max));
+    for (var it = 0; it < 2; it++) {
         let k = exp(s);
         let i0 = bessel_i0_scaled(k);
         let i1 = bessel_i1_scaled(k);

@@ -160,6 +160,9 @@ fn longitudinal_ln_w(w: LongitudinalWeight, theta: f32) -> f32 {
     return w.kappa_j * (cos(theta - w.theta_j) - 1.0) - d * d;
 }
 
+// Newton's stop for the weight's peak (radians; PEAK_STEP_TOLERANCE in fast_response.rs).
+const PEAK_STEP_TOLERANCE: f32 = 1e-3;
+
 fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) -> LongitudinalWeight {
     let kappa_j = 2.0 / (lambda_j * lambda_j);
     let k_m = 2.0 / (lambda_m * lambda_m);
@@ -175,7 +178,7 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
         }
         let step = clamp(grad / curvature, -0.3, 0.3);
         t = t + step;
-        if (abs(step) < 1e-6) {
+        if (abs(step) < PEAK_STEP_TOLERANCE) {
             break;
         }
     }

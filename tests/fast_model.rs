@@ -284,6 +284,10 @@ fn fig5_linear_quadrature_m4_against_m200() {
 fn fast_response_against_brute_force_grid() {
     let luts = Luts::default_tables();
     let configs = grid(512, 1);
+    // The tables are built (with rayon) before the rayon loop that reads them: a rayon worker that
+    // waited in the OnceLock while another test built them deadlocked the build, which needs the
+    // workers (seen with this test and fig5's run together).
+    azimuthal_tables();
     let t = std::time::Instant::now();
     let rows: Vec<([f64; 3], [f64; 3], f64)> = configs
         .par_iter()

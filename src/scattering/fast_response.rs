@@ -343,6 +343,11 @@ impl LongitudinalWeight {
     }
 }
 
+/// Newton's search for the weight's peak stops after a step below this (radians). It converges
+/// quadratically: the peak left is within ~1e-6 lambda* of the converged one (the 24000 light-lobe pairs
+/// of `bench-fast`, against a 1e-6 stop; 1.6 steps on average where that took 2.2).
+pub const PEAK_STEP_TOLERANCE: f32 = 1e-3;
+
 /// Finds theta* by Newton's method on
 /// d ln w / d theta = -kappa_j sin(theta - theta_j) - 2 (theta - mu_M) / lambda_M^2,
 /// started from the product of Gaussians Xu uses (g^c replaced by g). When the curvature
@@ -368,7 +373,7 @@ pub fn longitudinal_weight(
         }
         let step = (grad / curvature).clamp(-0.3, 0.3);
         t += step;
-        if step.abs() < 1e-6 {
+        if step.abs() < PEAK_STEP_TOLERANCE {
             break;
         }
     }
