@@ -88,6 +88,7 @@ struct LongitudinalLobe {
     // -ln v - ln(1 - e^(-2/v)), and ln sqrt(2 pi v).
     ln_m_norm: f32,
     ln_gaussian_norm: f32,
+    cos_tilted: f32,
 }
 
 fn longitudinal_lobe_with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> LongitudinalLobe {
@@ -96,19 +97,24 @@ fn longitudinal_lobe_with_variance(longitudinal: u32, theta_o: f32, alpha: f32, 
     if (longitudinal == LONGITUDINAL_PUBLISHED) {
         mu = 2.0 * alpha - theta_o;
     }
-    return LongitudinalLobe(longitudinal, theta_o, tilted, v, mu, -log(v) - log(1.0 - exp(-2.0 / v)), 0.5 * log(2.0 * PI * v));
+    return LongitudinalLobe(longitudinal, theta_o, tilted, v, mu, -log(v) - log(1.0 - exp(-2.0 / v)), 0.5 * log(2.0 * PI * v), cos(tilted));
 }
 
 fn longitudinal_lobe(longitudinal: u32, theta_o: f32, alpha: f32, beta: f32) -> LongitudinalLobe {
     return longitudinal_lobe_with_variance(longitudinal, theta_o, alpha, max(4.0 * beta * beta, 1e-8));
 }
 
-// ln M(theta_i) of d'Eon et al. 2011.
-fn longitudinal_ln_m(l: LongitudinalLobe, theta_i: f32) -> f32 {
-    let a = max(cos(theta_i), 0.0) * cos(l.tilted) / l.v;
+// d'Eon et al. 2011's ln M(theta_i) without its Bessel term (ln_m_shape).
+fn longitudinal_ln_m_shape(l: LongitudinalLobe, theta_i: f32) -> f32 {
     let half = sin(0.5 * (theta_i + l.tilted));
-    return log(bessel_i0_scaled(a)) - 2.0 * half * half / l.v + l.ln_m_norm;
+    return -2.0 * half * half / l.v + l.ln_m_norm;
 }
+
+// d'Eon's Bessel argument cos theta_i cos theta_o' / v (bessel_argument).
+fn longitudinal_bessel_argument(l: LongitudinalLobe, theta_i: f32) -> f32 {
+    return max(cos(theta_i), 0.0) * l.cos_tilted / l.v;
+}
+
 
 // The longitudinal factor relative to the Gaussian: published 2 cos^2(theta_i) / cos^2(theta_d); normalised
 // cos(theta_i) M^dEon / Gaussian.
@@ -119,8 +125,8 @@ fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
         return 2.0 * ci * ci / max(cd * cd, 1e-8);
     }
     let d = theta_i - l.mu;
-    let ln_ratio = longitudinal_ln_m(l, theta_i) + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
-    return ci * exp(clamp(ln_ratio, -80.0, 20.0));
+    let ln_rest = longitudinal_ln_m_shape(l, theta_i) + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
+    return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, theta_i)) * exp(clamp(ln_rest, -80.0, 20.0));
 }
 
 // longitudinal_factor x calN_t at theta_i.
