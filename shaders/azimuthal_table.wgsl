@@ -1,18 +1,17 @@
 // The exact azimuthal window integrals as a table (twin of src/scattering/azimuthal_table.rs): calN_TT and
-// calN_TRT under narrow lights (Xu Eq. 12) and calN_t^G of the forward-scattered light (Eq. 28). Each cell
+// calN_TRT under every light (Xu Eq. 12) and calN_t^G of the forward-scattered light (Eq. 28). Each cell
 // holds a two-node Gauss rule in the chord x = cos gamma_t of the window's measure, (w_1, w_1 x_1, w_2,
 // w_2 x_2); the value for absorption s = 2 p sigma_a' is w_1 e^(-s x_1) + w_2 e^(-s x_2).
 // The includer binds `azimuthal_table`: array<vec4<f32>>, cell 0 the header (eta_lo, eta_hi, eta samples, eta).
-// Prepended: circular_gaussian (bessel_i0_scaled), fast_azimuthal (sigma_a_prime, smoothstep_f, fits).
+// Prepended: circular_gaussian (bessel_i0_scaled), fast_azimuthal (sigma_a_prime, bravais_eta_prime).
 
 const TABLE_THETA_D: u32 = 32u;
 const THETA_D_MAX: f32 = 1.5;
-const TABLE_LAMBDA: u32 = 40u;
+const TABLE_LAMBDA: u32 = 54u;
 const TABLE_LAMBDA_MIN: f32 = 0.005;
-const TABLE_LAMBDA_MAX: f32 = 1.4;
+// LAMBDA_PRIME_MAX: every lambda' the shading meets.
+const TABLE_LAMBDA_MAX: f32 = 10.0;
 const TABLE_DPHI: u32 = 256u;
-const EXACT_BLEND_LO: f32 = 0.7;
-const EXACT_BLEND_HI: f32 = 1.4;
 
 fn table_trt_base() -> u32 {
     return 1u + TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
@@ -143,24 +142,4 @@ fn azimuthal_table_box(p: u32, sigma_a: vec3<f32>, theta_d: f32, dphi: f32) -> v
     let lo = mix(azimuthal_table[r0], azimuthal_table[r0 + 1u], f.w);
     let hi = mix(azimuthal_table[r1], azimuthal_table[r1 + 1u], f.w);
     return rule_value(mix(lo, hi, t.w), absorption_exponent(p, header.w, sigma_a, theta_d));
-}
-
-// calN_TT or calN_TRT: the table under narrow lights, the fit under wide ones (inner_integral_blended).
-fn inner_integral_blended(p: u32, eta: f32, sigma_a: vec3<f32>, theta_d: f32, lambda_prime: f32, dphi: f32, caustic_width: f32, caustic_fade: f32) -> vec3<f32> {
-    let t = smoothstep_f(EXACT_BLEND_LO, EXACT_BLEND_HI, lambda_prime);
-    var out = vec3<f32>(0.0);
-    if (t > 0.0) {
-        var fit: LobeFit;
-        if (p == 1u) {
-            fit.lobes[0] = tt_lobe(eta, sigma_a, theta_d);
-            fit.count = 1u;
-        } else {
-            fit = trt_lobes(eta, sigma_a, theta_d, caustic_width, caustic_fade);
-        }
-        out = out + t * inner_integral_lobes(fit, lambda_prime, dphi);
-    }
-    if (t < 1.0) {
-        out = out + (1.0 - t) * azimuthal_table_gaussian(p, eta, sigma_a, theta_d, lambda_prime, dphi);
-    }
-    return out;
 }

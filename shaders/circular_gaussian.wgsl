@@ -1,5 +1,5 @@
 // Circular-Gaussian primitives of Xu et al. 2011's fast model.
-// Twin of src/scattering/circular_gaussian.rs and the Bessel / kappa helpers of fast_azimuthal.rs:
+// Twin of src/scattering/circular_gaussian.rs and the Bessel helper of fast_azimuthal.rs:
 // same names, same formulas, f32.
 
 const PI: f32 = 3.14159265358979;
@@ -43,20 +43,6 @@ fn bessel_i0_scaled(x: f32) -> f32 {
     return p / sqrt(ax);
 }
 
-// I1(x) e^-x (A&S 9.8.3, 9.8.4), x >= 0.
-fn bessel_i1_scaled(x: f32) -> f32 {
-    let ax = abs(x);
-    if (ax <= 3.75) {
-        let t = (ax / 3.75) * (ax / 3.75);
-        let i1 = ax * (0.5 + t * (0.87890594 + t * (0.51498869 + t * (0.15084934 + t * (0.02658733 + t * (0.00301532 + t * 0.00032411))))));
-        return i1 * exp(-ax);
-    }
-    let t = 3.75 / ax;
-    let p = 0.39894228 + t * (-0.03988024 + t * (-0.00362018 + t * (0.00163801 + t * (-0.01031555
-        + t * (0.02282967 + t * (-0.02895312 + t * (0.01787654 + t * -0.00420059)))))));
-    return p / sqrt(ax);
-}
-
 // erf by A&S 7.1.26 (WGSL has no erf).
 fn erf_approx(x: f32) -> f32 {
     let a = abs(x);
@@ -82,59 +68,4 @@ fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec3<f32>
 fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32>) -> f32 {
     let m = gaussian_quadratic_moments(a, b, mu, lambda);
     return d.x * m.x + d.y * m.y + d.z * m.z;
-}
-
-// 2 pi e^-kappa I0(kappa): the period integral of exp(kappa (cos x - 1)).
-fn circular_gaussian_energy(kappa: f32) -> f32 {
-    return TAU * bessel_i0_scaled(kappa);
-}
-
-// Newton's start (kappa_newton_start): wide lobes by I0s(k) ~ e^-k (1 + k^2 / 4), narrow ones by
-// ratio ~ sqrt(2 pi / kappa) (1 + 1 / (8 kappa)).
-fn kappa_newton_start(ratio: f32) -> f32 {
-    let x = ratio / TAU;
-    if (x > 0.45) {
-        let k = -log(x);
-        return k + log(1.0 + 0.25 * k * k);
-    }
-    return TAU / (ratio * ratio) + 0.25;
-}
-
-// kappa whose period integral is `ratio` (two Newton steps on ln(2 pi I0s) in ln kappa).
-fn circular_gaussian_kappa_for_ratio(ratio: f32) -> f32 {
-    let kappa_min = 1e-4;
-    let kappa_max = 1e8;
-    if (!(ratio < TAU * 0.9999)) {
-        return kappa_min;
-    }
-    if (ratio <= 0.0) {
-        return kappa_max;
-    }
-    let goal = log(ratio);
-    var s = log(clamp(kappa_newton_start(ratio), kappa_min, kappa_max));
-    for (var it = 0; it < 2; it++) {
-        let k = exp(s);
-        let i0 = bessel_i0_scaled(k);
-        let i1 = bessel_i1_scaled(k);
-        let f = log(TAU * i0) - goal;
-        let df = k * (i1 / i0 - 1.0);
-        if (abs(df) < 1e-12) {
-            break;
-        }
-        s = clamp(s - clamp(f / df, -3.0, 3.0), log(kappa_min), log(kappa_max));
-    }
-    return exp(s);
-}
-
-// b integral g^c(x; 0, lambda') g^c(dphi - x; mu, lambda) dx / b, with dphi - mu passed as `dphi`.
-fn circular_gaussian_convolution(kappa_prime: f32, dphi: f32, kappa: f32) -> f32 {
-    let re = kappa_prime + kappa * cos(dphi);
-    let im = kappa * sin(dphi);
-    let km = sqrt(re * re + im * im);
-    return TAU * exp(km - kappa_prime - kappa) * bessel_i0_scaled(km);
-}
-
-fn smoothstep_f(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
 }

@@ -20,8 +20,6 @@ struct DualQuery {
 // Declared for the fast-model library's table reads, which these entry points never reach (the
 // derived layout leaves them out).
 @group(0) @binding(4) var<storage, read> lut_c: array<f32>;
-@group(0) @binding(5) var<storage, read> lut_h_tt: array<f32>;
-@group(0) @binding(6) var<storage, read> lut_h_trt: array<f32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

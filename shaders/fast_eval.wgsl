@@ -14,11 +14,9 @@ struct FastQuery {
 }
 
 @group(0) @binding(0) var<storage, read> lut_c: array<f32>;
-@group(0) @binding(1) var<storage, read> lut_h_tt: array<f32>;
-@group(0) @binding(2) var<storage, read> lut_h_trt: array<f32>;
-@group(0) @binding(3) var<storage, read> azimuthal_table: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> queries: array<FastQuery>;
-@group(0) @binding(5) var<storage, read_write> results: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> azimuthal_table: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> queries: array<FastQuery>;
+@group(0) @binding(3) var<storage, read_write> results: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

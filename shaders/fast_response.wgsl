@@ -143,11 +143,12 @@ fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_
     if (lobe == 0u) {
         return vec3<f32>(w * inner_integral_r(params.eta, theta_d, lp, dphi));
     }
+    // TT and TRT: the tabulated exact window integral at every lambda' (TRT at eta*-bar, Xu Eq. 26).
     if (lobe == 1u) {
-        return w * inner_integral_blended(1u, params.eta, sigma, theta_d, lp, dphi, params.caustic_width, params.caustic_fade);
+        return w * azimuthal_table_gaussian(1u, params.eta, sigma, theta_d, lp, dphi);
     }
     let eta = eta_star_mean(params.eta, params.eccentricity, lp, light.phi + phi_o);
-    return w * inner_integral_blended(2u, eta, sigma, theta_d, lp, dphi, params.caustic_width, params.caustic_fade);
+    return w * azimuthal_table_gaussian(2u, eta, sigma, theta_d, lp, dphi);
 }
 
 // The weight M_t g^c(theta_i; theta_j, lambda_j) in Laplace form.

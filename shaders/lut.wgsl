@@ -1,7 +1,7 @@
 // Xu 2011's tables as the fast model reads them. Twin of src/scattering/lut.rs: texels in storage
 // buffers (texels[(y * width + x) * channels + c]), bilinear between samples, clamped, so CPU and
 // GPU agree to rounding. Bindings are declared by the module that includes this file:
-//   lut_c (C_0..C_6, 128 x 64 x 7), lut_h_tt and lut_h_trt (H_0, H_2, H_4, 128 x 64 x 3).
+//   lut_c (C_0..C_6, 128 x 64 x 7). (The H_k tables feed only the CPU's circular-Gaussian fits.)
 
 const LUT_W: u32 = 128u;
 const LUT_H: u32 = 64u;
@@ -47,22 +47,6 @@ fn lut_sample_c(lambda_prime: f32, dphi: f32) -> array<f32, 7> {
     var out: array<f32, 7>;
     for (var k = 0u; k < 7u; k++) {
         out[k] = bilinear(lut_c[c.i00 + k], lut_c[c.i10 + k], lut_c[c.i01 + k], lut_c[c.i11 + k], c.wx, c.wy);
-    }
-    return out;
-}
-
-// H_0, H_2, H_4 of TT (trt false) or TRT at (eta, theta_d) (Xu Eq. 19, 23).
-fn lut_sample_h(trt: bool, eta: f32, theta_d: f32) -> vec3<f32> {
-    let tx = log(clamp(eta, 1.0, 10.0)) / log(10.0);
-    let ty = abs(theta_d) / FRAC_PI_2;
-    let c = lut_coord(tx, ty, 3u);
-    var out: vec3<f32>;
-    for (var k = 0u; k < 3u; k++) {
-        if (trt) {
-            out[k] = bilinear(lut_h_trt[c.i00 + k], lut_h_trt[c.i10 + k], lut_h_trt[c.i01 + k], lut_h_trt[c.i11 + k], c.wx, c.wy);
-        } else {
-            out[k] = bilinear(lut_h_tt[c.i00 + k], lut_h_tt[c.i10 + k], lut_h_tt[c.i01 + k], lut_h_tt[c.i11 + k], c.wx, c.wy);
-        }
     }
     return out;
 }

@@ -25,11 +25,10 @@ pub struct FastQuery {
 
 const _: () = assert!(std::mem::size_of::<FastQuery>() == 112);
 
-/// The three tables as storage buffers (texels as in [`LutTexture`]).
+/// The C_k table as a storage buffer (texels as in [`LutTexture`]; the H_k tables feed only the
+/// CPU's circular-Gaussian fits, which the GPU does not evaluate).
 pub struct GpuLuts {
     pub c: wgpu::Buffer,
-    pub h_tt: wgpu::Buffer,
-    pub h_trt: wgpu::Buffer,
 }
 
 impl GpuLuts {
@@ -43,8 +42,6 @@ impl GpuLuts {
         };
         Self {
             c: make("lut C_k", &luts.c),
-            h_tt: make("lut H_TT", &luts.h_tt),
-            h_trt: make("lut H_TRT", &luts.h_trt),
         }
     }
 }
@@ -82,12 +79,7 @@ impl FastEvalPipeline {
         table: &wgpu::Buffer,
         queries: &[FastQuery],
     ) -> Result<Vec<[[f32; 3]; 3]>, String> {
-        let v: Vec<[f32; 4]> = ctx.run_batch(
-            &self.pipeline,
-            &[&luts.c, &luts.h_tt, &luts.h_trt, table],
-            queries,
-            3,
-        )?;
+        let v: Vec<[f32; 4]> = ctx.run_batch(&self.pipeline, &[&luts.c, table], queries, 3)?;
         Ok((0..queries.len())
             .map(|i| std::array::from_fn(|t| [v[3 * i + t][0], v[3 * i + t][1], v[3 * i + t][2]]))
             .collect())

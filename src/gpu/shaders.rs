@@ -91,7 +91,7 @@ pub fn transmittance_eval_module() -> String {
 }
 
 /// The fast-model library (no bindings, no entry points): the including module declares the
-/// storage buffers `lut_c`, `lut_h_tt`, `lut_h_trt` and `azimuthal_table`.
+/// storage buffers `lut_c` and `azimuthal_table`.
 pub fn fast_model_library() -> String {
     [
         CIRCULAR_GAUSSIAN,

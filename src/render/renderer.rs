@@ -1292,7 +1292,7 @@ impl Renderer {
             segments: &self.hair.segments,
             absorption: &self.hair.absorption,
             lights: &self.lights,
-            luts: [&self.luts.c, &self.luts.h_tt, &self.luts.h_trt],
+            lut_c: &self.luts.c,
             shadow_values: &self.shadow_grid.values,
             dual_tables: &self.dual_tables,
             azimuthal_table: &self.azimuthal_table,

@@ -62,7 +62,8 @@ pub struct ShadingInputs<'a> {
     pub segments: &'a wgpu::Buffer,
     pub absorption: &'a wgpu::Buffer,
     pub lights: &'a wgpu::Buffer,
-    pub luts: [&'a wgpu::Buffer; 3],
+    /// The C_k table.
+    pub lut_c: &'a wgpu::Buffer,
     pub shadow_values: &'a wgpu::Buffer,
     pub dual_tables: &'a wgpu::Buffer,
     pub azimuthal_table: &'a wgpu::Buffer,
@@ -73,7 +74,7 @@ pub struct ShadingInputs<'a> {
 }
 
 impl<'a> ShadingInputs<'a> {
-    /// What every shading kernel reads, at its bindings (0-12 and 19), with the batch's buffer.
+    /// What every shading kernel reads, at its bindings (0-8, 11, 12 and 19), with the batch's buffer.
     pub fn shading_entries(&self, batch: &'a wgpu::Buffer) -> Vec<(u32, &'a wgpu::Buffer)> {
         vec![
             (0, self.camera),
@@ -84,9 +85,7 @@ impl<'a> ShadingInputs<'a> {
             (5, self.segments),
             (6, self.absorption),
             (7, self.lights),
-            (8, self.luts[0]),
-            (9, self.luts[1]),
-            (10, self.luts[2]),
+            (8, self.lut_c),
             (11, self.shadow_values),
             (12, self.dual_tables),
             (19, self.azimuthal_table),

@@ -1,4 +1,4 @@
-//! The exact azimuthal window integrals as a table: calN_TT, calN_TRT under narrow lights (Xu Eq. 12) and
+//! The exact azimuthal window integrals as a table: calN_TT, calN_TRT under every light (Xu Eq. 12) and
 //! calN_t^G of the forward-scattered light (Eq. 28), looked up instead of integrated per shading point.
 //!
 //! What is tabulated: for lobe p the window integral is
@@ -10,7 +10,8 @@
 //! 1, x, x^2, x^3 exactly against mu), and the runtime sum w_1 e^(-s x_1) + w_2 e^(-s x_2) gives calN_p for
 //! any absorption, per channel and per point (painted dye needs no rebuild). The error is that of a
 //! two-point rule for e^(-s x) over the spread of x inside one window (small: x lies in
-//! [sqrt(1 - 1/eta'^2), 1] and narrow windows see a narrow part of it) plus the interpolation between cells;
+//! [sqrt(1 - 1/eta'^2), 1] and narrow windows see a narrow part of it; wide ones, like the box windows,
+//! all of it) plus the interpolation between cells;
 //! `tests/azimuthal_table.rs` measures both against the integral.
 //!
 //! Axes (the integrals are even in theta_d and in dphi): |theta_d| in [0, THETA_D_MAX] uniform,
@@ -25,12 +26,10 @@
 //! (`shaders/azimuthal_table.wgsl`) reads the same buffer of vec4.
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
-use super::fast_azimuthal::{
-    LobeFit, Rgb32, bravais_eta_prime, fresnel_schlick, inner_integral_lobes, sigma_a_prime,
-    smoothstep,
-};
-use super::fast_exact_azimuthal::{EXACT_BLEND_HI, EXACT_BLEND_LO, for_each_window_node};
+use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_prime};
+use super::fast_exact_azimuthal::for_each_window_node;
 use super::fast_params::FastHairParams;
+use super::fast_response::LAMBDA_PRIME_MAX;
 use super::params::HairParams;
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
@@ -38,11 +37,14 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 /// Samples of |theta_d| over [0, THETA_D_MAX].
 pub const TABLE_THETA_D: usize = 32;
 pub const THETA_D_MAX: f32 = 1.5;
-/// Samples of lambda', log-spaced over [LAMBDA_MIN, LAMBDA_MAX] (the exact integrals are used below
-/// [`EXACT_BLEND_HI`]; the circular-Gaussian fits above it).
-pub const TABLE_LAMBDA: usize = 40;
+/// Samples of lambda', log-spaced over [LAMBDA_MIN, LAMBDA_MAX]: every lambda' the renderer meets (it
+/// clamps lambda' to [`LAMBDA_PRIME_MAX`]). Until 2026-11-30 the axis ended at 1.4 with 40 samples and
+/// Xu's circular-Gaussian fits took over from 0.7 (smoothstep blend): 54 keep the samples' spacing in
+/// ln lambda', and on lavapipe the fits, run by every SIMD group holding one wide light, had cost
+/// ~30 % of the shading pass.
+pub const TABLE_LAMBDA: usize = 54;
 pub const LAMBDA_MIN: f32 = 0.005;
-pub const LAMBDA_MAX: f32 = EXACT_BLEND_HI;
+pub const LAMBDA_MAX: f32 = LAMBDA_PRIME_MAX;
 /// Samples of |dphi| over [0, pi], both ends included.
 pub const TABLE_DPHI: usize = 256;
 /// Samples of eta*-bar for TRT when the fiber is elliptical (1 when it is round).
@@ -426,35 +428,4 @@ impl AzimuthalTable {
         let c = lerp4(lo, hi, wt);
         rule_value(c, absorption_exponent(p, header[3], sigma_a, theta_d))
     }
-}
-
-/// calN_TT (p = 1) or calN_TRT (p = 2): the tabulated exact integral under narrow lights, the
-/// circular-Gaussian fit (Xu Eq. 16, 20) under wide ones, blended by a smoothstep in lambda' over
-/// [EXACT_BLEND_LO, EXACT_BLEND_HI]. `eta` is eta*-bar for TRT. `fit` builds the fit on demand.
-#[allow(clippy::too_many_arguments)]
-pub fn inner_integral_blended(
-    table: &AzimuthalTable,
-    p: u32,
-    eta: f32,
-    sigma_a: Rgb32,
-    theta_d: f32,
-    lambda_prime: f32,
-    dphi: f32,
-    fit: impl FnOnce() -> LobeFit,
-) -> Rgb32 {
-    let t = smoothstep(EXACT_BLEND_LO, EXACT_BLEND_HI, lambda_prime);
-    let mut out = [0.0; 3];
-    if t > 0.0 {
-        let g = inner_integral_lobes(&fit(), lambda_prime, dphi);
-        for c in 0..3 {
-            out[c] += t * g[c];
-        }
-    }
-    if t < 1.0 {
-        let e = table.window_gaussian(p, eta, sigma_a, theta_d, lambda_prime, dphi);
-        for c in 0..3 {
-            out[c] += (1.0 - t) * e[c];
-        }
-    }
-    out
 }

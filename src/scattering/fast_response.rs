@@ -17,9 +17,9 @@
 //! paper's rule (mu - lambda, mu, mu + lambda); clipping keeps every sample useful and lets a large m
 //! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
 
-use super::azimuthal_table::{AzimuthalTable, inner_integral_blended};
+use super::azimuthal_table::AzimuthalTable;
 use super::circular_gaussian::{bessel_i0_scaled, gaussian_quadratic_moments};
-use super::fast_azimuthal::{LobeFit, Rgb32, eta_star_mean, inner_integral_r, trt_lobes, tt_lobe};
+use super::fast_azimuthal::{Rgb32, eta_star_mean, inner_integral_r};
 use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -171,27 +171,6 @@ pub fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
     (lambda_j / c.sqrt()).min(LAMBDA_PRIME_MAX)
 }
 
-/// The azimuthal fit of N_TT (lobe 1) or N_TRT (lobe 2) at theta_d, with the averaged eccentric index for TRT.
-pub fn azimuthal_fit(
-    luts: &Luts,
-    p: &FastHairParams,
-    lobe: u32,
-    theta_d: f32,
-    lambda_prime: f32,
-    phi_sum: f32,
-) -> LobeFit {
-    let sigma = p.sigma_a_rgb();
-    if lobe == 1 {
-        let mut fit = LobeFit::default();
-        fit.lobes[0] = tt_lobe(luts, p.eta, sigma, theta_d);
-        fit.count = 1;
-        fit
-    } else {
-        let eta = eta_star_mean(luts, p.eta, p.eccentricity, lambda_prime, phi_sum);
-        trt_lobes(luts, eta, sigma, theta_d, p.caustic_width, p.caustic_fade)
-    }
-}
-
 /// The tilted outgoing inclination theta_o' = theta_o - 2 alpha, reflected back into [-pi/2, pi/2] past a
 /// pole (pbrt-v4 takes |cos theta_o'|), so M stays normalised over theta_i.
 pub fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
@@ -321,17 +300,17 @@ pub fn outer_integrand(
         return [w * n; 3];
     }
     let sigma = p.sigma_a_rgb();
-    if lobe == 1 {
-        return inner_integral_blended(table, 1, p.eta, sigma, theta_d, lp, dphi, || {
-            azimuthal_fit(luts, p, 1, theta_d, lp, 0.0)
-        })
-        .map(|n| w * n);
-    }
-    let eta = eta_star_mean(luts, p.eta, p.eccentricity, lp, light.phi + phi_o);
-    inner_integral_blended(table, 2, eta, sigma, theta_d, lp, dphi, || {
-        trt_lobes(luts, eta, sigma, theta_d, p.caustic_width, p.caustic_fade)
-    })
-    .map(|n| w * n)
+    // TT and TRT: the tabulated exact window integral at every lambda' (Xu's circular-Gaussian fits,
+    // `tt_lobe` and `trt_lobes`, are kept as the published form and its tests).
+    // TRT's eta*-bar (Xu Eq. 26); TT reads the table's own eta.
+    let eta = if lobe == 1 {
+        p.eta
+    } else {
+        eta_star_mean(luts, p.eta, p.eccentricity, lp, light.phi + phi_o)
+    };
+    table
+        .window_gaussian(lobe, eta, sigma, theta_d, lp, dphi)
+        .map(|n| w * n)
 }
 
 /// The longitudinal weight w(theta_i) = M_t(theta_h) g^c(theta_i; theta_j, lambda_j) of one lobe, in Laplace
