@@ -75,35 +75,45 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 ty.name
             );
         }
-        // Constants the Rust side mirrors (counts that size buffers and units of work).
+        // Constants the Rust side mirrors (counts that size buffers and units of work, the azimuthal
+        // table's axes, the peak search's stop).
+        use strandlight::scattering::azimuthal_table as table;
         for (_, c) in module.constants.iter() {
             let expected = match c.name.as_deref() {
-                Some("SWEEP_RING") => strandlight::shadow::sweep::SWEEP_RING,
-                Some("SWEEP_SLOTS") => strandlight::render::shadow_grid::SWEEP_SLOTS,
+                Some("SWEEP_RING") => strandlight::shadow::sweep::SWEEP_RING as f64,
+                Some("SWEEP_SLOTS") => strandlight::render::shadow_grid::SWEEP_SLOTS as f64,
                 Some("SINGLE_SAMPLES") => {
-                    strandlight::render::segment_shading::SINGLE_SAMPLES as u32
+                    strandlight::render::segment_shading::SINGLE_SAMPLES as f64
                 }
-                Some("FLAG_SHADOWS") => strandlight::render::shading::FLAG_SHADOWS,
+                Some("FLAG_SHADOWS") => strandlight::render::shading::FLAG_SHADOWS as f64,
                 Some("FLAG_MULTIPLE_SCATTERING") => {
-                    strandlight::render::shading::FLAG_MULTIPLE_SCATTERING
+                    strandlight::render::shading::FLAG_MULTIPLE_SCATTERING as f64
                 }
-                Some("FLAG_SINGLE_KEPT") => strandlight::render::shading::FLAG_SINGLE_KEPT,
+                Some("FLAG_SINGLE_KEPT") => strandlight::render::shading::FLAG_SINGLE_KEPT as f64,
+                Some("TABLE_THETA_D") => table::TABLE_THETA_D as f64,
+                Some("TABLE_LAMBDA") => table::TABLE_LAMBDA as f64,
+                Some("TABLE_DPHI") => table::TABLE_DPHI as f64,
+                Some("TABLE_LAMBDA_MIN") => table::LAMBDA_MIN as f64,
+                Some("TABLE_LAMBDA_MAX") => table::LAMBDA_MAX as f64,
+                Some("PEAK_STEP_TOLERANCE") => {
+                    strandlight::scattering::fast_response::PEAK_STEP_TOLERANCE as f64
+                }
                 _ => continue,
             };
             seen.insert(c.name.clone().unwrap_or_default());
-            match module.global_expressions[c.init] {
-                naga::Expression::Literal(naga::Literal::U32(v)) => {
-                    assert_eq!(v, expected, "{name}: WGSL {:?} vs Rust", c.name)
-                }
+            let v = match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::F32(v)) => v as f64,
                 ref other => panic!("{name}: {:?} is {other:?}", c.name),
-            }
+            };
+            assert_eq!(v, expected, "{name}: WGSL {:?} vs Rust", c.name);
         }
         println!("{name}: {} lines valid", source.lines().count());
     }
     println!("struct layouts and constants compared: {seen:?}");
     assert_eq!(
         seen.len(),
-        21,
+        27,
         "every shared struct and constant was found and compared"
     );
 }

@@ -70,10 +70,11 @@ pub struct ParamArgs {
     /// Eccentricity a of the cross-section (1 = circular).
     #[arg(long, allow_negative_numbers = true)]
     pub eccentricity: Option<f64>,
-    /// TRT caustic width w_c, degrees.
+    /// TRT caustic width w_c, degrees (the exact model's Marschner and Xu variants; the renderer
+    /// integrates the exact caustic).
     #[arg(long, allow_negative_numbers = true)]
     pub caustic_width: Option<f64>,
-    /// Caustic fade range Delta eta'.
+    /// Caustic fade range Delta eta' (as the caustic width).
     #[arg(long, allow_negative_numbers = true)]
     pub caustic_fade: Option<f64>,
     /// Caustic intensity limit.

@@ -226,7 +226,7 @@ impl AzimuthalTable {
         + 3 * TABLE_THETA_D * TABLE_DPHI;
     pub const MAX_BYTES: u64 = (Self::MAX_CELLS * 16) as u64;
 
-    /// Builds the table for the fiber's eta and eccentricity (about 0.3 s on two cores for a round fiber).
+    /// Builds the table for the fiber's eta and eccentricity (about 0.7 s on two cores for a round fiber).
     pub fn build(eta: f32, eccentricity: f32) -> Self {
         let (eta_lo, eta_hi) = eta_star_range(eta, eccentricity);
         let eta_samples = if eta_lo == eta_hi {

@@ -3,8 +3,11 @@
 //! (Eq. 12):  calN_t(lambda', dphi, theta_d) = integral g^c(x; 0, lambda') N_t(theta_d, dphi - x) dx,
 //! dphi = phi_o - phi_j.
 //!
-//! f32 throughout, written as the WGSL twins in `shaders/` are (same function names). Xu's Schlick
-//! Fresnel is used everywhere (the H tables are built with it).
+//! f32 throughout, written as the WGSL twins in `shaders/` are (same function names) where the GPU uses
+//! them: N_R's inner integral, eta*-bar and the table's helpers. The circular-Gaussian fits of N_TT and
+//! N_TRT are the published form, kept on the CPU with their tests; the renderer reads the exact
+//! integrals from [`super::azimuthal_table`] at every lambda'. Xu's Schlick Fresnel is used everywhere
+//! (the H tables are built with it).
 //!
 //! Changes relative to the paper, each measured by the tests:
 //! - Circular-Gaussian integrals are the exact 2 pi e^-kappa I0(kappa), and the energy-preserving widths
@@ -12,8 +15,8 @@
 //!   amplitudes are then set from the energy, so each fitted lobe carries exactly the Taylor energy.
 //! - The caustic width w_c is Marschner's standard deviation; its circular Gaussians use bandwidth
 //!   sqrt(2) w_c.
-//! - Under narrow lights calN_TT and calN_TRT are the exact integrals of N_p instead of the fits
-//!   ([`super::fast_exact_azimuthal`], read from [`super::azimuthal_table`]).
+//! - The fast response's calN_TT and calN_TRT are the exact integrals of N_p instead of the fits
+//!   ([`super::fast_exact_azimuthal`], read from [`super::azimuthal_table`]), under every light.
 //! - T and T^2 in the energies (Eq. 19, 23) are interpolated at Chebyshev nodes of h^2 instead of
 //!   Taylor-expanded at h = 0 (same even quartic form, same tables; [`attenuation_polynomial`]).
 //! - N_TRT(0) for b_2 (Eq. 21) is the full root sum: for sqrt(2) < eta' < 2 phi(2, h) = 0 has the roots

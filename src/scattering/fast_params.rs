@@ -20,9 +20,10 @@ pub struct FastHairParams {
     /// Eccentricity a (1 = circular).
     pub eccentricity: f32,
     /// Marschner's caustic width w_c, a standard deviation (radians). The circular Gaussians of the
-    /// TRT caustics get bandwidth sqrt(2) w_c (MATH-NOTES: bandwidth = sqrt(2) x std-dev).
+    /// TRT caustics get bandwidth sqrt(2) w_c (MATH-NOTES: bandwidth = sqrt(2) x std-dev). Read only by
+    /// Xu's fits (`trt_lobes`): the response integrates the exact caustic from the azimuthal table.
     pub caustic_width: f32,
-    /// Delta eta' of the smoothstep blend past eta' = 2.
+    /// Delta eta' of the smoothstep blend past eta' = 2 (Xu's fits only, as `caustic_width`).
     pub caustic_fade: f32,
     /// m, segments of the linear quadrature (>= 2).
     pub quadrature_segments: u32,

@@ -82,31 +82,34 @@ pub fn panel(ui: &mut egui::Ui, current: &Look) -> Option<(Look, bool)> {
         d.eccentricity,
         "Ratio of the cross-section's axes (1 = circular); moves the TRT glints with the azimuth",
     ));
-    let mut wc = p.caustic_width.to_degrees();
-    let r = slider(
-        ui,
-        "caustic width w_c",
-        &mut wc,
-        5.0..=40.0,
-        "°",
-        1,
-        d.caustic_width.to_degrees(),
-        "Azimuthal width of the TRT caustic (glint) lobes, degrees",
-    );
-    if r.changed {
-        p.caustic_width = wc.to_radians();
-    }
-    c = c.or(r);
-    c = c.or(slider(
-        ui,
-        "caustic fade Δη'",
-        &mut p.caustic_fade,
-        0.05..=0.6,
-        "",
-        2,
-        d.caustic_fade,
-        "Range of the Bravais index over which the caustics fade out as η' approaches 2",
-    ));
+    // The renderer integrates the exact TRT caustic (the azimuthal table, the reference's unsmoothed
+    // root sum): Marschner's width and fade shape only Xu's published circular-Gaussian fits and the
+    // exact model's smoothed variant (CPU), so they are shown and kept in the session, not edited here.
+    ui.add_enabled_ui(false, |ui| {
+        let mut wc = p.caustic_width.to_degrees();
+        slider(
+            ui,
+            "caustic width w_c",
+            &mut wc,
+            5.0..=40.0,
+            "°",
+            1,
+            d.caustic_width.to_degrees(),
+            "Azimuthal width of the TRT caustic (glint) lobes, degrees",
+        );
+        let mut fade = p.caustic_fade;
+        slider(
+            ui,
+            "caustic fade Δη'",
+            &mut fade,
+            0.05..=0.6,
+            "",
+            2,
+            d.caustic_fade,
+            "Range of the Bravais index over which the caustics fade out as η' approaches 2",
+        );
+    });
+    ui.weak("The renderer integrates the exact caustic: w_c and Δη' shape only Xu's fitted lobes.");
     ui.separator();
 
     ui.strong("Multiple scattering (Zinke)");
