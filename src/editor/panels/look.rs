@@ -1,7 +1,8 @@
 //! The look panel: presets, absorption (melanin, dye colour or sigma_a; root-to-tip gradient; per-strand
 //! variation), Marschner's lobe shifts and widths (locked to his couplings unless opened), the fibre's
-//! index and eccentricity, the TRT caustic, Zinke's density factors and the longitudinal function.
-//! Only controls that reach the fast form are shown (the caustic limit and glint scale do not).
+//! index and eccentricity, Zinke's density factors and the longitudinal function. The TRT caustic's
+//! width and fade are shown disabled (only Xu's fits read them; the renderer integrates the exact
+//! caustic); the caustic limit and glint scale, which the fast form never reads, are not shown.
 //! Returns the edited look and whether a drag is still going on.
 
 use super::widgets::{Changed, linear_to_srgb8, reset_button, slider, slider32, srgb8_to_linear};
