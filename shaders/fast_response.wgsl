@@ -110,9 +110,9 @@ fn longitudinal_ln_m_shape(l: LongitudinalLobe, theta_i: f32) -> f32 {
     return -2.0 * half * half / l.v + l.ln_m_norm;
 }
 
-// d'Eon's Bessel argument cos theta_i cos theta_o' / v (bessel_argument).
-fn longitudinal_bessel_argument(l: LongitudinalLobe, theta_i: f32) -> f32 {
-    return max(cos(theta_i), 0.0) * l.cos_tilted / l.v;
+// d'Eon's Bessel argument cos theta_i cos theta_o' / v from cos theta_i clamped at 0 (bessel_argument).
+fn longitudinal_bessel_argument(l: LongitudinalLobe, cos_theta_i: f32) -> f32 {
+    return cos_theta_i * l.cos_tilted / l.v;
 }
 
 
@@ -126,7 +126,7 @@ fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
     }
     let d = theta_i - l.mu;
     let ln_rest = longitudinal_ln_m_shape(l, theta_i) + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
-    return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, theta_i)) * exp(clamp(ln_rest, -80.0, 20.0));
+    return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, ci)) * exp(clamp(ln_rest, -80.0, 20.0));
 }
 
 // longitudinal_factor x calN_t at theta_i.

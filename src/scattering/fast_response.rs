@@ -237,15 +237,17 @@ impl LongitudinalLobe {
         -2.0 * half * half / self.v + self.ln_m_norm
     }
 
-    /// d'Eon's Bessel argument a = cos theta_i cos theta_o' / v.
-    fn bessel_argument(&self, theta_i: f32) -> f32 {
-        theta_i.cos().max(0.0) * self.cos_tilted / self.v
+    /// d'Eon's Bessel argument a = cos theta_i cos theta_o' / v, from cos theta_i clamped at 0 (the
+    /// factor's own `ci`: computed once per node).
+    fn bessel_argument(&self, cos_theta_i: f32) -> f32 {
+        cos_theta_i * self.cos_tilted / self.v
     }
 
     /// ln M(theta_i) of d'Eon et al. 2011:
     /// ln M = ln(I0(a) e^-a) - 2 sin^2((theta_i + theta_o')/2) / v - ln v - ln(1 - e^(-2/v)), a = cos theta_i cos theta_o' / v.
     pub fn ln_m(&self, theta_i: f32) -> f32 {
-        bessel_i0_scaled(self.bessel_argument(theta_i)).ln() + self.ln_m_shape(theta_i)
+        bessel_i0_scaled(self.bessel_argument(theta_i.cos().max(0.0))).ln()
+            + self.ln_m_shape(theta_i)
     }
 
     /// The longitudinal factor of an outer integrand at theta_i, relative to the Gaussian:
@@ -263,7 +265,7 @@ impl LongitudinalLobe {
         }
         let d = theta_i - self.mu;
         let ln_rest = self.ln_m_shape(theta_i) + d * d / (2.0 * self.v) + self.ln_gaussian_norm;
-        ci * bessel_i0_scaled(self.bessel_argument(theta_i)) * ln_rest.clamp(-80.0, 20.0).exp()
+        ci * bessel_i0_scaled(self.bessel_argument(ci)) * ln_rest.clamp(-80.0, 20.0).exp()
     }
 }
 
