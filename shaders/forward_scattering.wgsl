@@ -75,17 +75,21 @@ fn path_zero() -> PathIntegrals {
 // from the same (a, M), absorption from the level-0 voxel (an empty one holds its neighbours'); zero
 // outside the volume.
 fn forward_integrand(x: vec3<f32>, omega: vec3<f32>, lod: f32) -> PathIntegrals {
-    var out = path_zero();
     let v = forward_voxel_at(x);
     if (v < 0) {
-        return out;
+        return path_zero();
     }
-    let e = extinction_at(x, lod);
+    return forward_integrand_of(extinction_at(x, lod), volume[3 * v + 2].xyz, omega);
+}
+
+// The integrands along omega where the volume reads extinction e and absorption sig (what
+// forward_integrand reads at a point; the shadow grid's sweeps read it at their grid points).
+fn forward_integrand_of(e: Extinction, sig: vec3<f32>, omega: vec3<f32>) -> PathIntegrals {
+    var out = path_zero();
     let c = crossings(e.a, e.m0, e.m1, omega);
     if (c <= 0.0) {
         return out;
     }
-    let sig = volume[3 * v + 2].xyz;
     let w = omega;
     let q = (dot(e.m0, w * w) + 2.0 * (e.m1.x * w.x * w.y + e.m1.y * w.x * w.z + e.m1.z * w.y * w.z)) / max(e.a, 1e-30);
     let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));

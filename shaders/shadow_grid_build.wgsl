@@ -1,4 +1,7 @@
-// The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). One workgroup per light
+// The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). First, before a grid's
+// first unit, `build_midplane_samples` reads what the sweeps need on the planes between the grid's
+// slices (the pyramid's (a, M), the voxel's absorption and solid share: light-independent); then one
+// workgroup per light
 // (all lights for a whole frame, a range of their sweeps per unit of progressive refinement) sweeps the
 // grid slice by slice along each of the light's directions (sweep_direction), adding each
 // point's transmittance (and, when multiple scattering is on, the forward-scattering terms T_f and
@@ -106,6 +109,70 @@ fn sweep_axes(g: ShadowGridInfo, omega: vec3<f32>) -> SweepAxes {
     let c = select(2u, 1u, a == 2u);
     let wa = max(m[a], 1e-6);
     return SweepAxes(a, b, c, omega[a] > 0.0, g.spacing / wa, vec2<f32>(omega[b] / wa, omega[c] / wa));
+}
+
+// MidplaneSamples in sweep.rs: per point of the planes between the slices across each axis a (plane j
+// in 0..=dims[a], the grid's points along b < c; the lattices of axes 0, 1, 2 one after another):
+// (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, solid share), (sigma_a RGB, 1 inside the volume, 0 outside:
+// no hair, zero integrands).
+@group(0) @binding(10) var<storage, read_write> grid_samples: array<vec4<f32>>;
+
+// sweep_lod in sweep.rs: the coarsest level whose voxel is at most half the spacing.
+fn sweep_lod(g: ShadowGridInfo) -> f32 {
+    return floor(max(log2(g.spacing / pyramid_info.levels[0].voxel) - 0.99, 0.0));
+}
+
+// MIDPLANE_REFINE in sweep.rs: samples per grid spacing across the planes.
+const MIDPLANE_REFINE: u32 = 2u;
+
+// The first sample of axis a's lattice ((dims[a] + 1) (R dims[b]) (R dims[c]) samples each).
+fn midplane_offset(g: ShadowGridInfo, a: u32) -> u32 {
+    let d = g.dims;
+    let r2 = MIDPLANE_REFINE * MIDPLANE_REFINE;
+    let s0 = (d.x + 1u) * d.y * d.z * r2;
+    let s1 = (d.y + 1u) * d.x * d.z * r2;
+    return select(select(0u, s0, a >= 1u), s0 + s1, a >= 2u);
+}
+
+@compute @workgroup_size(64)
+fn build_midplane_samples(@builtin(global_invocation_id) id: vec3<u32>) {
+    let g = shadow_grid;
+    let d = g.dims;
+    let total = midplane_offset(g, 2u) + (d.z + 1u) * d.x * d.y * MIDPLANE_REFINE * MIDPLANE_REFINE;
+    // Rows of the dispatch are 65535 workgroups wide whenever there is more than one.
+    let i = id.x + id.y * 65535u * 64u;
+    if (i >= total) {
+        return;
+    }
+    // MidplaneSamples::coordinates and position.
+    var a = 0u;
+    if (i >= midplane_offset(g, 2u)) {
+        a = 2u;
+    } else if (i >= midplane_offset(g, 1u)) {
+        a = 1u;
+    }
+    let b = select(0u, 1u, a == 0u);
+    let c = select(2u, 1u, a == 2u);
+    let r = i - midplane_offset(g, a);
+    let nb = d[b] * MIDPLANE_REFINE;
+    let nc = d[c] * MIDPLANE_REFINE;
+    var q = vec3<f32>(0.0);
+    q[a] = f32(r / (nb * nc));
+    q[b] = (f32(r % nb) + 0.5) / f32(MIDPLANE_REFINE);
+    q[c] = (f32((r / nb) % nc) + 0.5) / f32(MIDPLANE_REFINE);
+    let x = g.origin + q * g.spacing;
+    let v = forward_voxel_at(x);
+    if (v < 0) {
+        grid_samples[3u * i] = vec4<f32>(0.0);
+        grid_samples[3u * i + 1u] = vec4<f32>(0.0);
+        grid_samples[3u * i + 2u] = vec4<f32>(0.0);
+        return;
+    }
+    let e = extinction_at(x, sweep_lod(g));
+    let s = volume[3u * u32(v) + 2u];
+    grid_samples[3u * i] = vec4<f32>(e.a, e.m0);
+    grid_samples[3u * i + 1u] = vec4<f32>(e.m1, s.w);
+    grid_samples[3u * i + 2u] = vec4<f32>(s.xyz, 1.0);
 }
 
 // Without multiple scattering only tau is swept: one vec4 read and written per point.
@@ -225,6 +292,74 @@ fn slot_direction(l: GpuLight, slot: u32, forward: bool) -> SweepDirection {
     return sweep_direction(l.direction, l.lambda, j, count, forward);
 }
 
+// MidplaneSamples::midpoint: the samples at the midpoint of the path from slice k's point (ib, ic) to
+// the previous slice (on the plane between them, at (ib, ic) + shift / 2), bilinear in that plane, the
+// absorption weighted by the extinction; (a, M), (solid, sigma_a) and whether any sample around was
+// inside the volume.
+struct MidpointSample {
+    e: Extinction,
+    solid: f32,
+    sigma_a: vec3<f32>,
+    inside: bool,
+}
+
+fn midplane_sample(g: ShadowGridInfo, ax: SweepAxes, k: u32, ib: u32, ic: u32) -> MidpointSample {
+    let j = select(k, k + 1u, ax.towards_high);
+    // In fine points: grid point ib is at (ib + 1/2) R - 1/2.
+    let r = f32(MIDPLANE_REFINE);
+    let u = (f32(ib) + 0.5 + 0.5 * ax.shift.x) * r - 0.5;
+    let v = (f32(ic) + 0.5 + 0.5 * ax.shift.y) * r - 0.5;
+    let u0 = floor(u);
+    let v0 = floor(v);
+    let fu = u - u0;
+    let fv = v - v0;
+    let nb = g.dims[ax.b] * MIDPLANE_REFINE;
+    let nc = g.dims[ax.c] * MIDPLANE_REFINE;
+    let base = midplane_offset(g, ax.a) + j * nc * nb;
+    var out = MidpointSample(Extinction(0.0, vec3<f32>(0.0), vec3<f32>(0.0)), 0.0, vec3<f32>(0.0), false);
+    var absorbing = 0.0;
+    for (var corner = 0u; corner < 4u; corner++) {
+        let ou = f32(corner & 1u);
+        let ov = f32(corner >> 1u);
+        let iu = u0 + ou;
+        let iv = v0 + ov;
+        if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
+            continue;
+        }
+        let i = base + u32(iv) * nb + u32(iu);
+        let s2 = grid_samples[3u * i + 2u];
+        if (s2.w == 0.0) {
+            continue;
+        }
+        let s0 = grid_samples[3u * i];
+        let s1 = grid_samples[3u * i + 1u];
+        let w = select(1.0 - fu, fu, ou == 1.0) * select(1.0 - fv, fv, ov == 1.0);
+        out.inside = true;
+        out.e.a = out.e.a + w * s0.x;
+        out.e.m0 = out.e.m0 + w * s0.yzw;
+        out.e.m1 = out.e.m1 + w * s1.xyz;
+        out.solid = out.solid + w * s1.w;
+        out.sigma_a = out.sigma_a + (w * s0.x) * s2.xyz;
+        absorbing = absorbing + w * s0.x;
+    }
+    out.sigma_a = out.sigma_a / max(absorbing, 1e-30);
+    return out;
+}
+
+// sweep_integrand in sweep.rs: the integrands at sample s along omega; with `carried` all of them, else
+// the optical depth alone (the depth behind: hair only, the solid's share left out).
+fn sweep_integrand(s: MidpointSample, omega: vec3<f32>, carried: bool, behind: bool) -> PathIntegrals {
+    if (!s.inside) {
+        return path_zero();
+    }
+    if (carried) {
+        return forward_integrand_of(s.e, s.sigma_a, omega);
+    }
+    var f = path_zero();
+    f.tau = crossings(s.e.a, s.e.m0, s.e.m1, omega) * select(1.0, 1.0 - s.solid, behind);
+    return f;
+}
+
 @compute @workgroup_size(128)
 fn build_shadow_grid(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -275,8 +410,6 @@ fn build_shadow_grid(
     let n = g.dims.x * g.dims.y * g.dims.z;
     let forward = g.forward != 0u;
     let area = max(max(g.dims.x * g.dims.y, g.dims.x * g.dims.z), g.dims.y * g.dims.z);
-    // sweep_lod in sweep.rs: the coarsest level whose voxel is at most half the spacing.
-    let lod = floor(max(log2(g.spacing / pyramid_info.levels[0].voxel) - 0.99, 0.0));
     let scratch = 6u * area * scratch_slot;
     for (var slot = slot0; slot < slot1; slot++) {
         let d = slot_direction(l, slot, forward);
@@ -287,19 +420,14 @@ fn build_shadow_grid(
         let na = g.dims[ax.a];
         let nb = g.dims[ax.b];
         let nc = g.dims[ax.c];
-        // Unit steps and index strides along a, b, c (no dynamic vector indexing in the loop: lavapipe
-        // spills it to memory per invocation).
-        let unit = array<vec3<f32>, 3>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+        // Index strides along a, b, c (no dynamic vector indexing in the loop: lavapipe spills it to
+        // memory per invocation).
         let strides = vec3<u32>(1u, g.dims.x, g.dims.x * g.dims.y);
-        let ea = unit[ax.a] * g.spacing;
-        let eb = unit[ax.b] * g.spacing;
-        let ec = unit[ax.c] * g.spacing;
         let sa = strides[ax.a];
         let sb = strides[ax.b];
         let sc = strides[ax.c];
         // Whether the path carries the forward-scattering terms (the depth behind reads tau alone).
         let carried = forward && !d.behind;
-        let x0 = g.origin + vec3<f32>(0.5 * g.spacing) + d.omega * (0.5 * ax.step);
         for (var i = 0u; i < na; i++) {
             let k = select(i, na - 1u - i, ax.towards_high);
             let cur = scratch + 3u * area * (i & 1u);
@@ -315,22 +443,7 @@ fn build_shadow_grid(
                     up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, carried);
                 }
                 let p = k * sa + ib * sb + ic * sc;
-                let x = x0 + f32(k) * ea + f32(ib) * eb + f32(ic) * ec;
-                var f = path_zero();
-                if (carried) {
-                    f = forward_integrand(x, d.omega, lod);
-                } else {
-                    let v = forward_voxel_at(x);
-                    if (v >= 0) {
-                        // Zero outside the volume, as forward_integrand.
-                        f.tau = crossings_at(x, d.omega, lod);
-                        // The depth behind counts hair only: the head's solid is not fibres that
-                        // scatter light back (`sweep` in sweep.rs, `behind`).
-                        if (d.behind) {
-                            f.tau = f.tau * (1.0 - volume[3u * u32(v) + 2u].w);
-                        }
-                    }
-                }
+                let f = sweep_integrand(midplane_sample(g, ax, k, ib, ic), d.omega, carried, d.behind);
                 scratch_store(cur, q, path_add_scaled(up, f, ax.step), carried);
                 accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
             }

@@ -320,6 +320,71 @@ fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
     }
 }
 
+/// What the sweeps read at their midpoints ([`MidplaneSamples`]: the pyramid sampled once on the
+/// planes between the grid's slices, read bilinearly) against the pyramid read at each exact midpoint
+/// (what every sweep did before): the crossing density along random directions on the clump, at the
+/// midpoints of every seventh grid point where either reading sees hair.
+#[test]
+fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {
+    use strandlight::shadow::DensityPyramid;
+    use strandlight::shadow::cone::crossings;
+    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::grid::ShadowGrid;
+    use strandlight::shadow::sweep::{MidplaneSamples, SweepAxes, sweep_lod};
+    let v = clump_volume();
+    let pyramid = DensityPyramid::build(&v);
+    let grid = ShadowGrid::around(
+        &VolumeGrid {
+            origin: v.origin,
+            voxel: v.voxel,
+            dims: v.dims,
+        },
+        48,
+    );
+    let samples = MidplaneSamples::build(&grid, &pyramid, Some(&v));
+    let lod = sweep_lod(&grid, &pyramid);
+    let mut r = Rng01::new(5);
+    let (mut diffs, mut scale) = (Vec::new(), 0f32);
+    for _ in 0..24 {
+        let omega = sample_srbf(&mut r, Vec3::X, 10.0);
+        let ax = SweepAxes::new(&grid, omega);
+        for i in (0..grid.point_count()).step_by(7) {
+            let p = grid.point(i);
+            let idx = ((p - grid.origin) / grid.spacing - 0.5).round();
+            let (k, ib, ic) = (idx[ax.a] as u32, idx[ax.b] as u32, idx[ax.c] as u32);
+            let mid = p + omega * (0.5 * ax.step);
+            if !pyramid.inside(mid) || !pyramid.hair_near(mid, 2.0 * grid.spacing) {
+                continue;
+            }
+            let exact = pyramid.crossings_at(mid, omega, lod);
+            let read = samples
+                .midpoint(&grid, &ax, k, ib, ic)
+                .map_or(0.0, |s| crossings(s.a, s.m, omega));
+            if exact <= 0.0 && read <= 0.0 {
+                continue;
+            }
+            scale = scale.max(exact);
+            diffs.push((read - exact).abs());
+        }
+    }
+    diffs.sort_by(f32::total_cmp);
+    let q = |f: f64| diffs[((diffs.len() - 1) as f64 * f) as usize] / scale;
+    println!(
+        "{} midpoints: |midplane - pyramid| / peak crossings ({scale:.1} per cm): median {:.4}, p95 {:.4}, max {:.4}",
+        diffs.len(),
+        q(0.5),
+        q(0.95),
+        q(1.0)
+    );
+    assert!(diffs.len() > 1000);
+    assert!(
+        q(0.5) < 0.02 && q(0.95) < 0.05,
+        "median {} p95 {}",
+        q(0.5),
+        q(0.95)
+    );
+}
+
 /// 1600 random fibers in a 4 cm box, a quarter dyed red (they absorb green and blue), with the
 /// forward table, the volume (0.25 cm voxels) and its pyramid.
 struct DyedFibers {

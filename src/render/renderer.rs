@@ -494,6 +494,10 @@ impl Renderer {
             "the shadow sweeps' working memory",
             grid.largest_slice() as u64 * 96 * lights.len().max(1) as u64,
         )?;
+        check(
+            "the shadow sweeps' samples",
+            crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64 * 48,
+        )?;
         let gpu_hair = GpuHair::new(device, hair, sigma_a);
         let grid = settings.volume_grid(hair);
         let volume = GpuFiberDensity::new(device, grid, gpu_hair.segment_count);

@@ -34,6 +34,9 @@ pub struct GpuShadowGrid {
     pub values: wgpu::Buffer,
     /// Two slices of path integrals per light (three vec4 per point), the sweeps' working memory.
     pub scratch: wgpu::Buffer,
+    /// What the sweeps read on the planes between the grid's slices (three vec4 a point:
+    /// [`crate::shadow::sweep::MidplaneSamples`]), built before the grid's first entry.
+    pub samples: wgpu::Buffer,
     pub light_count: u32,
     pub forward: bool,
 }
@@ -75,6 +78,12 @@ impl GpuShadowGrid {
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
+            samples: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow grid samples"),
+                size: crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64 * 48,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
             light_count,
             forward,
         }
@@ -104,6 +113,7 @@ pub const SWEEP_SLOTS: u32 = 2 + crate::shadow::sweep::SWEEP_RING;
 
 pub struct ShadowGridPass {
     pipeline: wgpu::ComputePipeline,
+    samples_pipeline: wgpu::ComputePipeline,
 }
 
 impl ShadowGridPass {
@@ -114,12 +124,14 @@ impl ShadowGridPass {
         });
         Self {
             pipeline: compute_pipeline(device, &module, "build_shadow_grid"),
+            samples_pipeline: compute_pipeline(device, &module, "build_midplane_samples"),
         }
     }
 
     /// Encodes the build of entries [first, first + count) ([`SWEEP_SLOTS`] per light: its sweeps;
     /// ordered by light group, then slot, then light; one workgroup per light of the groups touched),
-    /// the range in a storage buffer (see `shadow_grid_build.wgsl`).
+    /// the range in a storage buffer (see `shadow_grid_build.wgsl`). A build from entry 0 first reads
+    /// the sweeps' samples from the pyramid and volume (`build_midplane_samples`).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -151,23 +163,54 @@ impl ShadowGridPass {
             bytemuck::cast_slice(&[first, count, x, group, per_entry as u32, 0, 0, 0]),
             wgpu::BufferUsages::STORAGE,
         );
-        let buffers = [
-            &inputs.pyramid.info_buffer,
-            &inputs.pyramid.pyramid,
-            &target.info,
-            inputs.lights,
-            &target.values,
-            &inputs.volume.info,
-            &inputs.volume.volume,
-            inputs.forward_table,
-            &range,
-            &target.scratch,
+        fn entries<'a>(list: &[(u32, &'a wgpu::Buffer)]) -> Vec<wgpu::BindGroupEntry<'a>> {
+            list.iter()
+                .map(|&(binding, b)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: b.as_entire_binding(),
+                })
+                .collect()
+        }
+        let samples_bind = (first == 0).then(|| {
+            let list = [
+                (0, &inputs.pyramid.info_buffer),
+                (1, &inputs.pyramid.pyramid),
+                (2, &target.info),
+                (5, &inputs.volume.info),
+                (6, &inputs.volume.volume),
+                (10, &target.samples),
+            ];
+            bind_buffers(
+                device,
+                &self.samples_pipeline,
+                "shadow grid samples",
+                &[],
+                entries(&list),
+            )
+        });
+        let list = [
+            (2, &target.info),
+            (3, inputs.lights),
+            (4, &target.values),
+            (5, &inputs.volume.info),
+            (6, &inputs.volume.volume),
+            (7, inputs.forward_table),
+            (8, &range),
+            (9, &target.scratch),
+            (10, &target.samples),
         ];
-        let bind = bind_buffers(device, &self.pipeline, "shadow grid", &buffers, Vec::new());
+        let bind = bind_buffers(device, &self.pipeline, "shadow grid", &[], entries(&list));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shadow grid"),
             timestamp_writes: timestamps,
         });
+        if let Some(samples_bind) = &samples_bind {
+            let samples = crate::shadow::sweep::MidplaneSamples::layout(&target.grid).1 as u32;
+            let groups = samples.div_ceil(64);
+            pass.set_pipeline(&self.samples_pipeline);
+            pass.set_bind_group(0, samples_bind, &[]);
+            pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(x, y, 1);

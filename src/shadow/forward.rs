@@ -143,6 +143,20 @@ pub fn forward_integrand(
         return PathIntegrals::default();
     };
     let (a, m) = pyramid.extinction_at(x, lod);
+    forward_integrand_of(a, m, volume.absorption[v], table, omega)
+}
+
+/// The integrands of [`PathIntegrals`] along omega (unit) where the volume reads extinction `a`,
+/// tensor `m` and absorption `sigma_a` (what [`forward_integrand`] reads at a point; the shadow
+/// grid's sweeps read it at their grid points). Twin of `forward_integrand_of` in
+/// `shaders/forward_scattering.wgsl`.
+pub fn forward_integrand_of(
+    a: f32,
+    m: [f32; 6],
+    sigma_a: [f32; 3],
+    table: &ForwardTable,
+    omega: Vec3,
+) -> PathIntegrals {
     let c = crossings(a, m, omega);
     if c <= 0.0 {
         return PathIntegrals::default();
@@ -158,8 +172,7 @@ pub fn forward_integrand(
         tau: c,
         ..Default::default()
     };
-    for ch in 0..3 {
-        let sig = volume.absorption[v][ch];
+    for (ch, &sig) in sigma_a.iter().enumerate() {
         let (af1, b1) = table.lookup(theta, sig);
         let (af2, b2) = table.lookup(-theta, sig);
         out.loss[ch] = c * (1.0 - 0.5 * (af1 + af2));

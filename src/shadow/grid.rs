@@ -142,11 +142,15 @@ pub struct GridValues {
 impl GridValues {
     /// The values for lights given as (centre direction, lambda).
     pub fn build(grid: ShadowGrid, src: &GridSources, lights: &[(Vec3, f32)]) -> Self {
+        let volume = src.forward.map(|(v, _)| v).or(src.occluder);
+        let samples = super::sweep::MidplaneSamples::build(&grid, src.pyramid, volume);
         Self {
             grid,
             lights: lights
                 .iter()
-                .map(|&(centre, lambda)| super::sweep::sweep_light(&grid, src, centre, lambda))
+                .map(|&(centre, lambda)| {
+                    super::sweep::sweep_light(&grid, src, &samples, centre, lambda)
+                })
                 .collect(),
         }
     }

@@ -6,16 +6,20 @@
 //!
 //! A sweep along omega (unit, towards the light) walks the grid's slices across the axis on which omega
 //! is largest, starting at the slice nearest the light. A point's path is its own segment up to the
-//! previous slice (`step` cm, read at its midpoint, the pyramid at the coarsest level whose voxel is
-//! at most half the grid spacing, so that no strand slips between neighbouring paths) and the path from where it lands there,
+//! previous slice (`step` cm, read at its midpoint) and the path from where it lands there,
 //! interpolated bilinearly in that slice (zero outside the grid: no hair lies outside it). The
+//! midpoints of every sweep across axis a lie on the planes between the slices: [`MidplaneSamples`]
+//! holds what the integrands need at those planes' points (the pyramid's (a, M) at the coarsest level
+//! whose voxel is at most half the grid spacing, so that no strand slips between neighbouring paths,
+//! the voxel's absorption and solid share), read once for every light and direction; a sweep reads
+//! them bilinearly at its midpoints and the pyramid no more. The
 //! interpolation spreads the shadow laterally by about sqrt(n / 6) spacings after n slices; the SRBF's
 //! width is the average over the directions of [`srbf_cones_on_ring`] with [`SWEEP_RING`] on the ring
 //! (the centre and three: the cone march, the reference, takes six), each a thin path.
 
-use super::cone::{DensityPyramid, srbf_cones_on_ring};
+use super::cone::{DensityPyramid, crossings, srbf_cones_on_ring};
 use super::fiber_density::FiberDensity;
-use super::forward::{ForwardTable, PathIntegrals, forward_integrand, forward_spread_weighted};
+use super::forward::{ForwardTable, PathIntegrals, forward_integrand_of, forward_spread_weighted};
 use super::grid::{GRID_INSIDE_SOLID, GRID_MIN_TRANSMITTANCE, GridShadow, GridSources, ShadowGrid};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -82,11 +86,7 @@ impl SweepAxes {
         } else {
             2
         };
-        let (b, c) = match a {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
+        let (b, c) = other_axes(a);
         let wa = m[a].max(1e-6);
         Self {
             a,
@@ -131,6 +131,183 @@ pub fn sweep_lod(grid: &ShadowGrid, pyramid: &DensityPyramid) -> f32 {
         .floor()
 }
 
+/// What a sweep reads at a point (twin of `build_midplane_samples` in
+/// `shaders/shadow_grid_build.wgsl`): the pyramid's extinction and orientation tensor at
+/// [`sweep_lod`], the level-0 voxel's absorption (with multiple scattering) and solid share.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GridSample {
+    pub a: f32,
+    pub m: [f32; 6],
+    pub sigma_a: [f32; 3],
+    pub solid: f32,
+}
+
+/// Samples per grid spacing across a sweep's planes ([`MidplaneSamples`]): at the grid's own spacing
+/// the bilinear reading blurs the density over a spacing, so every SRBF direction sees nearly the same
+/// paths, and the average of exp(-tau) over them came out too dark (back-lit blond clump of
+/// tests/ms_reference.rs: TT 33 % under the ray-shooting reference against 13 % when each midpoint read
+/// the pyramid itself).
+pub const MIDPLANE_REFINE: u32 = 2;
+
+/// The samples on the planes between the grid's slices, for the sweeps across each axis a: plane j
+/// (0..=dims[a], the cells' boundary j spacings from the origin) at [`MIDPLANE_REFINE`] points per
+/// spacing along the other two axes b < c; None outside the volume (zero integrands).
+/// Light-independent: read once per grid build. Twin of the GPU's `grid_samples` buffer (three vec4
+/// a point, the lattices of axes 0, 1, 2 one after another).
+pub struct MidplaneSamples {
+    pub samples: Vec<Option<GridSample>>,
+    /// The first sample of each axis' lattice.
+    pub offsets: [usize; 3],
+}
+
+impl MidplaneSamples {
+    /// The lattices' sizes, (dims[a] + 1) (R dims[b]) (R dims[c]) each (R = [`MIDPLANE_REFINE`]), and
+    /// their first samples.
+    pub fn layout(grid: &ShadowGrid) -> ([usize; 3], usize) {
+        let d = grid.dims.map(|d| d as usize);
+        let r = MIDPLANE_REFINE as usize;
+        let sizes = [0, 1, 2].map(|a| (d[a] + 1) * r * d[(a + 1) % 3] * r * d[(a + 2) % 3]);
+        ([0, sizes[0], sizes[0] + sizes[1]], sizes.iter().sum())
+    }
+
+    /// Sample `i` of the lattices: its axis a, plane j and the fine indices (ib, ic) along b < c.
+    pub fn coordinates(grid: &ShadowGrid, i: usize) -> (usize, u32, u32, u32) {
+        let (offsets, _) = Self::layout(grid);
+        let a = if i >= offsets[2] {
+            2
+        } else if i >= offsets[1] {
+            1
+        } else {
+            0
+        };
+        let r = i - offsets[a];
+        let (nb, nc) = Self::fine_dims(grid, a);
+        (
+            a,
+            (r / (nb * nc)) as u32,
+            (r % nb) as u32,
+            ((r / nb) % nc) as u32,
+        )
+    }
+
+    /// Fine points along b and c of axis a's planes.
+    fn fine_dims(grid: &ShadowGrid, a: usize) -> (usize, usize) {
+        let (b, c) = other_axes(a);
+        let r = MIDPLANE_REFINE as usize;
+        (r * grid.dims[b] as usize, r * grid.dims[c] as usize)
+    }
+
+    /// The position of sample (a, j, ib, ic) (ib, ic fine indices).
+    pub fn position(grid: &ShadowGrid, a: usize, j: u32, ib: u32, ic: u32) -> Vec3 {
+        let (b, c) = other_axes(a);
+        let r = MIDPLANE_REFINE as f32;
+        let mut q = Vec3::ZERO;
+        q[a] = j as f32;
+        q[b] = (ib as f32 + 0.5) / r;
+        q[c] = (ic as f32 + 0.5) / r;
+        grid.origin + q * grid.spacing
+    }
+
+    /// Every sample, from the pyramid at [`sweep_lod`] and `volume` (the forward sources' volume:
+    /// absorption and solid; without it the points inside the pyramid's box are inside).
+    pub fn build(
+        grid: &ShadowGrid,
+        pyramid: &DensityPyramid,
+        volume: Option<&FiberDensity>,
+    ) -> Self {
+        let lod = sweep_lod(grid, pyramid);
+        let (offsets, total) = Self::layout(grid);
+        let samples = (0..total)
+            .into_par_iter()
+            .map(|i| {
+                let (a, j, ib, ic) = Self::coordinates(grid, i);
+                let x = Self::position(grid, a, j, ib, ic);
+                let (sigma_a, solid) = match volume {
+                    Some(v) => {
+                        let voxel = v.voxel_at(x)?;
+                        (
+                            v.absorption[voxel],
+                            v.solid.get(voxel).copied().unwrap_or(0.0),
+                        )
+                    }
+                    None if pyramid.inside(x) => ([0.0; 3], 0.0),
+                    None => return None,
+                };
+                let (a, m) = pyramid.extinction_at(x, lod);
+                Some(GridSample {
+                    a,
+                    m,
+                    sigma_a,
+                    solid,
+                })
+            })
+            .collect();
+        Self { samples, offsets }
+    }
+
+    /// The samples at the midpoint of the path from slice `k`'s point (ib, ic) to the previous
+    /// slice of sweep `ax` (`midplane_sample` in the WGSL): on the plane between the two slices at
+    /// (ib, ic) + shift / 2, bilinear in that plane (the absorption weighted by the extinction, as the
+    /// fibers crossed weigh it); None when no sample around it is inside the volume.
+    pub fn midpoint(
+        &self,
+        grid: &ShadowGrid,
+        ax: &SweepAxes,
+        k: u32,
+        ib: u32,
+        ic: u32,
+    ) -> Option<GridSample> {
+        let j = if ax.towards_high { k + 1 } else { k };
+        // In fine points: grid point ib is at (ib + 1/2) R - 1/2.
+        let r = MIDPLANE_REFINE as f32;
+        let (u, v) = (
+            (ib as f32 + 0.5 + 0.5 * ax.shift[0]) * r - 0.5,
+            (ic as f32 + 0.5 + 0.5 * ax.shift[1]) * r - 0.5,
+        );
+        let (u0, v0) = (u.floor(), v.floor());
+        let (fu, fv) = (u - u0, v - v0);
+        let (nb, nc) = Self::fine_dims(grid, ax.a);
+        let (nb, nc) = (nb as u32, nc as u32);
+        let mut out = GridSample::default();
+        let (mut inside, mut absorbing) = (false, 0.0);
+        for corner in 0..4 {
+            let (ou, ov) = ((corner & 1) as f32, (corner >> 1) as f32);
+            let (iu, iv) = (u0 + ou, v0 + ov);
+            if iu < 0.0 || iv < 0.0 || iu >= nb as f32 || iv >= nc as f32 {
+                continue;
+            }
+            let i = self.offsets[ax.a]
+                + (j as usize * nc as usize + iv as usize) * nb as usize
+                + iu as usize;
+            let Some(s) = &self.samples[i] else {
+                continue;
+            };
+            let w = if ou == 1.0 { fu } else { 1.0 - fu } * if ov == 1.0 { fv } else { 1.0 - fv };
+            inside = true;
+            out.a += w * s.a;
+            out.solid += w * s.solid;
+            for (o, m) in out.m.iter_mut().zip(s.m) {
+                *o += w * m;
+            }
+            for (o, sig) in out.sigma_a.iter_mut().zip(s.sigma_a) {
+                *o += w * s.a * sig;
+            }
+            absorbing += w * s.a;
+        }
+        out.sigma_a = out.sigma_a.map(|x| x / absorbing.max(1e-30));
+        inside.then_some(out)
+    }
+}
+
+/// The axes other than a, in increasing order.
+fn other_axes(a: usize) -> (usize, usize) {
+    match a {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    }
+}
+
 /// The slice's integrals at the continuous position (u, v) (in points along b, c), bilinear; points
 /// outside the slice are outside the grid, where no hair is: zero.
 fn slice_bilinear(slice: &[PathIntegrals], nb: u32, nc: u32, u: f32, v: f32) -> PathIntegrals {
@@ -149,15 +326,35 @@ fn slice_bilinear(slice: &[PathIntegrals], nb: u32, nc: u32, u: f32, v: f32) -> 
     out
 }
 
+/// The integrands at a sample along omega (a sweep's, `sweep_integrand` in the WGSL): with the
+/// forward table all of them, else the optical depth alone; `behind`'s counts hair only (an
+/// occluder's solid is not fibres that scatter light back).
+pub fn sweep_integrand(
+    sample: Option<&GridSample>,
+    table: Option<&ForwardTable>,
+    omega: Vec3,
+    behind: bool,
+) -> PathIntegrals {
+    let Some(s) = sample else {
+        return PathIntegrals::default();
+    };
+    match table {
+        Some(table) if !behind => forward_integrand_of(s.a, s.m, s.sigma_a, table, omega),
+        _ => PathIntegrals {
+            tau: crossings(s.a, s.m, omega) * if behind { 1.0 - s.solid } else { 1.0 },
+            ..Default::default()
+        },
+    }
+}
+
 /// One sweep along omega: `visit(point, integrals)` for every grid point, the integrals of its path
 /// out of the grid with the first `skip` cm left out (the point's own fiber). Only the optical depth
-/// without `forward`.
-/// `behind`: the reversed sweep of the depth behind the point, which counts hair only (an occluder's
-/// solid is not fibres that scatter light back).
+/// without `table`. `behind`: the reversed sweep of the depth behind the point (optical depth alone,
+/// hair only).
 pub fn sweep(
     grid: &ShadowGrid,
-    pyramid: &DensityPyramid,
-    forward: Option<(&FiberDensity, &ForwardTable)>,
+    samples: &MidplaneSamples,
+    table: Option<&ForwardTable>,
     omega: Vec3,
     skip: f32,
     behind: bool,
@@ -165,7 +362,6 @@ pub fn sweep(
 ) {
     let ax = SweepAxes::new(grid, omega);
     let (nb, nc) = (grid.dims[ax.b], grid.dims[ax.c]);
-    let lod = sweep_lod(grid, pyramid);
     let mut prev: Vec<PathIntegrals> = Vec::new();
     for i in 0..grid.dims[ax.a] {
         let k = ax.slice(grid, i);
@@ -184,28 +380,12 @@ pub fn sweep(
                         ic as f32 + ax.shift[1],
                     )
                 };
-                let x = grid.point(ax.point_index(grid, k, ib, ic)) + omega * (0.5 * ax.step);
-                let f = match forward {
-                    // The depth behind reads the optical depth alone.
-                    Some((volume, _)) if behind => PathIntegrals {
-                        tau: if pyramid.inside(x) {
-                            pyramid.crossings_at(x, omega, lod) * (1.0 - volume.solid_at(x))
-                        } else {
-                            0.0
-                        },
-                        ..Default::default()
-                    },
-                    Some((volume, table)) => {
-                        forward_integrand(pyramid, volume, table, x, omega, lod)
-                    }
-                    // Zero outside the volume, as forward_integrand: with and without multiple
-                    // scattering the direct fraction sums the same samples.
-                    None if pyramid.inside(x) => PathIntegrals {
-                        tau: pyramid.crossings_at(x, omega, lod),
-                        ..Default::default()
-                    },
-                    None => PathIntegrals::default(),
-                };
+                let f = sweep_integrand(
+                    samples.midpoint(grid, &ax, k, ib, ic).as_ref(),
+                    table,
+                    omega,
+                    behind,
+                );
                 (
                     up.add_scaled(&f, ax.step),
                     up.add_scaled(&f, (ax.step - skip).max(0.0)),
@@ -264,27 +444,22 @@ fn finish(acc: &Accumulator, forward: bool) -> GridShadow {
 }
 
 /// Every grid point's stored value for one light (logarithms, as the GPU grid holds them): the
-/// sweeps of [`sweep_directions`], combined as [`super::grid::srbf_forward`] combines its cones.
+/// sweeps of [`sweep_directions`] over the grid's [`MidplaneSamples`], combined as
+/// [`super::grid::srbf_forward`] combines its cones.
 pub fn sweep_light(
     grid: &ShadowGrid,
     src: &GridSources,
+    samples: &MidplaneSamples,
     centre: Vec3,
     lambda: f32,
 ) -> Vec<GridShadow> {
     let forward = src.forward.is_some();
+    let table = src.forward.map(|(_, t)| t);
     let mut acc = vec![[0f32; 8]; grid.point_count()];
     for d in sweep_directions(centre, lambda, forward) {
-        sweep(
-            grid,
-            src.pyramid,
-            src.forward,
-            d.omega,
-            src.skip,
-            d.behind,
-            |i, f| {
-                accumulate(&mut acc[i], &d, f, forward);
-            },
-        );
+        sweep(grid, samples, table, d.omega, src.skip, d.behind, |i, f| {
+            accumulate(&mut acc[i], &d, f, forward);
+        });
     }
     acc.iter()
         .enumerate()
