@@ -210,7 +210,7 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
         let ang = fiber_angles(frame, l.direction);
         var t = vec3<f32>(1.0);
         if (shadows) {
-            t = vec3<f32>(grid_shadow(shadow_grid, a.position, j).transmittance, grid_shadow(shadow_grid, mid.position, j).transmittance, grid_shadow(shadow_grid, b.position, j).transmittance);
+            t = vec3<f32>(grid_transmittance(shadow_grid, a.position, j), grid_transmittance(shadow_grid, mid.position, j), grid_transmittance(shadow_grid, b.position, j));
         }
         let light = SrbfInFrame(ang.x, ang.y, l.lambda);
         var ra = zero; var tta = zero; var trta = zero;
@@ -310,33 +310,46 @@ fn count_first_rows(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // The indirect dispatch of `shade_segments`: one invocation per listed segment (its single scattering)
 // (none with FLAG_SINGLE_KEPT) and with multiple scattering a second (its midpoint's), in workgroups of
-// 64, as rows of at most 65535 workgroups.
+// 64 (each kind's rounded up on its own: the kinds' workgroups alternate), as rows of at most 65535
+// workgroups.
 @compute @workgroup_size(1)
 fn segment_dispatch() {
     let single = (batch.flags & FLAG_SINGLE_KEPT) == 0u;
     let multiple = (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u;
     let kinds = select(0u, 1u, single) + select(0u, 1u, multiple);
-    let groups = (kinds * atomicLoad(&work_count[0]) + 63u) / 64u;
+    let groups = kinds * ((atomicLoad(&work_count[0]) + 63u) / 64u);
     work_args[0] = min(groups, 65535u);
     work_args[1] = (groups + 65534u) / 65535u;
     work_args[2] = 1u;
 }
 
-// Invocation i < n (n segments listed): single scattering of listed segment i; i >= n: multiple
-// scattering at the midpoint of listed segment i - n. The kinds lie apart in the index, so a SIMD group
-// runs one of them (single and multiple scattering in one light loop spill on lavapipe and cost ~3x as
+// Invocation i < n (n segments listed; i after the workgroups' interleaving below): single scattering
+// of listed segment i; i >= n: multiple scattering at the midpoint of listed segment i - n. A workgroup
+// runs one kind, so a SIMD group runs one of them (single and multiple scattering in one light loop spill on lavapipe and cost ~3x as
 // much as apart). The first light batch (first == 0, every segment's first: the batches run in order)
 // stores the segment's radiance, the others add to it, so nothing needs clearing. With FLAG_SINGLE_KEPT
 // every invocation i < n is listed segment i's multiple scattering, and its single scattering stays.
 @compute @workgroup_size(64)
 fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     // Rows of the indirect dispatch are 65535 workgroups wide whenever there is more than one.
-    let i = id.x + id.y * 65535u * 64u;
+    let g = id.x + id.y * 65535u * 64u;
     let n = atomicLoad(&work_count[0]);
     let shadows = (batch.flags & FLAG_SHADOWS) != 0u;
     let restart = batch.first == 0u;
     // With the single scattering kept, every invocation is a segment's multiple scattering.
     let n_single = select(n, 0u, (batch.flags & FLAG_SINGLE_KEPT) != 0u);
+    // Both kinds: the workgroups alternate between them (even: the single scattering of 64 listed
+    // segments, odd: the same segments' multiple scattering), so that every contiguous share of the
+    // dispatch holds both (lavapipe gives each of its threads one contiguous share of a dispatch's
+    // workgroups: with the kinds in halves, one thread had all of the single scattering and the other
+    // all of the multiple, and the slower kind set the time).
+    var i = g;
+    if (n_single > 0u && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+        let w = g / 64u;
+        let j = (w >> 1u) * 64u + g % 64u;
+        let kind = select(0u, n_single, (w & 1u) == 1u);
+        i = select(n_single + n, kind + j, j < n);
+    }
     if (i < n_single) {
         let seg = work_list[i];
         let mid = segment_point(seg, 0.5);

@@ -95,3 +95,37 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
     }
     return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz, max(v1.w, 0.0));
 }
+
+// grid_shadow's transmittance alone (single scattering reads only it, three times per light and
+// segment): per corner the log transmittance and the inside flag, two floats where grid_shadow loads
+// two vec4. The same sums in the same order, so the same value.
+fn grid_transmittance(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> f32 {
+    let hi = vec3<f32>(g.dims) - vec3<f32>(1.0);
+    let q = clamp((p - g.origin) / g.spacing - vec3<f32>(0.5), vec3<f32>(0.0), hi);
+    let base = min(floor(q), max(hi - vec3<f32>(1.0), vec3<f32>(0.0)));
+    let f = q - base;
+    let n = g.dims.x * g.dims.y * g.dims.z;
+    var v = 0.0;
+    var o = 0.0;
+    var wo = 0.0;
+    var any_inside = false;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let c = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
+        let idx = min(vec3<u32>(base) + c, g.dims - vec3<u32>(1u));
+        let w3 = select(vec3<f32>(1.0) - f, f, c == vec3<u32>(1u));
+        let i = (idx.z * g.dims.y + idx.y) * g.dims.x + idx.x;
+        let w = w3.x * w3.y * w3.z;
+        let t = shadow_values[2u * (light * n + i)].x;
+        v = v + w * t;
+        if (shadow_values[2u * (light * n + i) + 1u].w >= 0.0) {
+            o = o + w * t;
+            wo = wo + w;
+        } else {
+            any_inside = true;
+        }
+    }
+    if (any_inside && wo > 1e-4) {
+        v = o / wo;
+    }
+    return exp(v);
+}
