@@ -1,7 +1,7 @@
-// The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). First, before a grid's
-// first unit, `build_midplane_samples` reads what the sweeps need on the planes between the grid's
-// slices (the pyramid's (a, M), the voxel's absorption and solid share: light-independent); then one
-// workgroup per light
+// The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). After each new pyramid,
+// `build_midplane_samples` reads what the sweeps need on the planes between the grid's slices (the
+// pyramid's (a, M), the voxel's absorption and solid share: light-independent); then one workgroup per
+// light
 // (all lights for a whole frame, a range of their sweeps per unit of progressive refinement) sweeps the
 // grid slice by slice along each of the light's directions (sweep_direction), adding each
 // point's transmittance (and, when multiple scattering is on, the forward-scattering terms T_f and
@@ -24,7 +24,8 @@
 // The entries this dispatch builds, [first, first + count) (SWEEP_SLOTS per light, ordered by group of
 // lights, then slot, then light: a unit of a few entries sweeps several lights side by side; one
 // workgroup per light of the groups touched), and the dispatch's workgroups along x
-// (a small buffer per dispatch, so the grid's uniform stays the one the shading pass reads).
+// (a small buffer per dispatch, so the grid's uniform stays the one the shading pass reads). For
+// `build_midplane_samples`, first and count are samples.
 struct BuildRange {
     first: u32,
     count: u32,
@@ -139,9 +140,11 @@ fn build_midplane_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let g = shadow_grid;
     let d = g.dims;
     let total = midplane_offset(g, 2u) + (d.z + 1u) * d.x * d.y * MIDPLANE_REFINE * MIDPLANE_REFINE;
+    // Samples [first, first + count) (build_range; a unit of progressive refinement builds a part).
     // Rows of the dispatch are 65535 workgroups wide whenever there is more than one.
-    let i = id.x + id.y * 65535u * 64u;
-    if (i >= total) {
+    let k = id.x + id.y * 65535u * 64u;
+    let i = build_range.first + k;
+    if (k >= build_range.count || i >= total) {
         return;
     }
     // MidplaneSamples::coordinates and position.

@@ -43,6 +43,9 @@ pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 /// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
+/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: S1's million in
+/// about 40 ms).
+const GUESS_GRID_SAMPLE_S: f64 = 50e-9;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
 /// A voxel resolved (lavapipe, two cores: 100-180 ns).
 const GUESS_VOXEL_S: f64 = 200e-9;
@@ -89,6 +92,9 @@ pub enum WorkUnit {
     VolumeResolve { first: u32, count: u32 },
     /// The resolved density's pyramid.
     DensityPyramid,
+    /// The shadow-grid sweeps' samples [first, first + count) (`MidplaneSamples`), after a new
+    /// pyramid and before the grid's entries.
+    GridSamples { first: u32, count: u32 },
     /// Shadow-grid entries [first, first + count) (`SWEEP_SLOTS` per light: its sweeps).
     ShadowGrid { first: u32, count: u32 },
     /// The visibility pass over segments [first, first + count) (the first part clears the targets;
@@ -282,6 +288,8 @@ pub struct Refinement {
     stage: Stage,
     /// Shadow-grid entries built for the current volume, lights and tables.
     pub(super) grid_done: u32,
+    /// The sweeps' samples built for the current pyramid and grid buffers (`MidplaneSamples`).
+    pub(super) samples_done: u32,
     /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
     /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
     /// preview shades those lights unshadowed).
@@ -289,8 +297,10 @@ pub struct Refinement {
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
-    /// Seconds per shadow-grid entry and per deposited segment (None: not measured yet).
+    /// Seconds per shadow-grid entry, per sample of its sweeps and per deposited segment (None: not
+    /// measured yet).
     grid_cost: Option<f64>,
+    samples_cost: Option<f64>,
     volume_cost: Option<f64>,
     /// Seconds per voxel resolved, and per row of the image's resolve before shading.
     resolve_cost: Option<f64>,
@@ -341,10 +351,12 @@ impl Default for Refinement {
         Self {
             stage: Stage::Visibility { first: 0 },
             grid_done: 0,
+            samples_done: 0,
             grid_partial: Vec::new(),
             shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
+            samples_cost: None,
             volume_cost: None,
             resolve_cost: None,
             backdrop_cost: None,
@@ -483,7 +495,7 @@ impl Refinement {
             WorkUnit::Volume { .. } | WorkUnit::VolumeResolve { .. } | WorkUnit::DensityPyramid => {
                 1
             }
-            WorkUnit::ShadowGrid { .. } => 2,
+            WorkUnit::GridSamples { .. } | WorkUnit::ShadowGrid { .. } => 2,
             WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } => 3,
             WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } => 4,
         };
@@ -493,6 +505,10 @@ impl Refinement {
             WorkUnit::ShadowGrid { count, .. } => {
                 let per = seconds / count.max(1) as f64;
                 self.grid_cost = ema(self.grid_cost, per);
+            }
+            WorkUnit::GridSamples { count, .. } => {
+                let per = seconds / count.max(1) as f64;
+                self.samples_cost = ema(self.samples_cost, per);
             }
             WorkUnit::Shade { row0, rows, .. } => {
                 let (slot, lights) = batch.unwrap_or((0, 1));
@@ -1099,9 +1115,25 @@ impl Renderer {
         }
     }
 
-    /// A shadow-grid unit towards `target` entries, or None when they are built.
+    /// A shadow-grid unit towards `target` entries (after the sweeps' samples), or None when they
+    /// are built.
     fn grid_unit(&mut self, target: u32) -> Option<WorkUnit> {
+        let samples = self.shadow_grid.sample_count();
         let r = &mut self.refinement;
+        if r.grid_done >= target {
+            return None;
+        }
+        if r.samples_done < samples {
+            let count = r.items(
+                r.samples_cost,
+                GUESS_GRID_SAMPLE_S,
+                u32::MAX / 2,
+                samples - r.samples_done,
+            );
+            let first = r.samples_done;
+            r.samples_done += count;
+            return Some(WorkUnit::GridSamples { first, count });
+        }
         if r.grid_done >= target {
             return None;
         }
@@ -1485,6 +1517,18 @@ impl Renderer {
                 self.volume_dirty = false;
                 self.shadow_grid_dirty = true;
                 self.refinement.grid_done = 0;
+                self.refinement.samples_done = 0;
+            }
+            WorkUnit::GridSamples { first, count } => {
+                let inputs = self.shadow_grid_inputs();
+                self.shadow_grid_pass.encode_samples(
+                    device,
+                    enc,
+                    &inputs,
+                    &self.shadow_grid,
+                    first,
+                    count,
+                );
             }
             WorkUnit::ShadowGrid { first, count } => {
                 let inputs = self.shadow_grid_inputs();

@@ -989,6 +989,7 @@ impl Renderer {
 
     /// A new shadow-grid buffer holds zeros, not finished entries: its groups count as unbuilt.
     fn grid_buffer_made(&mut self) {
+        self.refinement.samples_done = 0;
         let group = self
             .settings
             .lights_per_pass
@@ -1339,10 +1340,23 @@ impl Renderer {
             self.volume_dirty = false;
             self.shadow_grid_dirty = true;
             self.refinement.grid_done = 0;
+            self.refinement.samples_done = 0;
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
             let count = self.shadow_grid.entry_count();
             let inputs = self.shadow_grid_inputs();
+            let samples = self.shadow_grid.sample_count();
+            let samples_stale = self.refinement.samples_done < samples;
+            if samples_stale {
+                self.shadow_grid_pass.encode_samples(
+                    device,
+                    &mut enc,
+                    &inputs,
+                    &self.shadow_grid,
+                    0,
+                    samples,
+                );
+            }
             self.shadow_grid_pass.encode(
                 device,
                 &mut enc,
@@ -1353,6 +1367,7 @@ impl Renderer {
                 timer.and_then(|t| t.compute_writes("shadow_grid")),
             );
             self.last_ran.push("shadow_grid");
+            self.refinement.samples_done = samples;
             self.shadow_grid_dirty = false;
             self.refinement.grid_complete(count);
         }
@@ -1403,7 +1418,8 @@ impl Renderer {
         self.single_kept = false;
     }
 
-    /// Rebuilds the whole shadow grid alone and waits for it: wall-clock seconds (benchmarks). On lavapipe
+    /// Rebuilds the whole shadow grid alone, its sweeps' samples included, and waits for it:
+    /// wall-clock seconds (benchmarks). On lavapipe
     /// a compute pass's timestamps bracket the dispatch's submission to its thread pool, not its work, so
     /// a pass that no later barrier waits for inside its own bracket (the grid) reads ~0 ms there.
     pub fn time_shadow_grid(&mut self, ctx: &GpuContext) -> Result<f64, RenderError> {
@@ -1417,6 +1433,15 @@ impl Renderer {
                 label: Some("shadow grid alone"),
             });
         let inputs = self.shadow_grid_inputs();
+        let samples = self.shadow_grid.sample_count();
+        self.shadow_grid_pass.encode_samples(
+            &ctx.device,
+            &mut enc,
+            &inputs,
+            &self.shadow_grid,
+            0,
+            samples,
+        );
         self.shadow_grid_pass.encode(
             &ctx.device,
             &mut enc,
@@ -1426,6 +1451,7 @@ impl Renderer {
             self.shadow_grid.entry_count(),
             None,
         );
+        self.refinement.samples_done = samples;
         ctx.queue.submit([enc.finish()]);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())

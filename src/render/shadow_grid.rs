@@ -35,7 +35,7 @@ pub struct GpuShadowGrid {
     /// Two slices of path integrals per light (three vec4 per point), the sweeps' working memory.
     pub scratch: wgpu::Buffer,
     /// What the sweeps read on the planes between the grid's slices (three vec4 a point:
-    /// [`crate::shadow::sweep::MidplaneSamples`]), built before the grid's first entry.
+    /// [`crate::shadow::sweep::MidplaneSamples`]), built after each new pyramid.
     pub samples: wgpu::Buffer,
     pub light_count: u32,
     pub forward: bool,
@@ -80,7 +80,10 @@ impl GpuShadowGrid {
             }),
             samples: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("shadow grid samples"),
-                size: crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64 * 48,
+                size: crate::shadow::sweep::MidplaneSamples::layout(&grid)
+                    .1
+                    .max(1) as u64
+                    * 48,
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
@@ -92,6 +95,11 @@ impl GpuShadowGrid {
     /// Units of the build: [`SWEEP_SLOTS`] per light (its sweeps, then its values finished).
     pub fn entry_count(&self) -> u32 {
         self.light_count * SWEEP_SLOTS
+    }
+
+    /// The sweeps' samples ([`crate::shadow::sweep::MidplaneSamples::layout`]).
+    pub fn sample_count(&self) -> u32 {
+        crate::shadow::sweep::MidplaneSamples::layout(&self.grid).1 as u32
     }
 }
 
@@ -128,10 +136,55 @@ impl ShadowGridPass {
         }
     }
 
+    /// Encodes the sweeps' samples [first, first + count) of
+    /// [`MidplaneSamples::layout`](crate::shadow::sweep::MidplaneSamples::layout) (read from the
+    /// pyramid and volume, `build_midplane_samples`): every sweep reads them, so they are built
+    /// after each new pyramid (or new grid buffers) and before the grid's first entry.
+    pub fn encode_samples(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadowGridInputs,
+        target: &GpuShadowGrid,
+        first: u32,
+        count: u32,
+    ) {
+        let range = buffer_init(
+            device,
+            "shadow grid samples range",
+            bytemuck::cast_slice(&[first, count, 0, 0, 0, 0, 0, 0]),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let list = [
+            (0, &inputs.pyramid.info_buffer),
+            (1, &inputs.pyramid.pyramid),
+            (2, &target.info),
+            (5, &inputs.volume.info),
+            (6, &inputs.volume.volume),
+            (8, &range),
+            (10, &target.samples),
+        ];
+        let bind = bind_buffers(
+            device,
+            &self.samples_pipeline,
+            "shadow grid samples",
+            &[],
+            entries(&list),
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shadow grid samples"),
+            timestamp_writes: None,
+        });
+        let groups = count.div_ceil(64).max(1);
+        pass.set_pipeline(&self.samples_pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+    }
+
     /// Encodes the build of entries [first, first + count) ([`SWEEP_SLOTS`] per light: its sweeps;
     /// ordered by light group, then slot, then light; one workgroup per light of the groups touched),
-    /// the range in a storage buffer (see `shadow_grid_build.wgsl`). A build from entry 0 first reads
-    /// the sweeps' samples from the pyramid and volume (`build_midplane_samples`).
+    /// the range in a storage buffer (see `shadow_grid_build.wgsl`). The sweeps read the samples
+    /// ([`Self::encode_samples`]).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -163,31 +216,6 @@ impl ShadowGridPass {
             bytemuck::cast_slice(&[first, count, x, group, per_entry as u32, 0, 0, 0]),
             wgpu::BufferUsages::STORAGE,
         );
-        fn entries<'a>(list: &[(u32, &'a wgpu::Buffer)]) -> Vec<wgpu::BindGroupEntry<'a>> {
-            list.iter()
-                .map(|&(binding, b)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: b.as_entire_binding(),
-                })
-                .collect()
-        }
-        let samples_bind = (first == 0).then(|| {
-            let list = [
-                (0, &inputs.pyramid.info_buffer),
-                (1, &inputs.pyramid.pyramid),
-                (2, &target.info),
-                (5, &inputs.volume.info),
-                (6, &inputs.volume.volume),
-                (10, &target.samples),
-            ];
-            bind_buffers(
-                device,
-                &self.samples_pipeline,
-                "shadow grid samples",
-                &[],
-                entries(&list),
-            )
-        });
         let list = [
             (2, &target.info),
             (3, inputs.lights),
@@ -204,15 +232,18 @@ impl ShadowGridPass {
             label: Some("shadow grid"),
             timestamp_writes: timestamps,
         });
-        if let Some(samples_bind) = &samples_bind {
-            let samples = crate::shadow::sweep::MidplaneSamples::layout(&target.grid).1 as u32;
-            let groups = samples.div_ceil(64);
-            pass.set_pipeline(&self.samples_pipeline);
-            pass.set_bind_group(0, samples_bind, &[]);
-            pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
     }
+}
+
+/// Bind group entries at the given bindings.
+fn entries<'a>(list: &[(u32, &'a wgpu::Buffer)]) -> Vec<wgpu::BindGroupEntry<'a>> {
+    list.iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry {
+            binding,
+            resource: b.as_entire_binding(),
+        })
+        .collect()
 }
