@@ -30,7 +30,8 @@ fn forward_sigma_pos(s: f32) -> f32 {
     return 1.0 + log(s / FWD_SIGMA_MIN) / log(FWD_SIGMA_MAX / FWD_SIGMA_MIN) * f32(FWD_SIGMA_SAMPLES - 2u);
 }
 
-// (a_f, beta_f^2) at (theta, sigma_a), bilinear; the table holds (a_f, beta_f^2) pairs, theta fastest.
+// The means over +-theta of a_f and of a_f beta_f^2 at (theta, sigma_a), bilinear; the table holds the
+// nodes' means (ForwardTable::symmetric_node), theta fastest. Twin of ForwardTable::lookup_symmetric.
 fn forward_lookup(theta: f32, sigma_a: f32) -> vec2<f32> {
     let x = clamp((theta + FRAC_PI_2) / PI, 0.0, 1.0) * f32(FWD_THETA_SAMPLES - 1u);
     let y = clamp(forward_sigma_pos(sigma_a), 0.0, f32(FWD_SIGMA_SAMPLES - 1u));
@@ -95,11 +96,10 @@ fn forward_integrand_of(e: Extinction, sig: vec3<f32>, omega: vec3<f32>) -> Path
     let theta = asin_precise(sqrt(clamp(q, 0.0, 1.0)));
     out.tau = c;
     for (var ch = 0u; ch < 3u; ch++) {
-        let f1 = forward_lookup(theta, sig[ch]);
-        let f2 = forward_lookup(-theta, sig[ch]);
-        out.loss[ch] = c * (1.0 - 0.5 * (f1.x + f2.x));
-        out.mass[ch] = c * 0.5 * (f1.x + f2.x);
-        out.spread[ch] = c * 0.5 * (f1.x * f1.y + f2.x * f2.y);
+        let f = forward_lookup(theta, sig[ch]);
+        out.loss[ch] = c * (1.0 - f.x);
+        out.mass[ch] = c * f.x;
+        out.spread[ch] = c * f.y;
     }
     return out;
 }

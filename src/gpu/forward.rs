@@ -22,13 +22,12 @@ pub struct ForwardQuery {
 
 const _: () = assert!(std::mem::size_of::<ForwardQuery>() == 32);
 
-/// The table as (a_f, beta_f^2) pairs, theta fastest, as the shaders read it.
+/// The table as the shaders read it: per node the means over +-theta of a_f and of a_f beta_f^2
+/// ([`ForwardTable::symmetric_node`]), theta fastest.
 pub fn forward_table_texels(table: &ForwardTable) -> Vec<[f32; 2]> {
-    table
-        .a_f
-        .iter()
-        .zip(&table.beta_f2)
-        .map(|(a, b)| [*a, *b])
+    use crate::shadow::forward::{SIGMA_SAMPLES, THETA_SAMPLES};
+    (0..SIGMA_SAMPLES)
+        .flat_map(|j| (0..THETA_SAMPLES).map(move |i| table.symmetric_node(i, j)))
         .collect()
 }
 

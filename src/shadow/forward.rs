@@ -18,7 +18,8 @@
 //!
 //! Each voxel holds the sign-free orientation tensor only, so a_f and beta_f^2 are averaged over
 //! theta = +-asin(sqrt(omega^T <u u^T> omega)) (the fiber's inclination to the light, either way along it),
-//! with the tensor read trilinearly as the crossing density is. The absorption is the voxel's (an empty
+//! with the tensor read trilinearly as the crossing density is (the table's nodes hold the means over
+//! +-theta, [`ForwardTable::lookup_symmetric`]: one lookup a channel). The absorption is the voxel's (an empty
 //! voxel holds its neighbours'): reading it as zero where the trilinear density is not made every
 //! fourth crossing in a sparse clump a clear fiber, and T_f of blond hair 1.5-2x too high in blue.
 
@@ -60,6 +61,43 @@ impl ForwardTable {
             a_f: cells.iter().map(|c| c.0).collect(),
             beta_f2: cells.iter().map(|c| c.1).collect(),
         }
+    }
+
+    /// The means over +-theta of a_f and of a_f beta_f^2 at node (i, j) (theta index i, sigma_a
+    /// index j): the texels of the GPU's table ([`crate::gpu::forward::forward_table_texels`]).
+    pub fn symmetric_node(&self, i: usize, j: usize) -> [f32; 2] {
+        let (k, m) = (
+            j * THETA_SAMPLES + i,
+            j * THETA_SAMPLES + THETA_SAMPLES - 1 - i,
+        );
+        [
+            0.5 * (self.a_f[k] + self.a_f[m]),
+            0.5 * (self.a_f[k] * self.beta_f2[k] + self.a_f[m] * self.beta_f2[m]),
+        ]
+    }
+
+    /// The means over +-theta of a_f and of a_f beta_f^2 (a fiber crossed at inclination theta
+    /// either way along it) at (theta, sigma_a), bilinear in the nodes' means
+    /// ([`Self::symmetric_node`]; the theta samples lie symmetrically about 0, so the mean of a_f is
+    /// exactly that of [`Self::lookup`] at +-theta, and the mean of the product differs from the
+    /// product of the interpolated factors by the interpolation's error). One lookup where the
+    /// integrand took two. Twin of `forward_lookup` in `shaders/forward_scattering.wgsl`.
+    pub fn lookup_symmetric(&self, theta: f32, sigma_a: f32) -> (f32, f32) {
+        let x = ((theta + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
+            * (THETA_SAMPLES - 1) as f32;
+        let y = sigma_pos(sigma_a).clamp(0.0, (SIGMA_SAMPLES - 1) as f32);
+        let (i, j) = (
+            (x as usize).min(THETA_SAMPLES - 2),
+            (y as usize).min(SIGMA_SAMPLES - 2),
+        );
+        let (wx, wy) = (x - i as f32, y - j as f32);
+        let bil = |c: usize| {
+            let at = |i: usize, j: usize| self.symmetric_node(i, j)[c];
+            let a = at(i, j) + wx * (at(i + 1, j) - at(i, j));
+            let b = at(i, j + 1) + wx * (at(i + 1, j + 1) - at(i, j + 1));
+            a + wy * (b - a)
+        };
+        (bil(0), bil(1))
     }
 
     /// (a_f, beta_f^2) at (theta, sigma_a), bilinear.
@@ -173,11 +211,10 @@ pub fn forward_integrand_of(
         ..Default::default()
     };
     for (ch, &sig) in sigma_a.iter().enumerate() {
-        let (af1, b1) = table.lookup(theta, sig);
-        let (af2, b2) = table.lookup(-theta, sig);
-        out.loss[ch] = c * (1.0 - 0.5 * (af1 + af2));
-        out.mass[ch] = c * 0.5 * (af1 + af2);
-        out.spread[ch] = c * 0.5 * (af1 * b1 + af2 * b2);
+        let (a_f, spread) = table.lookup_symmetric(theta, sig);
+        out.loss[ch] = c * (1.0 - a_f);
+        out.mass[ch] = c * a_f;
+        out.spread[ch] = c * spread;
     }
     out
 }
