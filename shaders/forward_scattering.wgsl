@@ -84,7 +84,8 @@ fn forward_integrand(x: vec3<f32>, omega: vec3<f32>, lod: f32) -> PathIntegrals 
 }
 
 // The integrands along omega where the volume reads extinction e and absorption sig (what
-// forward_integrand reads at a point; the shadow grid's sweeps read it at their grid points).
+// forward_integrand reads at a point; the shadow grid's sweeps read it at their midpoints, from their
+// samples).
 fn forward_integrand_of(e: Extinction, sig: vec3<f32>, omega: vec3<f32>) -> PathIntegrals {
     var out = path_zero();
     let c = crossings(e.a, e.m0, e.m1, omega);

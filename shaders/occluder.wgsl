@@ -115,7 +115,7 @@ fn shade_occluder(s: Surface) -> vec3<f32> {
         }
         var t = 1.0;
         if (shadowed) {
-            t = mix(grid_shadow(shadow_grid, q, j).transmittance, 1.0, outside);
+            t = mix(grid_transmittance(shadow_grid, q, j), 1.0, outside);
         }
         sum = sum + t * e * l.rgb;
     }

@@ -58,11 +58,35 @@ fn grid_point(g: ShadowGridInfo, i: u32) -> vec3<f32> {
     return g.origin + (vec3<f32>(c) + vec3<f32>(0.5)) * g.spacing;
 }
 
-fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
+// The grid cell around a point (clamped at the border: ShadowGrid::corners): its lowest point and the
+// point's fractions across it.
+struct GridCell {
+    base: vec3<f32>,
+    f: vec3<f32>,
+}
+
+fn grid_cell(g: ShadowGridInfo, p: vec3<f32>) -> GridCell {
     let hi = vec3<f32>(g.dims) - vec3<f32>(1.0);
     let q = clamp((p - g.origin) / g.spacing - vec3<f32>(0.5), vec3<f32>(0.0), hi);
     let base = min(floor(q), max(hi - vec3<f32>(1.0), vec3<f32>(0.0)));
-    let f = q - base;
+    return GridCell(base, q - base);
+}
+
+// Corner `corner` of the cell: its index in a light's values and its trilinear weight.
+struct GridCorner {
+    i: u32,
+    w: f32,
+}
+
+fn grid_corner(g: ShadowGridInfo, cell: GridCell, corner: u32) -> GridCorner {
+    let o = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
+    let idx = min(vec3<u32>(cell.base) + o, g.dims - vec3<u32>(1u));
+    let w3 = select(vec3<f32>(1.0) - cell.f, cell.f, o == vec3<u32>(1u));
+    return GridCorner((idx.z * g.dims.y + idx.y) * g.dims.x + idx.x, w3.x * w3.y * w3.z);
+}
+
+fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
+    let cell = grid_cell(g, p);
     let n = g.dims.x * g.dims.y * g.dims.z;
     var v0 = vec4<f32>(0.0);
     var v1 = vec4<f32>(0.0);
@@ -72,11 +96,9 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
     var wo = 0.0;
     var any_inside = false;
     for (var corner = 0u; corner < 8u; corner++) {
-        let o = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
-        let idx = min(vec3<u32>(base) + o, g.dims - vec3<u32>(1u));
-        let w3 = select(vec3<f32>(1.0) - f, f, o == vec3<u32>(1u));
-        let i = (idx.z * g.dims.y + idx.y) * g.dims.x + idx.x;
-        let w = w3.x * w3.y * w3.z;
+        let c = grid_corner(g, cell, corner);
+        let i = c.i;
+        let w = c.w;
         let a = shadow_values[2u * (light * n + i)];
         let b = shadow_values[2u * (light * n + i) + 1u];
         v0 = v0 + w * a;
@@ -97,24 +119,19 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
 }
 
 // grid_shadow's transmittance alone (single scattering reads only it, three times per light and
-// segment): per corner the log transmittance and the inside flag, two floats where grid_shadow loads
-// two vec4. The same sums in the same order, so the same value.
+// segment, and the head's shading): per corner the log transmittance and the inside flag, two floats
+// where grid_shadow loads two vec4. The same sums in the same order, so the same value.
 fn grid_transmittance(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> f32 {
-    let hi = vec3<f32>(g.dims) - vec3<f32>(1.0);
-    let q = clamp((p - g.origin) / g.spacing - vec3<f32>(0.5), vec3<f32>(0.0), hi);
-    let base = min(floor(q), max(hi - vec3<f32>(1.0), vec3<f32>(0.0)));
-    let f = q - base;
+    let cell = grid_cell(g, p);
     let n = g.dims.x * g.dims.y * g.dims.z;
     var v = 0.0;
     var o = 0.0;
     var wo = 0.0;
     var any_inside = false;
     for (var corner = 0u; corner < 8u; corner++) {
-        let c = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
-        let idx = min(vec3<u32>(base) + c, g.dims - vec3<u32>(1u));
-        let w3 = select(vec3<f32>(1.0) - f, f, c == vec3<u32>(1u));
-        let i = (idx.z * g.dims.y + idx.y) * g.dims.x + idx.x;
-        let w = w3.x * w3.y * w3.z;
+        let c = grid_corner(g, cell, corner);
+        let i = c.i;
+        let w = c.w;
         let t = shadow_values[2u * (light * n + i)].x;
         v = v + w * t;
         if (shadow_values[2u * (light * n + i) + 1u].w >= 0.0) {

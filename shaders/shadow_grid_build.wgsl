@@ -1,9 +1,8 @@
 // The shadow-grid build pass: light-space sweeps (twin of src/shadow/sweep.rs). After each new pyramid,
 // `build_midplane_samples` reads what the sweeps need on the planes between the grid's slices (the
 // pyramid's (a, M), the voxel's absorption and solid share: light-independent); then one workgroup per
-// light
-// (all lights for a whole frame, a range of their sweeps per unit of progressive refinement) sweeps the
-// grid slice by slice along each of the light's directions (sweep_direction), adding each
+// light (all lights for a whole frame, a range of their sweeps per unit of progressive refinement)
+// sweeps the grid slice by slice along each of the light's directions (sweep_direction), adding each
 // point's transmittance (and, when multiple scattering is on, the forward-scattering terms T_f and
 // sigma_f^2, and the optical depth of the hair behind the point along the light's travel) to the
 // point's entry, then turns the sums into what the shading pass reads (finish).
@@ -113,7 +112,8 @@ fn sweep_axes(g: ShadowGridInfo, omega: vec3<f32>) -> SweepAxes {
 }
 
 // MidplaneSamples in sweep.rs: per point of the planes between the slices across each axis a (plane j
-// in 0..=dims[a], the grid's points along b < c; the lattices of axes 0, 1, 2 one after another):
+// in 0..=dims[a], MIDPLANE_REFINE points per spacing along b < c, at (i + 1/2) / R spacings; the
+// lattices of axes 0, 1, 2 one after another):
 // (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, solid share), (sigma_a RGB, 1 inside the volume, 0 outside:
 // no hair, zero integrands).
 @group(0) @binding(10) var<storage, read_write> grid_samples: array<vec4<f32>>;
@@ -296,7 +296,7 @@ fn slot_direction(l: GpuLight, slot: u32, forward: bool) -> SweepDirection {
 }
 
 // MidplaneSamples::midpoint: the samples at the midpoint of the path from slice k's point (ib, ic) to
-// the previous slice (on the plane between them, at (ib, ic) + shift / 2), bilinear in that plane, the
+// the previous slice (on their plane, `midplane`, at (ib, ic) + shift / 2), bilinear in that plane, the
 // absorption weighted by the extinction; (a, M), (solid, sigma_a) and whether any sample around was
 // inside the volume.
 struct MidpointSample {
@@ -306,19 +306,34 @@ struct MidpointSample {
     inside: bool,
 }
 
-fn midplane_sample(g: ShadowGridInfo, ax: SweepAxes, k: u32, ib: u32, ic: u32) -> MidpointSample {
+// A sweep's plane: its first sample and its fine points along b and c (once per slice, not per point:
+// dynamic vector indexing in the loop is spilled to memory by lavapipe).
+struct Midplane {
+    base: u32,
+    nb: u32,
+    nc: u32,
+}
+
+// The plane between slice k and the previous one of sweep ax.
+fn midplane(g: ShadowGridInfo, ax: SweepAxes, k: u32) -> Midplane {
     let j = select(k, k + 1u, ax.towards_high);
+    let nb = g.dims[ax.b] * MIDPLANE_REFINE;
+    let nc = g.dims[ax.c] * MIDPLANE_REFINE;
+    return Midplane(midplane_offset(g, ax.a) + j * nc * nb, nb, nc);
+}
+
+fn midplane_sample(plane: Midplane, shift: vec2<f32>, ib: u32, ic: u32) -> MidpointSample {
     // In fine points: grid point ib is at (ib + 1/2) R - 1/2.
     let r = f32(MIDPLANE_REFINE);
-    let u = (f32(ib) + 0.5 + 0.5 * ax.shift.x) * r - 0.5;
-    let v = (f32(ic) + 0.5 + 0.5 * ax.shift.y) * r - 0.5;
+    let u = (f32(ib) + 0.5 + 0.5 * shift.x) * r - 0.5;
+    let v = (f32(ic) + 0.5 + 0.5 * shift.y) * r - 0.5;
     let u0 = floor(u);
     let v0 = floor(v);
     let fu = u - u0;
     let fv = v - v0;
-    let nb = g.dims[ax.b] * MIDPLANE_REFINE;
-    let nc = g.dims[ax.c] * MIDPLANE_REFINE;
-    let base = midplane_offset(g, ax.a) + j * nc * nb;
+    let nb = plane.nb;
+    let nc = plane.nc;
+    let base = plane.base;
     var out = MidpointSample(Extinction(0.0, vec3<f32>(0.0), vec3<f32>(0.0)), 0.0, vec3<f32>(0.0), false);
     var absorbing = 0.0;
     for (var corner = 0u; corner < 4u; corner++) {
@@ -435,6 +450,7 @@ fn build_shadow_grid(
             let k = select(i, na - 1u - i, ax.towards_high);
             let cur = scratch + 3u * area * (i & 1u);
             let prev = scratch + 3u * area * ((i + 1u) & 1u);
+            let plane = midplane(g, ax, k);
             for (var q = lid; q < nb * nc; q += SWEEP_GROUP) {
                 // q = ic nb + ib by float division (integer division is scalar on lavapipe): q + 1/2
                 // lies 1/2 from a multiple of nb, far beyond WGSL's 2.5 ulp while nb nc < 10^6 (a
@@ -446,7 +462,7 @@ fn build_shadow_grid(
                     up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, carried);
                 }
                 let p = k * sa + ib * sb + ic * sc;
-                let f = sweep_integrand(midplane_sample(g, ax, k, ib, ic), d.omega, carried, d.behind);
+                let f = sweep_integrand(midplane_sample(plane, ax.shift, ib, ic), d.omega, carried, d.behind);
                 scratch_store(cur, q, path_add_scaled(up, f, ax.step), carried);
                 accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
             }

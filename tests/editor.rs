@@ -303,6 +303,7 @@ fn rebuilds_before_first_image(
             live.progress.and_then(|p| p.submitted),
             Some(
                 WorkUnit::ShadowGrid { .. }
+                    | WorkUnit::GridSamples { .. }
                     | WorkUnit::Volume { .. }
                     | WorkUnit::VolumeResolve { .. }
                     | WorkUnit::DensityPyramid

@@ -81,6 +81,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
         for (_, c) in module.constants.iter() {
             let expected = match c.name.as_deref() {
                 Some("SWEEP_RING") => strandlight::shadow::sweep::SWEEP_RING as f64,
+                Some("MIDPLANE_REFINE") => strandlight::shadow::sweep::MIDPLANE_REFINE as f64,
                 Some("SWEEP_SLOTS") => strandlight::render::shadow_grid::SWEEP_SLOTS as f64,
                 Some("SINGLE_SAMPLES") => {
                     strandlight::render::segment_shading::SINGLE_SAMPLES as f64
@@ -113,7 +114,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
     println!("struct layouts and constants compared: {seen:?}");
     assert_eq!(
         seen.len(),
-        27,
+        28,
         "every shared struct and constant was found and compared"
     );
 }

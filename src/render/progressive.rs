@@ -1134,9 +1134,6 @@ impl Renderer {
             r.samples_done += count;
             return Some(WorkUnit::GridSamples { first, count });
         }
-        if r.grid_done >= target {
-            return None;
-        }
         let count = r.items(
             r.grid_cost,
             GUESS_GRID_ENTRY_S,
@@ -1526,8 +1523,8 @@ impl Renderer {
                     enc,
                     &inputs,
                     &self.shadow_grid,
-                    first,
-                    count,
+                    first..first + count,
+                    None,
                 );
             }
             WorkUnit::ShadowGrid { first, count } => {

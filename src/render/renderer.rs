@@ -44,9 +44,10 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 /// The passes, in the order `render_frame` runs them (timestamp names).
-pub const PASSES: [&str; 6] = [
+pub const PASSES: [&str; 7] = [
     "fiber_density",
     "density_pyramid",
+    "grid_samples",
     "shadow_grid",
     "visibility",
     "shading",
@@ -1353,8 +1354,8 @@ impl Renderer {
                     &mut enc,
                     &inputs,
                     &self.shadow_grid,
-                    0,
-                    samples,
+                    0..samples,
+                    timer.and_then(|t| t.compute_writes("grid_samples")),
                 );
             }
             self.shadow_grid_pass.encode(
@@ -1366,6 +1367,9 @@ impl Renderer {
                 count,
                 timer.and_then(|t| t.compute_writes("shadow_grid")),
             );
+            if samples_stale {
+                self.last_ran.push("grid_samples");
+            }
             self.last_ran.push("shadow_grid");
             self.refinement.samples_done = samples;
             self.shadow_grid_dirty = false;
@@ -1439,8 +1443,8 @@ impl Renderer {
             &mut enc,
             &inputs,
             &self.shadow_grid,
-            0,
-            samples,
+            0..samples,
+            None,
         );
         self.shadow_grid_pass.encode(
             &ctx.device,

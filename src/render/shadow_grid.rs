@@ -136,7 +136,7 @@ impl ShadowGridPass {
         }
     }
 
-    /// Encodes the sweeps' samples [first, first + count) of
+    /// Encodes the sweeps' samples `range` of
     /// [`MidplaneSamples::layout`](crate::shadow::sweep::MidplaneSamples::layout) (read from the
     /// pyramid and volume, `build_midplane_samples`): every sweep reads them, so they are built
     /// after each new pyramid (or new grid buffers) and before the grid's first entry.
@@ -146,13 +146,14 @@ impl ShadowGridPass {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &ShadowGridInputs,
         target: &GpuShadowGrid,
-        first: u32,
-        count: u32,
+        range: std::ops::Range<u32>,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
+        let count = range.end.saturating_sub(range.start);
         let range = buffer_init(
             device,
             "shadow grid samples range",
-            bytemuck::cast_slice(&[first, count, 0, 0, 0, 0, 0, 0]),
+            bytemuck::cast_slice(&[range.start, count, 0, 0, 0, 0, 0, 0]),
             wgpu::BufferUsages::STORAGE,
         );
         let list = [
@@ -173,7 +174,7 @@ impl ShadowGridPass {
         );
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shadow grid samples"),
-            timestamp_writes: None,
+            timestamp_writes: timestamps,
         });
         let groups = count.div_ceil(64).max(1);
         pass.set_pipeline(&self.samples_pipeline);

@@ -83,41 +83,31 @@ impl ForwardTable {
     /// product of the interpolated factors by the interpolation's error). One lookup where the
     /// integrand took two. Twin of `forward_lookup` in `shaders/forward_scattering.wgsl`.
     pub fn lookup_symmetric(&self, theta: f32, sigma_a: f32) -> (f32, f32) {
-        let x = ((theta + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
-            * (THETA_SAMPLES - 1) as f32;
-        let y = sigma_pos(sigma_a).clamp(0.0, (SIGMA_SAMPLES - 1) as f32);
-        let (i, j) = (
-            (x as usize).min(THETA_SAMPLES - 2),
-            (y as usize).min(SIGMA_SAMPLES - 2),
-        );
-        let (wx, wy) = (x - i as f32, y - j as f32);
-        let bil = |c: usize| {
-            let at = |i: usize, j: usize| self.symmetric_node(i, j)[c];
-            let a = at(i, j) + wx * (at(i + 1, j) - at(i, j));
-            let b = at(i, j + 1) + wx * (at(i + 1, j + 1) - at(i, j + 1));
-            a + wy * (b - a)
-        };
+        let bil = |c: usize| bilinear(theta, sigma_a, |i, j| self.symmetric_node(i, j)[c]);
         (bil(0), bil(1))
     }
 
     /// (a_f, beta_f^2) at (theta, sigma_a), bilinear.
     pub fn lookup(&self, theta: f32, sigma_a: f32) -> (f32, f32) {
-        let x = ((theta + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
-            * (THETA_SAMPLES - 1) as f32;
-        let y = sigma_pos(sigma_a).clamp(0.0, (SIGMA_SAMPLES - 1) as f32);
-        let (i, j) = (
-            (x as usize).min(THETA_SAMPLES - 2),
-            (y as usize).min(SIGMA_SAMPLES - 2),
-        );
-        let (wx, wy) = (x - i as f32, y - j as f32);
-        let at = |t: &[f32], i: usize, j: usize| t[j * THETA_SAMPLES + i];
-        let bil = |t: &[f32]| {
-            let a = at(t, i, j) + wx * (at(t, i + 1, j) - at(t, i, j));
-            let b = at(t, i, j + 1) + wx * (at(t, i + 1, j + 1) - at(t, i, j + 1));
-            a + wy * (b - a)
-        };
+        let bil = |t: &[f32]| bilinear(theta, sigma_a, |i, j| t[j * THETA_SAMPLES + i]);
         (bil(&self.a_f), bil(&self.beta_f2))
     }
+}
+
+/// The bilinear reading at (theta, sigma_a) of a table over the nodes (theta index i, sigma_a
+/// index j) given by `at`.
+fn bilinear(theta: f32, sigma_a: f32, at: impl Fn(usize, usize) -> f32) -> f32 {
+    let x = ((theta + std::f32::consts::FRAC_PI_2) / std::f32::consts::PI).clamp(0.0, 1.0)
+        * (THETA_SAMPLES - 1) as f32;
+    let y = sigma_pos(sigma_a).clamp(0.0, (SIGMA_SAMPLES - 1) as f32);
+    let (i, j) = (
+        (x as usize).min(THETA_SAMPLES - 2),
+        (y as usize).min(SIGMA_SAMPLES - 2),
+    );
+    let (wx, wy) = (x - i as f32, y - j as f32);
+    let a = at(i, j) + wx * (at(i + 1, j) - at(i, j));
+    let b = at(i, j + 1) + wx * (at(i + 1, j + 1) - at(i, j + 1));
+    a + wy * (b - a)
 }
 
 /// What the shader needs from the shadow path of one light at one point.
@@ -186,7 +176,7 @@ pub fn forward_integrand(
 
 /// The integrands of [`PathIntegrals`] along omega (unit) where the volume reads extinction `a`,
 /// tensor `m` and absorption `sigma_a` (what [`forward_integrand`] reads at a point; the shadow
-/// grid's sweeps read it at their grid points). Twin of `forward_integrand_of` in
+/// grid's sweeps read it at their midpoints, from their samples). Twin of `forward_integrand_of` in
 /// `shaders/forward_scattering.wgsl`.
 pub fn forward_integrand_of(
     a: f32,
