@@ -197,23 +197,36 @@ fn scratch_store(base: u32, i: u32, f: PathIntegrals, forward: bool) {
     }
 }
 
-// slice_bilinear in sweep.rs: the previous slice at (u, v), zero outside it.
-fn slice_bilinear(base: u32, nb: u32, nc: u32, u: f32, v: f32, forward: bool) -> PathIntegrals {
+// bilinear_corners in sweep.rs: corner `corner` ((0, 0), (1, 0), (0, 1), (1, 1)) of the nb x nc lattice's
+// points around (u, v): its index v nb + u, its bilinear weight, and whether it lies in the lattice.
+struct BilinearCorner {
+    i: u32,
+    w: f32,
+    inside: bool,
+}
+
+fn bilinear_corner(u: f32, v: f32, nb: u32, nc: u32, corner: u32) -> BilinearCorner {
     let u0 = floor(u);
     let v0 = floor(v);
-    let fu = u - u0;
-    let fv = v - v0;
+    let ou = f32(corner & 1u);
+    let ov = f32(corner >> 1u);
+    let iu = u0 + ou;
+    let iv = v0 + ov;
+    if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
+        return BilinearCorner(0u, 0.0, false);
+    }
+    let w = select(1.0 - (u - u0), u - u0, ou == 1.0) * select(1.0 - (v - v0), v - v0, ov == 1.0);
+    return BilinearCorner(u32(iv) * nb + u32(iu), w, true);
+}
+
+// slice_bilinear in sweep.rs: the previous slice at (u, v), zero outside it.
+fn slice_bilinear(base: u32, nb: u32, nc: u32, u: f32, v: f32, forward: bool) -> PathIntegrals {
     var out = path_zero();
     for (var corner = 0u; corner < 4u; corner++) {
-        let ou = f32(corner & 1u);
-        let ov = f32(corner >> 1u);
-        let iu = u0 + ou;
-        let iv = v0 + ov;
-        if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
-            continue;
+        let c = bilinear_corner(u, v, nb, nc, corner);
+        if (c.inside) {
+            out = path_add_scaled(out, scratch_load(base, c.i, forward), c.w);
         }
-        let w = select(1.0 - fu, fu, ou == 1.0) * select(1.0 - fv, fv, ov == 1.0);
-        out = path_add_scaled(out, scratch_load(base, u32(iv) * nb + u32(iu), forward), w);
     }
     return out;
 }
@@ -327,31 +340,21 @@ fn midplane_sample(plane: Midplane, shift: vec2<f32>, ib: u32, ic: u32) -> Midpo
     let r = f32(MIDPLANE_REFINE);
     let u = (f32(ib) + 0.5 + 0.5 * shift.x) * r - 0.5;
     let v = (f32(ic) + 0.5 + 0.5 * shift.y) * r - 0.5;
-    let u0 = floor(u);
-    let v0 = floor(v);
-    let fu = u - u0;
-    let fv = v - v0;
-    let nb = plane.nb;
-    let nc = plane.nc;
-    let base = plane.base;
     var out = MidpointSample(Extinction(0.0, vec3<f32>(0.0), vec3<f32>(0.0)), 0.0, vec3<f32>(0.0), false);
     var absorbing = 0.0;
     for (var corner = 0u; corner < 4u; corner++) {
-        let ou = f32(corner & 1u);
-        let ov = f32(corner >> 1u);
-        let iu = u0 + ou;
-        let iv = v0 + ov;
-        if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
+        let c = bilinear_corner(u, v, plane.nb, plane.nc, corner);
+        if (!c.inside) {
             continue;
         }
-        let i = base + u32(iv) * nb + u32(iu);
+        let i = plane.base + c.i;
         let s2 = grid_samples[3u * i + 2u];
         if (s2.w == 0.0) {
             continue;
         }
         let s0 = grid_samples[3u * i];
         let s1 = grid_samples[3u * i + 1u];
-        let w = select(1.0 - fu, fu, ou == 1.0) * select(1.0 - fv, fv, ov == 1.0);
+        let w = c.w;
         out.inside = true;
         out.e.a = out.e.a + w * s0.x;
         out.e.m0 = out.e.m0 + w * s0.yzw;

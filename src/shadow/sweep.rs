@@ -264,25 +264,14 @@ impl MidplaneSamples {
             (ib as f32 + 0.5 + 0.5 * ax.shift[0]) * r - 0.5,
             (ic as f32 + 0.5 + 0.5 * ax.shift[1]) * r - 0.5,
         );
-        let (u0, v0) = (u.floor(), v.floor());
-        let (fu, fv) = (u - u0, v - v0);
         let (nb, nc) = Self::fine_dims(grid, ax.a);
-        let (nb, nc) = (nb as u32, nc as u32);
+        let plane = self.offsets[ax.a] + j as usize * nc * nb;
         let mut out = GridSample::default();
         let (mut inside, mut absorbing) = (false, 0.0);
-        for corner in 0..4 {
-            let (ou, ov) = ((corner & 1) as f32, (corner >> 1) as f32);
-            let (iu, iv) = (u0 + ou, v0 + ov);
-            if iu < 0.0 || iv < 0.0 || iu >= nb as f32 || iv >= nc as f32 {
-                continue;
-            }
-            let i = self.offsets[ax.a]
-                + (j as usize * nc as usize + iv as usize) * nb as usize
-                + iu as usize;
-            let Some(s) = &self.samples[i] else {
+        for (i, w) in bilinear_corners(u, v, nb as u32, nc as u32) {
+            let Some(s) = &self.samples[plane + i] else {
                 continue;
             };
-            let w = if ou == 1.0 { fu } else { 1.0 - fu } * if ov == 1.0 { fv } else { 1.0 - fv };
             inside = true;
             out.a += w * s.a;
             out.solid += w * s.solid;
@@ -311,19 +300,26 @@ fn other_axes(a: usize) -> (usize, usize) {
 /// The slice's integrals at the continuous position (u, v) (in points along b, c), bilinear; points
 /// outside the slice are outside the grid, where no hair is: zero.
 fn slice_bilinear(slice: &[PathIntegrals], nb: u32, nc: u32, u: f32, v: f32) -> PathIntegrals {
+    bilinear_corners(u, v, nb, nc).fold(PathIntegrals::default(), |out, (i, w)| {
+        out.add_scaled(&slice[i], w)
+    })
+}
+
+/// The lattice points around the continuous position (u, v) of an nb x nc lattice (index
+/// v nb + u), with their bilinear weights, in the order (0, 0), (1, 0), (0, 1), (1, 1); points
+/// outside the lattice left out (twin of `bilinear_corner` in `shaders/shadow_grid_build.wgsl`).
+fn bilinear_corners(u: f32, v: f32, nb: u32, nc: u32) -> impl Iterator<Item = (usize, f32)> {
     let (u0, v0) = (u.floor(), v.floor());
     let (fu, fv) = (u - u0, v - v0);
-    let mut out = PathIntegrals::default();
-    for corner in 0..4 {
+    (0..4).filter_map(move |corner| {
         let (ou, ov) = ((corner & 1) as f32, (corner >> 1) as f32);
         let (iu, iv) = (u0 + ou, v0 + ov);
         if iu < 0.0 || iv < 0.0 || iu >= nb as f32 || iv >= nc as f32 {
-            continue;
+            return None;
         }
         let w = if ou == 1.0 { fu } else { 1.0 - fu } * if ov == 1.0 { fv } else { 1.0 - fv };
-        out = out.add_scaled(&slice[iv as usize * nb as usize + iu as usize], w);
-    }
-    out
+        Some((iv as usize * nb as usize + iu as usize, w))
+    })
 }
 
 /// The integrands at a sample along omega (a sweep's, `sweep_integrand` in the WGSL): with the
