@@ -45,22 +45,30 @@ fn bessel_i0_scaled(x: f32) -> f32 {
 
 // erf by A&S 7.1.26 (WGSL has no erf).
 fn erf_approx(x: f32) -> f32 {
-    let a = abs(x);
+    return gaussian_end(x).y;
+}
+
+// One end u of a Gaussian's segment (GaussianEnd in circular_gaussian.rs): (u, erf(u), e^(-u^2)), the two
+// sharing one exponential.
+fn gaussian_end(u: f32) -> vec3<f32> {
+    let a = abs(u);
     let t = 1.0 / (1.0 + 0.3275911 * a);
     let poly = t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
-    return sign(x) * (1.0 - poly * exp(-a * a));
+    let gauss = exp(-a * a);
+    return vec3<f32>(u, sign(u) * (1.0 - poly * gauss), gauss);
 }
 
 
 // integral_a^b y^k g(x; mu, lambda) dx (k = 0, 1, 2; y = x - mu), once per segment pair.
 fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec3<f32> {
-    let ua = (a - mu) / lambda;
-    let ub = (b - mu) / lambda;
-    let ea = exp(-ua * ua);
-    let eb = exp(-ub * ub);
-    let m0 = 0.5 * SQRT_PI * (erf_approx(ub) - erf_approx(ua));
-    let m1 = 0.5 * (ea - eb);
-    let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
+    return gaussian_quadratic_moments_between(gaussian_end((a - mu) / lambda), gaussian_end((b - mu) / lambda), lambda);
+}
+
+// gaussian_quadratic_moments between two ends found already (gaussian_end).
+fn gaussian_quadratic_moments_between(a: vec3<f32>, b: vec3<f32>, lambda: f32) -> vec3<f32> {
+    let m0 = 0.5 * SQRT_PI * (b.y - a.y);
+    let m1 = 0.5 * (a.z - b.z);
+    let m2 = 0.5 * m0 - 0.5 * (b.x * b.z - a.x * a.z);
     return vec3<f32>(lambda * m0, lambda * lambda * m1, lambda * lambda * lambda * m2);
 }
 

@@ -148,9 +148,14 @@ fn dual_quadrature(p: FastHairParams, d: DualIntegrand, mu: f32, l: f32) -> vec3
 
 // M_t^G per unit light power (Xu Eq. 27).
 fn global_response_lobe(p: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32) -> vec3<f32> {
+    return global_response_lobe_in_view(p, lobe, longitudinal_lobe(p.longitudinal, theta_o, p.alpha[lobe], p.beta[lobe]), light, phi_o, sigma_f2);
+}
+
+// global_response_lobe with the lobe's longitudinal function of the view (view_lobes).
+fn global_response_lobe_in_view(p: FastHairParams, lobe: u32, longitudinal: LongitudinalLobe, light: SrbfInFrame, phi_o: f32, sigma_f2: f32) -> vec3<f32> {
+    let theta_o = longitudinal.theta_o;
     let sigma = forward_spread(sigma_f2, light.lambda);
     let beta = p.beta[lobe];
-    let longitudinal = longitudinal_lobe(p.longitudinal, theta_o, p.alpha[lobe], beta);
     let g = gaussian_product(light.theta, SQRT_2 * sigma, longitudinal.mu, 2.0 * SQRT_2 * beta);
     let c = g.x / (2.0 * PI * sigma * 2.0 * beta * max(cos(light.theta), 1e-3));
     if (c < 1e-30) {

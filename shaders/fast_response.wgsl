@@ -60,7 +60,13 @@ fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
 }
 
 fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
-    let c = max(cos(theta_i) * cos(theta_j), 1e-8);
+    return azimuthal_bandwidth_cos(lambda_j, cos(theta_i), cos(theta_j));
+}
+
+// azimuthal_bandwidth from cos theta_i (the node's, shared with its longitudinal factor) and cos theta_j
+// (the light's, once for its nodes).
+fn azimuthal_bandwidth_cos(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
+    let c = max(cos_theta_i * cos_theta_j, 1e-8);
     return min(lambda_j / sqrt(c), LAMBDA_PRIME_MAX);
 }
 
@@ -76,8 +82,11 @@ fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
     return t;
 }
 
+// x beyond which 1 - e^(-x) rounds to 1 in f32 (ONE_MINUS_EXP_IS_ONE in fast_response.rs).
+const ONE_MINUS_EXP_IS_ONE: f32 = 17.5;
+
 // One lobe's longitudinal function for one view (twin of LongitudinalLobe in fast_response.rs): what does
-// not depend on theta_i, computed once per lobe and light instead of at every quadrature sample.
+// not depend on theta_i, computed once per view (view_lobes) instead of at every quadrature sample.
 struct LongitudinalLobe {
     longitudinal: u32,
     theta_o: f32,
@@ -89,6 +98,7 @@ struct LongitudinalLobe {
     ln_m_norm: f32,
     ln_gaussian_norm: f32,
     cos_tilted: f32,
+    sin_tilted: f32,
 }
 
 fn longitudinal_lobe_with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> LongitudinalLobe {
@@ -97,7 +107,13 @@ fn longitudinal_lobe_with_variance(longitudinal: u32, theta_o: f32, alpha: f32, 
     if (longitudinal == LONGITUDINAL_PUBLISHED) {
         mu = 2.0 * alpha - theta_o;
     }
-    return LongitudinalLobe(longitudinal, theta_o, tilted, v, mu, -log(v) - log(1.0 - exp(-2.0 / v)), 0.5 * log(2.0 * PI * v), cos(tilted));
+    let ln_v = log(v);
+    // ln(1 - e^(-2/v)) is 0 in f32 past ONE_MINUS_EXP_IS_ONE.
+    var ln_csch_part = 0.0;
+    if (2.0 / v <= ONE_MINUS_EXP_IS_ONE) {
+        ln_csch_part = log(1.0 - exp(-2.0 / v));
+    }
+    return LongitudinalLobe(longitudinal, theta_o, tilted, v, mu, -ln_v - ln_csch_part, 0.5 * (log(2.0 * PI) + ln_v), cos(tilted), sin(tilted));
 }
 
 fn longitudinal_lobe(longitudinal: u32, theta_o: f32, alpha: f32, beta: f32) -> LongitudinalLobe {
@@ -119,21 +135,30 @@ fn longitudinal_bessel_argument(l: LongitudinalLobe, cos_theta_i: f32) -> f32 {
 // The longitudinal factor relative to the Gaussian: published 2 cos^2(theta_i) / cos^2(theta_d); normalised
 // cos(theta_i) M^dEon / Gaussian.
 fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
-    let ci = max(cos(theta_i), 0.0);
-    if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
-        let cd = cos(0.5 * (l.theta_o - theta_i));
-        return 2.0 * ci * ci / max(cd * cd, 1e-8);
-    }
-    let d = theta_i - l.mu;
-    let ln_rest = longitudinal_ln_m_shape(l, theta_i) + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
-    return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, ci)) * exp(clamp(ln_rest, -80.0, 20.0));
+    return longitudinal_factor_at(l, theta_i, sin(theta_i), cos(theta_i), 0.0);
 }
 
-// longitudinal_factor x calN_t at theta_i.
-fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, longitudinal: LongitudinalLobe, theta_i: f32) -> vec3<f32> {
-    let theta_d = 0.5 * (theta_o - theta_i);
-    let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let w = longitudinal_factor(longitudinal, theta_i);
+// longitudinal_factor times e^(ln_scale) at a node whose sin and cos are known (factor_at): the shape's
+// 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o').
+fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: f32, ln_scale: f32) -> f32 {
+    let ci = max(cos_i, 0.0);
+    if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
+        let cd = cos(0.5 * (l.theta_o - theta_i));
+        return 2.0 * ci * ci / max(cd * cd, 1e-8) * exp(ln_scale);
+    }
+    let cos_sum = cos_i * l.cos_tilted - sin_i * l.sin_tilted;
+    let d = theta_i - l.mu;
+    let ln_rest = -(1.0 - cos_sum) / l.v + l.ln_m_norm + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
+    return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, ci)) * exp(clamp(ln_rest, -80.0, 20.0) + ln_scale);
+}
+
+// longitudinal_factor x e^(ln_scale) x calN_t at theta_i; cos_theta_j the light's.
+fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, theta_i: f32, ln_scale: f32) -> vec3<f32> {
+    let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
+    let sin_i = sin(theta_i);
+    let cos_i = cos(theta_i);
+    let lp = azimuthal_bandwidth_cos(light.lambda, cos_i, cos_theta_j);
+    let w = longitudinal_factor_at(longitudinal, theta_i, sin_i, cos_i, ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if (w == 0.0) {
         return vec3<f32>(0.0);
@@ -201,10 +226,10 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
     return w;
 }
 
-fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
     let d = (ti - w.peak) / w.lambda;
-    let ratio = exp(clamp(longitudinal_ln_w(w, ti) - w.ln_w_peak + d * d, -80.0, 20.0));
-    return ratio * outer_integrand(params, lobe, light, theta_o, phi_o, longitudinal, ti);
+    let ln_ratio = clamp(longitudinal_ln_w(w, ti) - w.ln_w_peak + d * d, -80.0, 20.0);
+    return outer_integrand(params, lobe, light, cos_theta_j, phi_o, longitudinal, ti, ln_ratio);
 }
 
 // The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
@@ -216,6 +241,8 @@ struct Quadrature {
     mu: f32,
     l: f32,
     x0: f32,
+    // gaussian_end at x0: each node's is found once.
+    e0: vec3<f32>,
     f0: vec3<f32>,
     x1: f32,
     f1: vec3<f32>,
@@ -229,7 +256,7 @@ struct Quadrature {
 // integrands' table reads on lavapipe), only the m - 1 inner nodes, and quadrature_end closes the rule
 // at +pi/2.
 fn quadrature_start(mu: f32, l: f32) -> Quadrature {
-    return Quadrature(mu, l, -FRAC_PI_2, vec3<f32>(0.0), 0.0, vec3<f32>(0.0), vec3<f32>(0.0));
+    return Quadrature(mu, l, -FRAC_PI_2, gaussian_end((-FRAC_PI_2 - mu) / l), vec3<f32>(0.0), 0.0, vec3<f32>(0.0), vec3<f32>(0.0));
 }
 
 fn quadrature_end(q: ptr<function, Quadrature>, m: u32) {
@@ -252,7 +279,9 @@ fn quadrature_node(q: ptr<function, Quadrature>, s: u32, m: u32, x: f32, f: vec3
         // of moments either way, the line being the parabola with q2 = 0 (Newton form in y = x - mu).
         let x1 = (*q).x1;
         let pair = !odd && x1 > x0 && x > x1;
-        let mo = gaussian_quadratic_moments(x0, x, (*q).mu, (*q).l);
+        let end = gaussian_end((x - (*q).mu) / (*q).l);
+        let mo = gaussian_quadratic_moments_between((*q).e0, end, (*q).l);
+        (*q).e0 = end;
         let y0 = x0 - (*q).mu;
         var q1 = (f - f0) / (x - x0);
         var q2 = vec3<f32>(0.0);
@@ -270,9 +299,21 @@ fn quadrature_node(q: ptr<function, Quadrature>, s: u32, m: u32, x: f32, f: vec3
 
 // M_t for lobe t (0 = R, 1 = TT, 2 = TRT), RGB (Xu Eq. 11 by Sec. 4.2.2, parabolas on paired segments).
 fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, theta_o: f32, phi_o: f32) -> vec3<f32> {
-    let alpha = params.alpha[lobe];
+    return srbf_response_lobe_in_view(params, lobe, longitudinal_lobe(params.longitudinal, theta_o, params.alpha[lobe], params.beta[lobe]), light, phi_o);
+}
+
+// The three lobes' longitudinal functions seen from theta_o (view_lobes): once per shading point.
+fn view_lobes(params: FastHairParams, theta_o: f32) -> array<LongitudinalLobe, 3> {
+    return array<LongitudinalLobe, 3>(
+        longitudinal_lobe(params.longitudinal, theta_o, params.alpha[0], params.beta[0]),
+        longitudinal_lobe(params.longitudinal, theta_o, params.alpha[1], params.beta[1]),
+        longitudinal_lobe(params.longitudinal, theta_o, params.alpha[2], params.beta[2]),
+    );
+}
+
+// srbf_response_lobe with the lobe's longitudinal function of the view.
+fn srbf_response_lobe_in_view(params: FastHairParams, lobe: u32, longitudinal: LongitudinalLobe, light: SrbfInFrame, phi_o: f32) -> vec3<f32> {
     let beta = params.beta[lobe];
-    let longitudinal = longitudinal_lobe(params.longitudinal, theta_o, alpha, beta);
     let lambda_m = 2.0 * SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * 2.0 * beta);
@@ -280,10 +321,11 @@ fn srbf_response_lobe(params: FastHairParams, lobe: u32, light: SrbfInFrame, the
         return vec3<f32>(0.0);
     }
     let m = params.quadrature_segments;
+    let cos_j = cos(light.theta);
     var q = quadrature_start(w.peak, w.lambda);
     for (var s = 1u; s < m; s++) {
         let x = quadrature_sample(s, m, q.mu, q.l);
-        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, theta_o, phi_o, longitudinal, w, x));
+        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, cos_j, phi_o, longitudinal, w, x));
     }
     quadrature_end(&q, m);
     return max(scale * q.out, vec3<f32>(0.0));

@@ -75,6 +75,7 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
     p.sigma_a = vec4<f32>(sp.sigma_a, 0.0);
     let frame = fiber_frame(sp.tangent);
     let o = fiber_angles(frame, omega_o);
+    let lobes = view_lobes(p, o.x);
     var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var j = first; j < first + count; j++) {
         let l = lights[j];
@@ -88,9 +89,9 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
         // Each lobe's response is called from one place (its lobe a constant: lavapipe runs every
         // branch of a lobe chosen at run time), the local term from one loop below.
         if (single) {
-            out.r = out.r + k * srbf_response_lobe(p, 0u, light, o.x, o.y);
-            out.tt = out.tt + k * srbf_response_lobe(p, 1u, light, o.x, o.y);
-            out.trt = out.trt + k * srbf_response_lobe(p, 2u, light, o.x, o.y);
+            out.r = out.r + k * srbf_response_lobe_in_view(p, 0u, lobes[0], light, o.y);
+            out.tt = out.tt + k * srbf_response_lobe_in_view(p, 1u, lobes[1], light, o.y);
+            out.trt = out.trt + k * srbf_response_lobe_in_view(p, 2u, lobes[2], light, o.y);
         }
         if (multiple) {
             // One spread for the three channels: their mean sigma_f^2.
@@ -104,7 +105,7 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
             let lit = sh.transmittance > 0.0;
             let scattered = any(sh.transmittance_f > vec3<f32>(sh.transmittance));
             if (scattered) {
-                global = global_response_lobe(p, 0u, light, o.x, o.y, s2) + global_response_lobe(p, 1u, light, o.x, o.y, s2) + global_response_lobe(p, 2u, light, o.x, o.y, s2);
+                global = global_response_lobe_in_view(p, 0u, lobes[0], light, o.y, s2) + global_response_lobe_in_view(p, 1u, lobes[1], light, o.y, s2) + global_response_lobe_in_view(p, 2u, lobes[2], light, o.y, s2);
             }
             // Part 0 the direct light's local term (no spread), part 1 the scattered light's.
             let spread_apart = scattered && !(s2 == 0.0 && lit);
@@ -201,6 +202,7 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
     let painted = any(a.sigma_a != b.sigma_a);
     let frame = fiber_frame(mid.tangent);
     let o = fiber_angles(frame, omega_o);
+    let lobes = view_lobes(params, o.x);
     let zero = vec3<f32>(0.0);
     var r0 = zero; var r1 = zero; var r2 = zero;
     var tt0 = zero; var tt1 = zero; var tt2 = zero;
@@ -221,9 +223,9 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
             if (e == 1u) {
                 pe = pb;
             }
-            let r = l.rgb * srbf_response_lobe(pe, 0u, light, o.x, o.y);
-            let tt = l.rgb * srbf_response_lobe(pe, 1u, light, o.x, o.y);
-            let trt = l.rgb * srbf_response_lobe(pe, 2u, light, o.x, o.y);
+            let r = l.rgb * srbf_response_lobe_in_view(pe, 0u, lobes[0], light, o.y);
+            let tt = l.rgb * srbf_response_lobe_in_view(pe, 1u, lobes[1], light, o.y);
+            let trt = l.rgb * srbf_response_lobe_in_view(pe, 2u, lobes[2], light, o.y);
             if (e == 0u) {
                 ra = r;
                 tta = tt;

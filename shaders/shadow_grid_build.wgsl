@@ -116,7 +116,10 @@ fn sweep_axes(g: ShadowGridInfo, omega: vec3<f32>) -> SweepAxes {
 // lattices of axes 0, 1, 2 one after another):
 // (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, solid share), (sigma_a RGB, 1 inside the volume, 0 outside:
 // no hair, zero integrands).
-@group(0) @binding(10) var<storage, read_write> grid_samples: array<vec4<f32>>;
+// Three vec2<u32> a sample (sample_packing.rs): (a as f32 (negative outside the volume), unorm n_xx n_yy),
+// (unorm n_zz solid, snorm n_xy n_xz), (f16 sigma_a r g, f16 sigma_a b | snorm n_yz << 16), with
+// n = M / a.
+@group(0) @binding(10) var<storage, read_write> grid_samples: array<vec2<u32>>;
 
 // sweep_lod in sweep.rs: the coarsest level whose voxel is at most half the spacing.
 fn sweep_lod(g: ShadowGridInfo) -> f32 {
@@ -166,16 +169,22 @@ fn build_midplane_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let x = g.origin + q * g.spacing;
     let v = forward_voxel_at(x);
     if (v < 0) {
-        grid_samples[3u * i] = vec4<f32>(0.0);
-        grid_samples[3u * i + 1u] = vec4<f32>(0.0);
-        grid_samples[3u * i + 2u] = vec4<f32>(0.0);
+        // GridSample::OUTSIDE: a = -1.
+        grid_samples[3u * i] = vec2<u32>(bitcast<u32>(-1.0), 0u);
+        grid_samples[3u * i + 1u] = vec2<u32>(0u);
+        grid_samples[3u * i + 2u] = vec2<u32>(0u);
         return;
     }
     let e = extinction_at(x, sweep_lod(g));
     let s = volume[3u * u32(v) + 2u];
-    grid_samples[3u * i] = vec4<f32>(e.a, e.m0);
-    grid_samples[3u * i + 1u] = vec4<f32>(e.m1, s.w);
-    grid_samples[3u * i + 2u] = vec4<f32>(s.xyz, 1.0);
+    let inv = select(0.0, 1.0 / e.a, e.a > 0.0);
+    let n0 = e.m0 * inv;
+    let n1 = e.m1 * inv;
+    grid_samples[3u * i] = vec2<u32>(bitcast<u32>(e.a), pack2x16unorm(n0.xy));
+    grid_samples[3u * i + 1u] = vec2<u32>(pack2x16unorm(vec2<f32>(n0.z, s.w)), pack2x16snorm(n1.xy));
+    let low = pack2x16float(vec2<f32>(s.z, 0.0)) & 0xffffu;
+    let high = pack2x16snorm(vec2<f32>(0.0, n1.z)) & 0xffff0000u;
+    grid_samples[3u * i + 2u] = vec2<u32>(pack2x16float(s.xy), low | high);
 }
 
 // Without multiple scattering only tau is swept: one vec4 read and written per point.
@@ -348,20 +357,26 @@ fn midplane_sample(plane: Midplane, shift: vec2<f32>, ib: u32, ic: u32) -> Midpo
             continue;
         }
         let i = plane.base + c.i;
-        let s2 = grid_samples[3u * i + 2u];
-        if (s2.w == 0.0) {
+        let s0 = grid_samples[3u * i];
+        let a = bitcast<f32>(s0.x);
+        if (a < 0.0) {
             continue;
         }
-        let s0 = grid_samples[3u * i];
         let s1 = grid_samples[3u * i + 1u];
+        let s2 = grid_samples[3u * i + 2u];
+        let n_xx_yy = unpack2x16unorm(s0.y);
+        let n_zz_solid = unpack2x16unorm(s1.x);
+        let n_xy_xz = unpack2x16snorm(s1.y);
+        let sigma_rg = unpack2x16float(s2.x);
         let w = c.w;
+        let wa = w * a;
         out.inside = true;
-        out.e.a = out.e.a + w * s0.x;
-        out.e.m0 = out.e.m0 + w * s0.yzw;
-        out.e.m1 = out.e.m1 + w * s1.xyz;
-        out.solid = out.solid + w * s1.w;
-        out.sigma_a = out.sigma_a + (w * s0.x) * s2.xyz;
-        absorbing = absorbing + w * s0.x;
+        out.e.a = out.e.a + wa;
+        out.e.m0 = out.e.m0 + wa * vec3<f32>(n_xx_yy, n_zz_solid.x);
+        out.e.m1 = out.e.m1 + wa * vec3<f32>(n_xy_xz, unpack2x16snorm(s2.y).y);
+        out.solid = out.solid + w * n_zz_solid.y;
+        out.sigma_a = out.sigma_a + wa * vec3<f32>(sigma_rg, unpack2x16float(s2.y).x);
+        absorbing = absorbing + wa;
     }
     out.sigma_a = out.sigma_a / max(absorbing, 1e-30);
     return out;

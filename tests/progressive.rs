@@ -199,6 +199,35 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     println!("eta 1.55 -> 1.62 with its tables: difference to render_frame {d:.1e}");
     assert_eq!(d, 0.0);
     assert!(difference(&b, &c) > 1e-3, "the new eta changed the image");
+
+    // A light set of another size: the grid's values are made anew for it, the samples its sweeps
+    // read (the pyramid's, light-independent) are kept.
+    let fewer = &lights[..lights.len() / 2];
+    progressive.set_lights(&ctx, fewer);
+    let units = refine_all(&mut progressive, &ctx);
+    let c = progressive.read_frame(&ctx).expect("read");
+    whole.set_lights(&ctx, fewer);
+    whole.render_frame(&ctx);
+    let a = whole.read_frame(&ctx).expect("read");
+    let d = difference(&a, &c);
+    println!(
+        "{} -> {} lights: {} units; difference to render_frame {d:.1e}",
+        lights.len(),
+        fewer.len(),
+        units.len()
+    );
+    assert!(
+        units
+            .iter()
+            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. }))
+    );
+    assert!(
+        !units
+            .iter()
+            .any(|u| matches!(u, WorkUnit::GridSamples { .. })),
+        "a change of the light count keeps the grid's samples"
+    );
+    assert_eq!(d, 0.0);
 }
 
 /// A renderer of `scene` with its settings, look and camera, on `hair` with `sigma_a`.

@@ -10,11 +10,11 @@ use std::time::Instant;
 use strandlight::envmap::SrbfSet;
 use strandlight::scattering::azimuthal_table::AzimuthalTable;
 use strandlight::scattering::dual_response::{
-    dual_scattering_components, global_response_lobe, local_response,
+    dual_scattering_components, global_response_lobe_in_view, local_response,
 };
 use strandlight::scattering::dual_terms::DualTables;
 use strandlight::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
-use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
+use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response_in_view, view_lobes};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::tables::build_all;
 use strandlight::scattering::{
@@ -137,8 +137,10 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
         .map(|_| {
             let t = Instant::now();
             for (lights, theta_o, phi_o) in &points {
+                // What the view fixes, once per point (as the shading pass).
+                let lobes = view_lobes(&fp, *theta_o);
                 for l in lights {
-                    let r = srbf_response(&luts, &table, &fp, *l, *theta_o, *phi_o);
+                    let r = srbf_response_in_view(&luts, &table, &fp, &lobes, *l, *phi_o);
                     checksum += r.iter().flatten().map(|v| *v as f64).sum::<f64>();
                 }
             }
@@ -151,15 +153,24 @@ pub fn run(args: BenchFastArgs) -> anyhow::Result<()> {
         .map(|_| {
             let t = Instant::now();
             for (lights, theta_o, phi_o) in &points {
+                let lobes = view_lobes(&fp, *theta_o);
                 for l in lights {
                     let (to, po) = (*theta_o, *phi_o);
-                    let r = srbf_response(&luts, &table, &fp, *l, to, po);
+                    let r = srbf_response_in_view(&luts, &table, &fp, &lobes, *l, po);
                     // A shadow-grid value: half the light forward-scattered, spread 0.05 rad^2,
                     // two fibers behind the point.
                     let (direct, t_f, s2, behind) = (0.5, [0.7f32; 3], 0.05, 2.0);
                     let mut global = [0.0f32; 3];
                     for lobe in 0..3 {
-                        let g = global_response_lobe(&table, &fp, lobe, *l, to, po, s2);
+                        let g = global_response_lobe_in_view(
+                            &table,
+                            &fp,
+                            lobe,
+                            &lobes[lobe as usize],
+                            *l,
+                            po,
+                            s2,
+                        );
                         for c in 0..3 {
                             global[c] += g[c];
                         }

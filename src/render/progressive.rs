@@ -1072,14 +1072,18 @@ impl Renderer {
     ) -> Progress {
         let r = &self.refinement;
         let grid_cost = r.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
+        let samples_cost = r.samples_cost.unwrap_or(GUESS_GRID_SAMPLE_S);
         let entries = self.shadow_grid.entry_count() as f64;
+        let samples = self.shadow_grid.sample_count() as f64;
+        // The grid's sweeps and the samples they read (rebuilt with the pyramid: done when the
+        // grid is not stale).
         let grid_total = if self.grid_used() {
-            entries * grid_cost
+            entries * grid_cost + samples * samples_cost
         } else {
             0.0
         };
         let grid_done = if self.grid_needed() {
-            r.grid_done as f64 * grid_cost
+            r.grid_done as f64 * grid_cost + (r.samples_done as f64).min(samples) * samples_cost
         } else {
             grid_total
         };

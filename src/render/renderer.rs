@@ -497,7 +497,8 @@ impl Renderer {
         )?;
         check(
             "the shadow sweeps' samples",
-            crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64 * 48,
+            crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64
+                * super::shadow_grid::SAMPLE_BYTES,
         )?;
         let gpu_hair = GpuHair::new(device, hair, sigma_a);
         let grid = settings.volume_grid(hair);
@@ -953,9 +954,8 @@ impl Renderer {
         }
         self.light_count = lights.len() as u32;
         if self.light_count != self.shadow_grid.light_count {
-            self.shadow_grid = GpuShadowGrid::new(
+            self.shadow_grid = self.shadow_grid.with_lights(
                 &ctx.device,
-                self.shadow_grid.grid,
                 self.light_count,
                 self.skip,
                 self.settings.multiple_scattering,
@@ -988,9 +988,9 @@ impl Renderer {
         Ok(())
     }
 
-    /// A new shadow-grid buffer holds zeros, not finished entries: its groups count as unbuilt.
+    /// A new shadow-grid buffer holds zeros, not finished entries: its groups count as unbuilt (its
+    /// samples are the old grid's, [`GpuShadowGrid::with_lights`], or unbuilt in a new renderer).
     fn grid_buffer_made(&mut self) {
-        self.refinement.samples_done = 0;
         let group = self
             .settings
             .lights_per_pass
@@ -1156,9 +1156,8 @@ impl Renderer {
         }
         if multiple_scattering != self.settings.multiple_scattering {
             // The grid's layout (and what it holds) depends on multiple scattering.
-            self.shadow_grid = GpuShadowGrid::new(
+            self.shadow_grid = self.shadow_grid.with_lights(
                 &ctx.device,
-                self.shadow_grid.grid,
                 self.light_count,
                 self.skip,
                 multiple_scattering,

@@ -10,11 +10,11 @@ use crate::envmap::srbf::srbf_integral;
 use crate::hair::Hair;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
-    dual_scattering_components, global_response_lobe, local_response,
+    dual_scattering_components, global_response_lobe_in_view, local_response,
 };
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::fast_params::FastHairParams;
-use crate::scattering::fast_response::{SrbfInFrame, srbf_response};
+use crate::scattering::fast_response::{SrbfInFrame, srbf_response_in_view, view_lobes};
 use crate::scattering::lut::Luts;
 use crate::shadow::grid::{GridShadow, GridValues};
 use glam::Vec3;
@@ -131,6 +131,7 @@ pub fn shade_point(
     p.sigma_a = [sp.sigma_a[0], sp.sigma_a[1], sp.sigma_a[2], 0.0];
     let frame = fiber_frame(sp.tangent);
     let (theta_o, phi_o) = fiber_angles(frame, omega_o);
+    let lobes = view_lobes(&p, theta_o);
     let mut out = [[0.0; 3]; 5];
     for (li, l) in lights.iter().enumerate() {
         let dir = l.dir().normalize().as_vec3();
@@ -146,7 +147,7 @@ pub fn shade_point(
             |g| g.shadow(sp.position, li),
         );
         let light = SrbfInFrame { theta, phi, lambda };
-        let m = srbf_response(luts, table, &p, light, theta_o, phi_o);
+        let m = srbf_response_in_view(luts, table, &p, &lobes, light, phi_o);
         for t in 0..3 {
             for c in 0..3 {
                 out[t][c] += sh.transmittance * l.rgb[c] as f32 * m[t][c];
@@ -164,7 +165,15 @@ pub fn shade_point(
         }
         if sh.transmittance_f.iter().any(|&t| t > sh.transmittance) {
             for t in 0..3 {
-                let g = global_response_lobe(table, &p, t, light, theta_o, phi_o, s2);
+                let g = global_response_lobe_in_view(
+                    table,
+                    &p,
+                    t,
+                    &lobes[t as usize],
+                    light,
+                    phi_o,
+                    s2,
+                );
                 for c in 0..3 {
                     global[c] += g[c];
                 }
@@ -220,6 +229,7 @@ pub fn shade_segment_single(
     let painted = ends[0].sigma_a != ends[1].sigma_a;
     let frame = fiber_frame(mid.tangent);
     let (theta_o, phi_o) = fiber_angles(frame, omega_o);
+    let lobes = view_lobes(params, theta_o);
     let at = [ends[0].position, mid.position, ends[1].position];
     let mut out = [[[0.0; 3]; 3]; 3];
     for (li, l) in lights.iter().enumerate() {
@@ -229,9 +239,9 @@ pub fn shade_segment_single(
             phi,
             lambda: l.lambda as f32,
         };
-        let ma = srbf_response(luts, table, &pa, light, theta_o, phi_o);
+        let ma = srbf_response_in_view(luts, table, &pa, &lobes, light, phi_o);
         let mb = if painted {
-            srbf_response(luts, table, &pb, light, theta_o, phi_o)
+            srbf_response_in_view(luts, table, &pb, &lobes, light, phi_o)
         } else {
             ma
         };

@@ -34,12 +34,15 @@ pub struct GpuShadowGrid {
     pub values: wgpu::Buffer,
     /// Two slices of path integrals per light (three vec4 per point), the sweeps' working memory.
     pub scratch: wgpu::Buffer,
-    /// What the sweeps read on the planes between the grid's slices (three vec4 a point:
+    /// What the sweeps read on the planes between the grid's slices (six words a point:
     /// [`crate::shadow::sweep::MidplaneSamples`]), built after each new pyramid.
     pub samples: wgpu::Buffer,
     pub light_count: u32,
     pub forward: bool,
 }
+
+/// Bytes of one of the sweeps' samples ([`crate::shadow::sample_packing`]).
+pub const SAMPLE_BYTES: u64 = 24;
 
 impl GpuShadowGrid {
     pub fn new(
@@ -83,12 +86,28 @@ impl GpuShadowGrid {
                 size: crate::shadow::sweep::MidplaneSamples::layout(&grid)
                     .1
                     .max(1) as u64
-                    * 48,
+                    * SAMPLE_BYTES,
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
             light_count,
             forward,
+        }
+    }
+
+    /// The grid for `light_count` lights and the multiple-scattering toggle `forward`: new values and
+    /// scratch, the same samples (they depend on the pyramid and the volume alone: a change of the
+    /// light count or of the toggle does not rebuild them).
+    pub fn with_lights(
+        &self,
+        device: &wgpu::Device,
+        light_count: u32,
+        skip: f32,
+        forward: bool,
+    ) -> Self {
+        Self {
+            samples: self.samples.clone(),
+            ..Self::new(device, self.grid, light_count, skip, forward)
         }
     }
 

@@ -340,7 +340,14 @@ fn rule_value(c: [f32; 4], s: Rgb32) -> Rgb32 {
     s.map(|s| c[0].max(0.0) * (-s * x1).exp() + c[2].max(0.0) * (-s * x2).exp())
 }
 
+/// Two cells along dphi, mixed.
+#[inline(always)]
+fn dphi_pair(cells: &[[f32; 4]], w: f32) -> [f32; 4] {
+    lerp4(cells[0], cells[1], w)
+}
+
 /// WGSL's mix.
+#[inline(always)]
 fn lerp4(a: [f32; 4], b: [f32; 4], w: f32) -> [f32; 4] {
     std::array::from_fn(|k| a[k] * (1.0 - w) + b[k] * w)
 }
@@ -394,15 +401,17 @@ impl AzimuthalTable {
         }
         let (f, wf) = axis_position(u * (TABLE_DPHI - 1) as f32, TABLE_DPHI);
         let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
-        let at = |ie: usize, it: usize, il: usize, ip: usize| -> [f32; 4] {
-            cells[base + ie * per_lobe + (it * TABLE_LAMBDA + il) * TABLE_DPHI + ip]
+        // The (theta_d, lambda') corners of index sample ie, each with its two dphi neighbours
+        // side by side.
+        let slab = |ie: usize| {
+            let at = |it: usize, il: usize| {
+                let i = base + ie * per_lobe + (it * TABLE_LAMBDA + il) * TABLE_DPHI + f;
+                dphi_pair(&cells[i..i + 2], wf)
+            };
+            let near = lerp4(at(t, l), at(t, l + 1), wl);
+            let far = lerp4(at(t + 1, l), at(t + 1, l + 1), wl);
+            lerp4(near, far, wt)
         };
-        let bilerp = |ie: usize, it: usize| {
-            let lo = lerp4(at(ie, it, l, f), at(ie, it, l, f + 1), wf);
-            let hi = lerp4(at(ie, it, l + 1, f), at(ie, it, l + 1, f + 1), wf);
-            lerp4(lo, hi, wl)
-        };
-        let slab = |ie: usize| lerp4(bilerp(ie, t), bilerp(ie, t + 1), wt);
         let mut c = slab(e);
         if we > 0.0 {
             c = lerp4(c, slab(e + 1), we);

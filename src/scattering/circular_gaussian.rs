@@ -100,11 +100,33 @@ const ERF_A: [f64; 5] = [
 /// erf(x) by A&S 7.1.26 in f32, as WGSL (which has no erf) computes it: the published 1.5e-7 plus
 /// f32 rounding near erf = 1, about 2.5e-7 in all (tested).
 pub fn erf_approx(x: f32) -> f32 {
-    let a = x.abs();
-    let t = 1.0 / (1.0 + ERF_P as f32 * a);
-    let [a1, a2, a3, a4, a5] = ERF_A.map(|c| c as f32);
-    let poly = t * (a1 + t * (a2 + t * (a3 + t * (a4 + t * a5))));
-    x.signum() * (1.0 - poly * (-a * a).exp())
+    GaussianEnd::at(x).erf
+}
+
+/// One end u of a Gaussian's segment: erf(u) ([`erf_approx`]) and e^(-u^2), which share the one
+/// exponential. A quadrature's segments share their ends, so it finds each end once (WGSL twin:
+/// `gaussian_end`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussianEnd {
+    pub u: f32,
+    pub erf: f32,
+    /// e^(-u^2).
+    pub gauss: f32,
+}
+
+impl GaussianEnd {
+    pub fn at(u: f32) -> Self {
+        let a = u.abs();
+        let t = 1.0 / (1.0 + ERF_P as f32 * a);
+        let [a1, a2, a3, a4, a5] = ERF_A.map(|c| c as f32);
+        let poly = t * (a1 + t * (a2 + t * (a3 + t * (a4 + t * a5))));
+        let gauss = (-a * a).exp();
+        Self {
+            u,
+            erf: u.signum() * (1.0 - poly * gauss),
+            gauss,
+        }
+    }
 }
 
 /// The same formula in f64, to check the published bound itself.
@@ -147,11 +169,18 @@ pub fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: [f32
 /// The moments integral y^k g dx (k = 0, 1, 2; y = x - mu) over [a, b] of [`gaussian_quadratic_integral`],
 /// computed once for the three channels of a segment pair.
 pub fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> [f32; 3] {
-    let (ua, ub) = ((a - mu) / lambda, (b - mu) / lambda);
-    let (ea, eb) = ((-ua * ua).exp(), (-ub * ub).exp());
-    let m0 = 0.5 * PI.sqrt() * (erf_approx(ub) - erf_approx(ua));
-    let m1 = 0.5 * (ea - eb);
-    let m2 = 0.5 * m0 - 0.5 * (ub * eb - ua * ea);
+    gaussian_quadratic_moments_between(
+        GaussianEnd::at((a - mu) / lambda),
+        GaussianEnd::at((b - mu) / lambda),
+        lambda,
+    )
+}
+
+/// [`gaussian_quadratic_moments`] between two ends u = (x - mu) / lambda found already.
+pub fn gaussian_quadratic_moments_between(a: GaussianEnd, b: GaussianEnd, lambda: f32) -> [f32; 3] {
+    let m0 = 0.5 * PI.sqrt() * (b.erf - a.erf);
+    let m1 = 0.5 * (a.gauss - b.gauss);
+    let m2 = 0.5 * m0 - 0.5 * (b.u * b.gauss - a.u * a.gauss);
     [
         lambda * m0,
         lambda * lambda * m1,

@@ -13,7 +13,9 @@ use super::azimuthal_table::AzimuthalTable;
 use super::dual_terms::{DualTables, HairBehind};
 use super::fast_azimuthal::Rgb32;
 use super::fast_params::FastHairParams;
-use super::fast_response::{LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature};
+use super::fast_response::{
+    LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature, view_lobes,
+};
 use super::lut::wrap_angle_f32;
 use std::f32::consts::{PI, SQRT_2};
 
@@ -57,9 +59,32 @@ pub fn global_response_lobe(
     phi_o: f32,
     sigma_f2: f32,
 ) -> Rgb32 {
+    let lobes = view_lobes(p, theta_o);
+    global_response_lobe_in_view(
+        table,
+        p,
+        lobe,
+        &lobes[lobe as usize],
+        light,
+        phi_o,
+        sigma_f2,
+    )
+}
+
+/// [`global_response_lobe`] with the lobe's longitudinal function of the view
+/// ([`crate::scattering::fast_response::view_lobes`], shared with single scattering).
+pub fn global_response_lobe_in_view(
+    table: &AzimuthalTable,
+    p: &FastHairParams,
+    lobe: u32,
+    longitudinal: &LongitudinalLobe,
+    light: SrbfInFrame,
+    phi_o: f32,
+    sigma_f2: f32,
+) -> Rgb32 {
+    let theta_o = longitudinal.theta_o;
     let sigma = forward_spread(sigma_f2, light.lambda);
-    let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
-    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, alpha, beta);
+    let beta = p.beta[lobe as usize];
     // g^u with std sigma is Xu's g with bandwidth sqrt(2) sigma, over sqrt(2 pi) sigma.
     let (scale, mu, l) = gaussian_product(
         light.theta,

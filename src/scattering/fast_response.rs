@@ -18,7 +18,7 @@
 //! converge to the exact integral (the paper's rule spaces samples by lambda whatever m is).
 
 use super::azimuthal_table::AzimuthalTable;
-use super::circular_gaussian::{bessel_i0_scaled, gaussian_quadratic_moments};
+use super::circular_gaussian::{GaussianEnd, bessel_i0_scaled, gaussian_quadratic_moments_between};
 use super::fast_azimuthal::{Rgb32, eta_star_mean, inner_integral_r};
 use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
@@ -94,6 +94,8 @@ pub struct Quadrature {
     pub mu: f32,
     pub lambda: f32,
     x0: f32,
+    /// erf and e^(-u^2) at x0 (the next segment's start: each node's found once).
+    e0: GaussianEnd,
     f0: Rgb32,
     x1: f32,
     f1: Rgb32,
@@ -110,6 +112,7 @@ impl Quadrature {
             mu,
             lambda,
             x0: -FRAC_PI_2,
+            e0: GaussianEnd::at((-FRAC_PI_2 - mu) / lambda),
             f0: [0.0; 3],
             x1: 0.0,
             f1: [0.0; 3],
@@ -138,7 +141,9 @@ impl Quadrature {
             // end): the line is the parabola with q2 = 0 (Newton form in y = x - mu).
             let (x1, f1, mu) = (self.x1, self.f1, self.mu);
             let pair = !odd && x1 > x0 && x > x1;
-            let mo = gaussian_quadratic_moments(x0, x, mu, self.lambda);
+            let end = GaussianEnd::at((x - mu) / self.lambda);
+            let mo = gaussian_quadratic_moments_between(self.e0, end, self.lambda);
+            self.e0 = end;
             let y0 = x0 - mu;
             for c in 0..3 {
                 let (q1, q2, y1) = if pair {
@@ -167,7 +172,13 @@ pub struct SrbfInFrame {
 
 /// lambda' = lambda_j / sqrt(cos theta_i cos theta_j) (Xu Eq. 11), clamped to the table.
 pub fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
-    let c = (theta_i.cos() * theta_j.cos()).max(1e-8);
+    azimuthal_bandwidth_cos(lambda_j, theta_i.cos(), theta_j.cos())
+}
+
+/// [`azimuthal_bandwidth`] from cos theta_i and cos theta_j (the quadrature's node has the first from its
+/// longitudinal factor, the light the second for all its nodes).
+pub fn azimuthal_bandwidth_cos(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
+    let c = (cos_theta_i * cos_theta_j).max(1e-8);
     (lambda_j / c.sqrt()).min(LAMBDA_PRIME_MAX)
 }
 
@@ -183,6 +194,9 @@ pub fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
         t
     }
 }
+
+/// x beyond which 1 - e^(-x) rounds to 1 in f32 (e^(-x) < 2^-25 from x = 25 ln 2 = 17.33).
+const ONE_MINUS_EXP_IS_ONE: f32 = 17.5;
 
 /// One lobe's longitudinal function for one view, with everything that does not depend on theta_i computed
 /// once: it is evaluated at every quadrature sample of every light. Holds the centre of the Gaussian the
@@ -203,8 +217,9 @@ pub struct LongitudinalLobe {
     pub ln_m_norm: f32,
     /// ln(sqrt(2 pi v)): the log of the Gaussian's normalisation.
     pub ln_gaussian_norm: f32,
-    /// cos(theta_o').
+    /// cos(theta_o') and sin(theta_o').
     pub cos_tilted: f32,
+    pub sin_tilted: f32,
 }
 
 impl LongitudinalLobe {
@@ -215,6 +230,15 @@ impl LongitudinalLobe {
 
     pub fn with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> Self {
         let tilted = tilted_outgoing(theta_o, alpha);
+        let (sin_tilted, cos_tilted) = tilted.sin_cos();
+        let ln_v = v.ln();
+        // ln(1 - e^(-2/v)) is 0 in f32 once e^(-2/v) is under half an ulp of 1 (2/v > 25 ln 2 = 17.33;
+        // every lobe with beta < 0.169): skipped there, the same value.
+        let ln_csch_part = if 2.0 / v > ONE_MINUS_EXP_IS_ONE {
+            0.0
+        } else {
+            (1.0 - (-2.0 / v).exp()).ln()
+        };
         Self {
             longitudinal,
             theta_o,
@@ -225,9 +249,10 @@ impl LongitudinalLobe {
             } else {
                 -tilted
             },
-            ln_m_norm: -v.ln() - (1.0 - (-2.0 / v).exp()).ln(),
-            ln_gaussian_norm: 0.5 * (2.0 * PI * v).ln(),
-            cos_tilted: tilted.cos(),
+            ln_m_norm: -ln_v - ln_csch_part,
+            ln_gaussian_norm: 0.5 * ((2.0 * PI).ln() + ln_v),
+            cos_tilted,
+            sin_tilted,
         }
     }
 
@@ -258,14 +283,27 @@ impl LongitudinalLobe {
     ///   clamped as the light's ratio is (no logarithm of the Bessel term, no cos(theta_o') per call: they
     ///   cost `bench-fast` ~4 %).
     pub fn factor(&self, theta_i: f32) -> f32 {
-        let ci = theta_i.cos().max(0.0);
+        self.factor_at(theta_i, theta_i.sin_cos(), 0.0)
+    }
+
+    /// [`Self::factor`] times e^(ln_scale), at a node whose (sin, cos)(theta_i) are known (shared with
+    /// its lambda'); ln_scale is the weight's ratio to its Gaussian, joined to the factor's own
+    /// exponential. The shape's 2 sin^2((theta_i + theta_o')/2) is 1 - cos(theta_i + theta_o') from the
+    /// two angles' sines and cosines (its rounding, ~1e-7 / v in the logarithm, is 1e-5 at beta = 0.05).
+    pub fn factor_at(&self, theta_i: f32, (sin_i, cos_i): (f32, f32), ln_scale: f32) -> f32 {
+        let ci = cos_i.max(0.0);
         if self.longitudinal == LONGITUDINAL_PUBLISHED {
             let cd = (0.5 * (self.theta_o - theta_i)).cos();
-            return 2.0 * ci * ci / (cd * cd).max(1e-8);
+            return 2.0 * ci * ci / (cd * cd).max(1e-8) * ln_scale.exp();
         }
+        let cos_sum = cos_i * self.cos_tilted - sin_i * self.sin_tilted;
         let d = theta_i - self.mu;
-        let ln_rest = self.ln_m_shape(theta_i) + d * d / (2.0 * self.v) + self.ln_gaussian_norm;
-        ci * bessel_i0_scaled(self.bessel_argument(ci)) * ln_rest.clamp(-80.0, 20.0).exp()
+        let ln_rest = -(1.0 - cos_sum) / self.v
+            + self.ln_m_norm
+            + d * d / (2.0 * self.v)
+            + self.ln_gaussian_norm;
+        ci * bessel_i0_scaled(self.bessel_argument(ci))
+            * (ln_rest.clamp(-80.0, 20.0) + ln_scale).exp()
     }
 }
 
@@ -277,6 +315,8 @@ pub fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f
 
 /// The smooth factor of the outer integral at theta_i: the longitudinal factor ([`LongitudinalLobe::factor`])
 /// times calN_t.
+/// `cos_theta_j`: the light's cos(theta_j), found once for its nodes; `ln_scale` the weight's ratio to
+/// the quadrature's Gaussian ([`LongitudinalLobe::factor_at`]).
 #[allow(clippy::too_many_arguments)]
 pub fn outer_integrand(
     luts: &Luts,
@@ -284,14 +324,16 @@ pub fn outer_integrand(
     p: &FastHairParams,
     lobe: u32,
     light: SrbfInFrame,
-    theta_o: f32,
+    cos_theta_j: f32,
     phi_o: f32,
     longitudinal: &LongitudinalLobe,
     theta_i: f32,
+    ln_scale: f32,
 ) -> Rgb32 {
-    let theta_d = 0.5 * (theta_o - theta_i);
-    let lp = azimuthal_bandwidth(light.lambda, theta_i, light.theta);
-    let w = longitudinal.factor(theta_i);
+    let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
+    let (sin_i, cos_i) = theta_i.sin_cos();
+    let lp = azimuthal_bandwidth_cos(light.lambda, cos_i, cos_theta_j);
+    let w = longitudinal.factor_at(theta_i, (sin_i, cos_i), ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if w == 0.0 {
         return [0.0; 3];
@@ -411,8 +453,27 @@ pub fn srbf_response_lobe(
     theta_o: f32,
     phi_o: f32,
 ) -> Rgb32 {
-    let (alpha, beta) = (p.alpha[lobe as usize], p.beta[lobe as usize]);
-    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, alpha, beta);
+    let lobes = view_lobes(p, theta_o);
+    srbf_response_lobe_in_view(luts, table, p, lobe, &lobes[lobe as usize], light, phi_o)
+}
+
+/// The three lobes' longitudinal functions seen from theta_o: they depend on the hair's parameters and
+/// the view only, so a shading point finds them once for all its lights (WGSL twin: `view_lobes`).
+pub fn view_lobes(p: &FastHairParams, theta_o: f32) -> [LongitudinalLobe; 3] {
+    std::array::from_fn(|t| LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]))
+}
+
+/// [`srbf_response_lobe`] with the lobe's longitudinal function of the view ([`view_lobes`]).
+pub fn srbf_response_lobe_in_view(
+    luts: &Luts,
+    table: &AzimuthalTable,
+    p: &FastHairParams,
+    lobe: u32,
+    longitudinal: &LongitudinalLobe,
+    light: SrbfInFrame,
+    phi_o: f32,
+) -> Rgb32 {
+    let beta = p.beta[lobe as usize];
     let lambda_m = 2.0 * std::f32::consts::SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     // The unit-area Gaussian of standard deviation 2 beta in theta_i; the longitudinal factor holds the rest.
@@ -420,21 +481,22 @@ pub fn srbf_response_lobe(
     if scale < 1e-30 {
         return [0.0; 3];
     }
+    let cos_j = light.theta.cos();
     linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
         let d = (ti - w.peak) / w.lambda;
-        let ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0).exp();
+        let ln_ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0);
         outer_integrand(
             luts,
             table,
             p,
             lobe,
             light,
-            theta_o,
+            cos_j,
             phi_o,
-            &longitudinal,
+            longitudinal,
             ti,
+            ln_ratio,
         )
-        .map(|v| ratio * v)
     })
     // The parabolas may dip below zero where f vanishes; the response cannot.
     .map(|v| (scale * v).max(0.0))
@@ -449,5 +511,19 @@ pub fn srbf_response(
     theta_o: f32,
     phi_o: f32,
 ) -> [Rgb32; 3] {
-    std::array::from_fn(|t| srbf_response_lobe(luts, table, p, t as u32, light, theta_o, phi_o))
+    srbf_response_in_view(luts, table, p, &view_lobes(p, theta_o), light, phi_o)
+}
+
+/// [`srbf_response`] with the view's longitudinal functions ([`view_lobes`]).
+pub fn srbf_response_in_view(
+    luts: &Luts,
+    table: &AzimuthalTable,
+    p: &FastHairParams,
+    lobes: &[LongitudinalLobe; 3],
+    light: SrbfInFrame,
+    phi_o: f32,
+) -> [Rgb32; 3] {
+    std::array::from_fn(|t| {
+        srbf_response_lobe_in_view(luts, table, p, t as u32, &lobes[t], light, phi_o)
+    })
 }

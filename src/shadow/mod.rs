@@ -6,6 +6,7 @@ pub mod fiber_grid;
 pub mod forward;
 pub mod grid;
 pub mod ray_shooting;
+pub mod sample_packing;
 pub mod solid;
 pub mod sweep;
 

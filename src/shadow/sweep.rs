@@ -152,8 +152,9 @@ pub const MIDPLANE_REFINE: u32 = 2;
 /// The samples on the planes between the grid's slices, for the sweeps across each axis a: plane j
 /// (0..=dims[a], the cells' boundary j spacings from the origin) at [`MIDPLANE_REFINE`] points per
 /// spacing along the other two axes b < c; None outside the volume (zero integrands).
-/// Light-independent: read once per grid build. Twin of the GPU's `grid_samples` buffer (three vec4
-/// a point, the lattices of axes 0, 1, 2 one after another).
+/// Light-independent: read once per grid build. Twin of the GPU's `grid_samples` buffer (six words a
+/// point, [`crate::shadow::sample_packing`]; the lattices of axes 0, 1, 2 one after another): the
+/// samples are held as the GPU unpacks them ([`GridSample::quantised`]).
 pub struct MidplaneSamples {
     pub samples: Vec<Option<GridSample>>,
     /// The first sample of each axis' lattice.
@@ -234,12 +235,15 @@ impl MidplaneSamples {
                     None => return None,
                 };
                 let (a, m) = pyramid.extinction_at(x, lod);
-                Some(GridSample {
-                    a,
-                    m,
-                    sigma_a,
-                    solid,
-                })
+                Some(
+                    GridSample {
+                        a,
+                        m,
+                        sigma_a,
+                        solid,
+                    }
+                    .quantised(),
+                )
             })
             .collect();
         Self { samples, offsets }
