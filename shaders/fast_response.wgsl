@@ -120,12 +120,6 @@ fn longitudinal_lobe(longitudinal: u32, theta_o: f32, alpha: f32, beta: f32) -> 
     return longitudinal_lobe_with_variance(longitudinal, theta_o, alpha, max(4.0 * beta * beta, 1e-8));
 }
 
-// d'Eon et al. 2011's ln M(theta_i) without its Bessel term (ln_m_shape).
-fn longitudinal_ln_m_shape(l: LongitudinalLobe, theta_i: f32) -> f32 {
-    let half = sin(0.5 * (theta_i + l.tilted));
-    return -2.0 * half * half / l.v + l.ln_m_norm;
-}
-
 // d'Eon's Bessel argument cos theta_i cos theta_o' / v from cos theta_i clamped at 0 (bessel_argument).
 fn longitudinal_bessel_argument(l: LongitudinalLobe, cos_theta_i: f32) -> f32 {
     return cos_theta_i * l.cos_tilted / l.v;
@@ -139,7 +133,7 @@ fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
 }
 
 // longitudinal_factor times e^(ln_scale) at a node whose sin and cos are known (factor_at): the shape's
-// 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o').
+// 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o') from the angles' sines and cosines.
 fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: f32, ln_scale: f32) -> f32 {
     let ci = max(cos_i, 0.0);
     if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
@@ -147,8 +141,11 @@ fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: 
         return 2.0 * ci * ci / max(cd * cd, 1e-8) * exp(ln_scale);
     }
     let cos_sum = cos_i * l.cos_tilted - sin_i * l.sin_tilted;
+    let sin_sum = sin_i * l.cos_tilted + cos_i * l.sin_tilted;
+    // 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0 (no cancellation near the peak).
+    let one_minus_cos = select(1.0 - cos_sum, sin_sum * sin_sum / (1.0 + cos_sum), cos_sum > 0.0);
     let d = theta_i - l.mu;
-    let ln_rest = -(1.0 - cos_sum) / l.v + l.ln_m_norm + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
+    let ln_rest = -one_minus_cos / l.v + l.ln_m_norm + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
     return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, ci)) * exp(clamp(ln_rest, -80.0, 20.0) + ln_scale);
 }
 

@@ -113,13 +113,14 @@ fn sweep_axes(g: ShadowGridInfo, omega: vec3<f32>) -> SweepAxes {
 
 // MidplaneSamples in sweep.rs: per point of the planes between the slices across each axis a (plane j
 // in 0..=dims[a], MIDPLANE_REFINE points per spacing along b < c, at (i + 1/2) / R spacings; the
-// lattices of axes 0, 1, 2 one after another):
-// (a, M_xx, M_yy, M_zz), (M_xy, M_xz, M_yz, solid share), (sigma_a RGB, 1 inside the volume, 0 outside:
-// no hair, zero integrands).
-// Three vec2<u32> a sample (sample_packing.rs): (a as f32 (negative outside the volume), unorm n_xx n_yy),
+// lattices of axes 0, 1, 2 one after another), three vec2<u32> a sample (sample_packing.rs):
+// (a as f32 (negative outside the volume: no hair, zero integrands), unorm n_xx n_yy),
 // (unorm n_zz solid, snorm n_xy n_xz), (f16 sigma_a r g, f16 sigma_a b | snorm n_yz << 16), with
 // n = M / a.
 @group(0) @binding(10) var<storage, read_write> grid_samples: array<vec2<u32>>;
+
+// The largest finite f16.
+const F16_MAX: f32 = 65504.0;
 
 // sweep_lod in sweep.rs: the coarsest level whose voxel is at most half the spacing.
 fn sweep_lod(g: ShadowGridInfo) -> f32 {
@@ -182,9 +183,11 @@ fn build_midplane_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let n1 = e.m1 * inv;
     grid_samples[3u * i] = vec2<u32>(bitcast<u32>(e.a), pack2x16unorm(n0.xy));
     grid_samples[3u * i + 1u] = vec2<u32>(pack2x16unorm(vec2<f32>(n0.z, s.w)), pack2x16snorm(n1.xy));
-    let low = pack2x16float(vec2<f32>(s.z, 0.0)) & 0xffffu;
+    // The absorption within f16's range (GridSample::pack).
+    let sigma = min(s.xyz, vec3<f32>(F16_MAX));
+    let low = pack2x16float(vec2<f32>(sigma.z, 0.0)) & 0xffffu;
     let high = pack2x16snorm(vec2<f32>(0.0, n1.z)) & 0xffff0000u;
-    grid_samples[3u * i + 2u] = vec2<u32>(pack2x16float(s.xy), low | high);
+    grid_samples[3u * i + 2u] = vec2<u32>(pack2x16float(sigma.xy), low | high);
 }
 
 // Without multiple scattering only tau is swept: one vec4 read and written per point.

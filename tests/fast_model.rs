@@ -439,6 +439,52 @@ fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
     );
 }
 
+/// The longitudinal factor (f32, [`LongitudinalLobe::factor`]: the shape from the node's sine and
+/// cosine, 1 - cos as sin^2 / (1 + cos) near the peak) against its definition in f64,
+/// cos(theta_i) M^dEon(theta_i, theta_o) / g(theta_i; -theta_o', sqrt v), within four standard
+/// deviations of the peak, down to beta = 0.5 degrees (1 - cos from the products alone lost ~1e-7 / v
+/// of the logarithm there: 4e-4).
+#[test]
+fn the_longitudinal_factor_follows_its_f64_definition_near_the_peak() {
+    use strandlight::scattering::fast_response::LongitudinalLobe;
+    use strandlight::scattering::marschner::{
+        deon_variance, ln_longitudinal_deon, tilted_outgoing,
+    };
+    let mut worst = 0.0f64;
+    for beta_deg in [0.5f64, 1.0, 2.0, 3.75, 5.0, 10.0, 20.0] {
+        for alpha_deg in [-10.0f64, -3.0, 0.0, 3.0] {
+            for theta_o_deg in [0.0f64, 30.0, -55.0, 80.0] {
+                let (beta, alpha, theta_o) = (
+                    beta_deg.to_radians(),
+                    alpha_deg.to_radians(),
+                    theta_o_deg.to_radians(),
+                );
+                let v = deon_variance(beta);
+                let t = tilted_outgoing(theta_o, alpha);
+                let lobe = LongitudinalLobe::new(0, theta_o as f32, alpha as f32, beta as f32);
+                for k in -16..=16 {
+                    let ti = -t + 0.25 * k as f64 * v.sqrt();
+                    if ti.abs() >= FRAC_PI_2 - 1e-3 {
+                        continue;
+                    }
+                    let gaussian = (-(ti + t) * (ti + t) / (2.0 * v)).exp() / (2.0 * PI * v).sqrt();
+                    let exact = ti.cos() * ln_longitudinal_deon(v, ti, t).exp() / gaussian;
+                    let got = lobe.factor(ti as f32) as f64;
+                    let rel = (got / exact - 1.0).abs();
+                    worst = worst.max(rel);
+                    assert!(
+                        rel < 2e-4,
+                        "beta {beta_deg} alpha {alpha_deg} theta_o {theta_o_deg} theta_i {ti}: {got} vs {exact}"
+                    );
+                }
+            }
+        }
+    }
+    println!(
+        "longitudinal factor against f64 near the peak: worst relative difference {worst:.1e}"
+    );
+}
+
 /// The quadratures evaluate their integrands at the m - 1 inner nodes only, taking them as 0 at the
 /// poles (linear_quadrature): every integrand carries the longitudinal factor, whose clamped
 /// cos(theta_i) is exactly 0 at +-pi/2 in f32, for both longitudinal functions, any tilt, width and

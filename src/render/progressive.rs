@@ -288,7 +288,8 @@ pub struct Refinement {
     stage: Stage,
     /// Shadow-grid entries built for the current volume, lights and tables.
     pub(super) grid_done: u32,
-    /// The sweeps' samples built for the current pyramid and grid buffers (`MidplaneSamples`).
+    /// The sweeps' samples built for the current pyramid (`MidplaneSamples`; a new light count or
+    /// multiple-scattering toggle keeps them, `GpuShadowGrid::with_lights`).
     pub(super) samples_done: u32,
     /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
     /// entries, finished by the last: such an entry is neither the old value nor the new one, and the

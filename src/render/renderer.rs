@@ -962,7 +962,17 @@ impl Renderer {
             );
             self.grid_buffer_made();
         }
-        self.mark_shadow_grid_dirty();
+        // An absorption change made while no grid read it (no lights) waits in the volume: the
+        // grid's forward terms read it now.
+        if self.volume_absorption_old
+            && self.settings.shadows
+            && self.settings.multiple_scattering
+            && self.light_count > 0
+        {
+            self.mark_volume_dirty();
+        } else {
+            self.mark_shadow_grid_dirty();
+        }
         self.update_batches(&ctx.device);
     }
 
@@ -1079,6 +1089,8 @@ impl Renderer {
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
+        // The sweeps' samples read the pyramid the volume makes.
+        self.refinement.samples_done = 0;
         self.volume_stale = false;
         self.volume_stale_density = false;
         self.volume_absorption_old = false;

@@ -13,9 +13,7 @@ use super::azimuthal_table::AzimuthalTable;
 use super::dual_terms::{DualTables, HairBehind};
 use super::fast_azimuthal::Rgb32;
 use super::fast_params::FastHairParams;
-use super::fast_response::{
-    LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature, view_lobes,
-};
+use super::fast_response::{LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature};
 use super::lut::wrap_angle_f32;
 use std::f32::consts::{PI, SQRT_2};
 
@@ -59,16 +57,9 @@ pub fn global_response_lobe(
     phi_o: f32,
     sigma_f2: f32,
 ) -> Rgb32 {
-    let lobes = view_lobes(p, theta_o);
-    global_response_lobe_in_view(
-        table,
-        p,
-        lobe,
-        &lobes[lobe as usize],
-        light,
-        phi_o,
-        sigma_f2,
-    )
+    let t = lobe as usize;
+    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]);
+    global_response_lobe_in_view(table, p, lobe, &longitudinal, light, phi_o, sigma_f2)
 }
 
 /// [`global_response_lobe`] with the lobe's longitudinal function of the view

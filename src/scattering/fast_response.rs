@@ -289,7 +289,8 @@ impl LongitudinalLobe {
     /// [`Self::factor`] times e^(ln_scale), at a node whose (sin, cos)(theta_i) are known (shared with
     /// its lambda'); ln_scale is the weight's ratio to its Gaussian, joined to the factor's own
     /// exponential. The shape's 2 sin^2((theta_i + theta_o')/2) is 1 - cos(theta_i + theta_o') from the
-    /// two angles' sines and cosines (its rounding, ~1e-7 / v in the logarithm, is 1e-5 at beta = 0.05).
+    /// two angles' sines and cosines, as sin^2 / (1 + cos) near the peak (1 - cos itself would lose
+    /// ~1e-7 / v of the logarithm there: 1e-4 at beta = 1 degree; `tests/fast_model.rs` bounds it).
     pub fn factor_at(&self, theta_i: f32, (sin_i, cos_i): (f32, f32), ln_scale: f32) -> f32 {
         let ci = cos_i.max(0.0);
         if self.longitudinal == LONGITUDINAL_PUBLISHED {
@@ -297,8 +298,15 @@ impl LongitudinalLobe {
             return 2.0 * ci * ci / (cd * cd).max(1e-8) * ln_scale.exp();
         }
         let cos_sum = cos_i * self.cos_tilted - sin_i * self.sin_tilted;
+        let sin_sum = sin_i * self.cos_tilted + cos_i * self.sin_tilted;
+        // 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0: no cancellation near the peak.
+        let one_minus_cos = if cos_sum > 0.0 {
+            sin_sum * sin_sum / (1.0 + cos_sum)
+        } else {
+            1.0 - cos_sum
+        };
         let d = theta_i - self.mu;
-        let ln_rest = -(1.0 - cos_sum) / self.v
+        let ln_rest = -one_minus_cos / self.v
             + self.ln_m_norm
             + d * d / (2.0 * self.v)
             + self.ln_gaussian_norm;
@@ -453,8 +461,9 @@ pub fn srbf_response_lobe(
     theta_o: f32,
     phi_o: f32,
 ) -> Rgb32 {
-    let lobes = view_lobes(p, theta_o);
-    srbf_response_lobe_in_view(luts, table, p, lobe, &lobes[lobe as usize], light, phi_o)
+    let t = lobe as usize;
+    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]);
+    srbf_response_lobe_in_view(luts, table, p, lobe, &longitudinal, light, phi_o)
 }
 
 /// The three lobes' longitudinal functions seen from theta_o: they depend on the hair's parameters and

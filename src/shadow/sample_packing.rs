@@ -39,8 +39,9 @@ fn from_snorm16(bits: u32) -> f32 {
     ((bits & 0xffff) as u16 as i16 as f32 / 32767.0).max(-1.0)
 }
 
+/// f16 bits of x, clamped to f16's largest finite value (65504; WGSL leaves larger ones undefined).
 fn f16_bits(x: f32) -> u32 {
-    f16::from_f32(x).to_bits() as u32
+    f16::from_f32(x.min(f16::MAX.to_f32())).to_bits() as u32
 }
 
 fn from_f16(bits: u32) -> f32 {
