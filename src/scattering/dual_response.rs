@@ -57,8 +57,7 @@ pub fn global_response_lobe(
     phi_o: f32,
     sigma_f2: f32,
 ) -> Rgb32 {
-    let t = lobe as usize;
-    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]);
+    let longitudinal = LongitudinalLobe::of_lobe(p, lobe, theta_o);
     global_response_lobe_in_view(table, p, lobe, &longitudinal, light, phi_o, sigma_f2)
 }
 

@@ -228,6 +228,12 @@ impl LongitudinalLobe {
         Self::with_variance(longitudinal, theta_o, alpha, (4.0 * beta * beta).max(1e-8))
     }
 
+    /// Lobe `lobe` (0 = R, 1 = TT, 2 = TRT) of the hair's parameters seen from theta_o.
+    pub fn of_lobe(p: &FastHairParams, lobe: u32, theta_o: f32) -> Self {
+        let t = lobe as usize;
+        Self::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t])
+    }
+
     pub fn with_variance(longitudinal: u32, theta_o: f32, alpha: f32, v: f32) -> Self {
         let tilted = tilted_outgoing(theta_o, alpha);
         let (sin_tilted, cos_tilted) = tilted.sin_cos();
@@ -461,15 +467,14 @@ pub fn srbf_response_lobe(
     theta_o: f32,
     phi_o: f32,
 ) -> Rgb32 {
-    let t = lobe as usize;
-    let longitudinal = LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]);
+    let longitudinal = LongitudinalLobe::of_lobe(p, lobe, theta_o);
     srbf_response_lobe_in_view(luts, table, p, lobe, &longitudinal, light, phi_o)
 }
 
 /// The three lobes' longitudinal functions seen from theta_o: they depend on the hair's parameters and
 /// the view only, so a shading point finds them once for all its lights (WGSL twin: `view_lobes`).
 pub fn view_lobes(p: &FastHairParams, theta_o: f32) -> [LongitudinalLobe; 3] {
-    std::array::from_fn(|t| LongitudinalLobe::new(p.longitudinal, theta_o, p.alpha[t], p.beta[t]))
+    std::array::from_fn(|t| LongitudinalLobe::of_lobe(p, t as u32, theta_o))
 }
 
 /// [`srbf_response_lobe`] with the lobe's longitudinal function of the view ([`view_lobes`]).
