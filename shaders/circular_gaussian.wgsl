@@ -43,13 +43,8 @@ fn bessel_i0_scaled(x: f32) -> f32 {
     return p / sqrt(ax);
 }
 
-// erf by A&S 7.1.26 (WGSL has no erf).
-fn erf_approx(x: f32) -> f32 {
-    return gaussian_end(x).y;
-}
-
 // One end u of a Gaussian's segment (GaussianEnd in circular_gaussian.rs): (u, erf(u), e^(-u^2)), the two
-// sharing one exponential.
+// sharing one exponential; erf by A&S 7.1.26 (WGSL has no erf).
 fn gaussian_end(u: f32) -> vec3<f32> {
     let a = abs(u);
     let t = 1.0 / (1.0 + 0.3275911 * a);
@@ -59,12 +54,8 @@ fn gaussian_end(u: f32) -> vec3<f32> {
 }
 
 
-// integral_a^b y^k g(x; mu, lambda) dx (k = 0, 1, 2; y = x - mu), once per segment pair.
-fn gaussian_quadratic_moments(a: f32, b: f32, mu: f32, lambda: f32) -> vec3<f32> {
-    return gaussian_quadratic_moments_between(gaussian_end((a - mu) / lambda), gaussian_end((b - mu) / lambda), lambda);
-}
-
-// gaussian_quadratic_moments between two ends found already (gaussian_end).
+// integral_a^b y^k g(x; mu, lambda) dx (k = 0, 1, 2; y = x - mu) between two ends found already
+// (gaussian_end; gaussian_quadratic_moments_between in circular_gaussian.rs), once per segment pair.
 fn gaussian_quadratic_moments_between(a: vec3<f32>, b: vec3<f32>, lambda: f32) -> vec3<f32> {
     let m0 = 0.5 * SQRT_PI * (b.y - a.y);
     let m1 = 0.5 * (a.z - b.z);
@@ -72,8 +63,3 @@ fn gaussian_quadratic_moments_between(a: vec3<f32>, b: vec3<f32>, lambda: f32) -
     return vec3<f32>(lambda * m0, lambda * lambda * m1, lambda * lambda * lambda * m2);
 }
 
-// integral_a^b (d0 + d1 y + d2 y^2) g(x; mu, lambda) dx, y = x - mu.
-fn gaussian_quadratic_integral(a: f32, b: f32, mu: f32, lambda: f32, d: vec3<f32>) -> f32 {
-    let m = gaussian_quadratic_moments(a, b, mu, lambda);
-    return d.x * m.x + d.y * m.y + d.z * m.z;
-}

@@ -59,13 +59,9 @@ fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
     return lo + (hi - lo) * f32(k) / f32(denom);
 }
 
-fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
-    return azimuthal_bandwidth_cos(lambda_j, cos(theta_i), cos(theta_j));
-}
-
-// azimuthal_bandwidth from cos theta_i (the node's, shared with its longitudinal factor) and cos theta_j
-// (the light's, once for its nodes).
-fn azimuthal_bandwidth_cos(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
+// lambda' = lambda_j / sqrt(cos theta_i cos theta_j) from cos theta_i (the node's, shared with its
+// longitudinal factor) and cos theta_j (the light's, once for its nodes).
+fn azimuthal_bandwidth(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
     let c = max(cos_theta_i * cos_theta_j, 1e-8);
     return min(lambda_j / sqrt(c), LAMBDA_PRIME_MAX);
 }
@@ -154,7 +150,7 @@ fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_th
     let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
     let sin_i = sin(theta_i);
     let cos_i = cos(theta_i);
-    let lp = azimuthal_bandwidth_cos(light.lambda, cos_i, cos_theta_j);
+    let lp = azimuthal_bandwidth(light.lambda, cos_i, cos_theta_j);
     let w = longitudinal_factor_at(longitudinal, theta_i, sin_i, cos_i, ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if (w == 0.0) {

@@ -170,14 +170,10 @@ pub struct SrbfInFrame {
     pub lambda: f32,
 }
 
-/// lambda' = lambda_j / sqrt(cos theta_i cos theta_j) (Xu Eq. 11), clamped to the table.
-pub fn azimuthal_bandwidth(lambda_j: f32, theta_i: f32, theta_j: f32) -> f32 {
-    azimuthal_bandwidth_cos(lambda_j, theta_i.cos(), theta_j.cos())
-}
-
-/// [`azimuthal_bandwidth`] from cos theta_i and cos theta_j (the quadrature's node has the first from its
-/// longitudinal factor, the light the second for all its nodes).
-pub fn azimuthal_bandwidth_cos(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
+/// lambda' = lambda_j / sqrt(cos theta_i cos theta_j) (Xu Eq. 11), clamped to the table, from cos theta_i
+/// (the quadrature node's, shared with its longitudinal factor) and cos theta_j (the light's, found once
+/// for its nodes).
+pub fn azimuthal_bandwidth(lambda_j: f32, cos_theta_i: f32, cos_theta_j: f32) -> f32 {
     let c = (cos_theta_i * cos_theta_j).max(1e-8);
     (lambda_j / c.sqrt()).min(LAMBDA_PRIME_MAX)
 }
@@ -346,7 +342,7 @@ pub fn outer_integrand(
 ) -> Rgb32 {
     let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
     let (sin_i, cos_i) = theta_i.sin_cos();
-    let lp = azimuthal_bandwidth_cos(light.lambda, cos_i, cos_theta_j);
+    let lp = azimuthal_bandwidth(light.lambda, cos_i, cos_theta_j);
     let w = longitudinal.factor_at(theta_i, (sin_i, cos_i), ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
     if w == 0.0 {
