@@ -130,6 +130,12 @@ fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
 
 // longitudinal_factor times e^(ln_scale) at a node whose sin and cos are known (factor_at): the shape's
 // 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o') from the angles' sines and cosines.
+// 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0: no cancellation near x = 0 (one_minus_cos in
+// fast_response.rs).
+fn one_minus_cos(sin_x: f32, cos_x: f32) -> f32 {
+    return select(1.0 - cos_x, sin_x * sin_x / (1.0 + cos_x), cos_x > 0.0);
+}
+
 fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: f32, ln_scale: f32) -> f32 {
     let ci = max(cos_i, 0.0);
     if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
@@ -138,18 +144,15 @@ fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: 
     }
     let cos_sum = cos_i * l.cos_tilted - sin_i * l.sin_tilted;
     let sin_sum = sin_i * l.cos_tilted + cos_i * l.sin_tilted;
-    // 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0 (no cancellation near the peak).
-    let one_minus_cos = select(1.0 - cos_sum, sin_sum * sin_sum / (1.0 + cos_sum), cos_sum > 0.0);
     let d = theta_i - l.mu;
-    let ln_rest = -one_minus_cos / l.v + l.ln_m_norm + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
+    let ln_rest = -one_minus_cos(sin_sum, cos_sum) / l.v + l.ln_m_norm + d * d / (2.0 * l.v) + l.ln_gaussian_norm;
     return ci * bessel_i0_scaled(longitudinal_bessel_argument(l, ci)) * exp(clamp(ln_rest, -80.0, 20.0) + ln_scale);
 }
 
 // longitudinal_factor x e^(ln_scale) x calN_t at theta_i; cos_theta_j the light's.
-fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, theta_i: f32, ln_scale: f32) -> vec3<f32> {
+// sin_i, cos_i: the node's, shared with its weight.
+fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: f32, ln_scale: f32) -> vec3<f32> {
     let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
-    let sin_i = sin(theta_i);
-    let cos_i = cos(theta_i);
     let lp = azimuthal_bandwidth(light.lambda, cos_i, cos_theta_j);
     let w = longitudinal_factor_at(longitudinal, theta_i, sin_i, cos_i, ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
@@ -180,9 +183,29 @@ struct LongitudinalWeight {
     ln_w_peak: f32,
 }
 
-fn longitudinal_ln_w(w: LongitudinalWeight, theta: f32) -> f32 {
+// ln w from sin and cos of theta - theta_j (LongitudinalWeight::ln_w_from).
+fn longitudinal_ln_w_from(w: LongitudinalWeight, theta: f32, sin_d: f32, cos_d: f32) -> f32 {
     let d = (theta - w.mu_m) / w.lambda_m;
-    return w.kappa_j * (cos(theta - w.theta_j) - 1.0) - d * d;
+    return -w.kappa_j * one_minus_cos(sin_d, cos_d) - d * d;
+}
+
+fn longitudinal_ln_w(w: LongitudinalWeight, theta: f32) -> f32 {
+    return longitudinal_ln_w_from(w, theta, sin(theta - w.theta_j), cos(theta - w.theta_j));
+}
+
+// At a node whose sin and cos are known, with the light's (LongitudinalWeight::ln_w_at): no cosine
+// per node.
+fn longitudinal_ln_w_at(w: LongitudinalWeight, theta: f32, sin_t: f32, cos_t: f32, sin_j: f32, cos_j: f32) -> f32 {
+    return longitudinal_ln_w_from(w, theta, sin_t * cos_j - cos_t * sin_j, cos_t * cos_j + sin_t * sin_j);
+}
+
+// A light's lobe is skipped below this (NEGLIGIBLE_LN_WEIGHT in fast_response.rs).
+const NEGLIGIBLE_LN_WEIGHT: f32 = -14.0;
+
+// Whether the weight's mass is under e^NEGLIGIBLE_LN_WEIGHT of a light centred on the lobe's
+// (LongitudinalWeight::negligible).
+fn longitudinal_weight_negligible(w: LongitudinalWeight) -> bool {
+    return w.ln_w_peak + log(w.lambda / w.lambda_m) < NEGLIGIBLE_LN_WEIGHT;
 }
 
 // Newton's stop for the weight's peak (radians; PEAK_STEP_TOLERANCE in fast_response.rs).
@@ -219,10 +242,12 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
     return w;
 }
 
-fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, sin_theta_j: f32, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+    let sin_i = sin(ti);
+    let cos_i = cos(ti);
     let d = (ti - w.peak) / w.lambda;
-    let ln_ratio = clamp(longitudinal_ln_w(w, ti) - w.ln_w_peak + d * d, -80.0, 20.0);
-    return outer_integrand(params, lobe, light, cos_theta_j, phi_o, longitudinal, ti, ln_ratio);
+    let ln_ratio = clamp(longitudinal_ln_w_at(w, ti, sin_i, cos_i, sin_theta_j, cos_theta_j) - w.ln_w_peak + d * d, -80.0, 20.0);
+    return outer_integrand(params, lobe, light, cos_theta_j, phi_o, longitudinal, ti, sin_i, cos_i, ln_ratio);
 }
 
 // The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
@@ -310,15 +335,16 @@ fn srbf_response_lobe_in_view(params: FastHairParams, lobe: u32, longitudinal: L
     let lambda_m = 2.0 * SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * 2.0 * beta);
-    if (scale < 1e-30) {
-        return vec3<f32>(0.0);
-    }
-    let m = params.quadrature_segments;
+    // A negligible light's lobe runs no node (its quadrature stays 0): a loop that no lane of a SIMD
+    // group enters is skipped, where lavapipe runs both sides of a branch.
+    let skip = longitudinal_weight_negligible(w) || scale < 1e-30;
+    let m = select(params.quadrature_segments, 0u, skip);
+    let sin_j = sin(light.theta);
     let cos_j = cos(light.theta);
     var q = quadrature_start(w.peak, w.lambda);
     for (var s = 1u; s < m; s++) {
         let x = quadrature_sample(s, m, q.mu, q.l);
-        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, cos_j, phi_o, longitudinal, w, x));
+        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, sin_j, cos_j, phi_o, longitudinal, w, x));
     }
     quadrature_end(&q, m);
     return max(scale * q.out, vec3<f32>(0.0));

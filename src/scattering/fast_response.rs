@@ -191,6 +191,17 @@ pub fn tilted_outgoing(theta_o: f32, alpha: f32) -> f32 {
     }
 }
 
+/// 1 - cos x from sin x and cos x: sin^2 x / (1 + cos x) where cos x > 0, so that no cancellation
+/// loses the small values near x = 0 (1 - cos x itself rounds to multiples of 6e-8 there: scaled by a
+/// narrow light's kappa_j = 2 / lambda_j^2, 5e-3 of a logarithm at lambda_j = 0.005).
+pub fn one_minus_cos(sin_x: f32, cos_x: f32) -> f32 {
+    if cos_x > 0.0 {
+        sin_x * sin_x / (1.0 + cos_x)
+    } else {
+        1.0 - cos_x
+    }
+}
+
 /// x beyond which 1 - e^(-x) rounds to 1 in f32 (e^(-x) < 2^-25 from x = 25 ln 2 = 17.33).
 const ONE_MINUS_EXP_IS_ONE: f32 = 17.5;
 
@@ -301,14 +312,8 @@ impl LongitudinalLobe {
         }
         let cos_sum = cos_i * self.cos_tilted - sin_i * self.sin_tilted;
         let sin_sum = sin_i * self.cos_tilted + cos_i * self.sin_tilted;
-        // 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0: no cancellation near the peak.
-        let one_minus_cos = if cos_sum > 0.0 {
-            sin_sum * sin_sum / (1.0 + cos_sum)
-        } else {
-            1.0 - cos_sum
-        };
         let d = theta_i - self.mu;
-        let ln_rest = -one_minus_cos / self.v
+        let ln_rest = -one_minus_cos(sin_sum, cos_sum) / self.v
             + self.ln_m_norm
             + d * d / (2.0 * self.v)
             + self.ln_gaussian_norm;
@@ -325,8 +330,9 @@ pub fn ln_longitudinal_deon(v: f32, theta_i: f32, theta_o: f32, alpha: f32) -> f
 
 /// The smooth factor of the outer integral at theta_i: the longitudinal factor ([`LongitudinalLobe::factor`])
 /// times calN_t.
-/// `cos_theta_j`: the light's cos(theta_j), found once for its nodes; `ln_scale` the weight's ratio to
-/// the quadrature's Gaussian ([`LongitudinalLobe::factor_at`]).
+/// `cos_theta_j`: the light's cos(theta_j), found once for its nodes; (sin, cos)(theta_i) the node's,
+/// shared with its weight; `ln_scale` the weight's ratio to the quadrature's Gaussian
+/// ([`LongitudinalLobe::factor_at`]).
 #[allow(clippy::too_many_arguments)]
 pub fn outer_integrand(
     luts: &Luts,
@@ -338,10 +344,10 @@ pub fn outer_integrand(
     phi_o: f32,
     longitudinal: &LongitudinalLobe,
     theta_i: f32,
+    (sin_i, cos_i): (f32, f32),
     ln_scale: f32,
 ) -> Rgb32 {
     let theta_d = 0.5 * (longitudinal.theta_o - theta_i);
-    let (sin_i, cos_i) = theta_i.sin_cos();
     let lp = azimuthal_bandwidth(light.lambda, cos_i, cos_theta_j);
     let w = longitudinal.factor_at(theta_i, (sin_i, cos_i), ln_scale);
     // An inner node clipped onto a pole (the quadrature skips the end nodes themselves).
@@ -383,12 +389,46 @@ pub struct LongitudinalWeight {
 }
 
 impl LongitudinalWeight {
-    /// ln w(theta) without the 1 / (sqrt(2 pi) beta) factor.
+    /// ln w(theta) without the 1 / (sqrt(2 pi) beta) factor:
+    /// kappa_j (cos(theta - theta_j) - 1) - ((theta - mu_M) / lambda_M)^2.
     pub fn ln_w(&self, theta: f32) -> f32 {
+        let (s, c) = (theta - self.theta_j).sin_cos();
+        self.ln_w_from(theta, s, c)
+    }
+
+    /// [`Self::ln_w`] at a quadrature node whose (sin, cos)(theta) are known, with the light's
+    /// (sin, cos)(theta_j): cos and sin of theta - theta_j by the difference formulas (no cosine per
+    /// node).
+    pub fn ln_w_at(
+        &self,
+        theta: f32,
+        (sin_t, cos_t): (f32, f32),
+        (sin_j, cos_j): (f32, f32),
+    ) -> f32 {
+        let c = cos_t * cos_j + sin_t * sin_j;
+        let s = sin_t * cos_j - cos_t * sin_j;
+        self.ln_w_from(theta, s, c)
+    }
+
+    /// Whether the weight's mass, e^(ln w(theta*)) lambda*, is under e^NEGLIGIBLE_LN_WEIGHT of lambda_M,
+    /// the mass of a light centred on the lobe's peak (WGSL twin: `longitudinal_weight_negligible`).
+    pub fn negligible(&self) -> bool {
+        self.ln_w_peak + (self.lambda / self.lambda_m).ln() < NEGLIGIBLE_LN_WEIGHT
+    }
+
+    fn ln_w_from(&self, theta: f32, sin_d: f32, cos_d: f32) -> f32 {
         let d = (theta - self.mu_m) / self.lambda_m;
-        self.kappa_j * ((theta - self.theta_j).cos() - 1.0) - d * d
+        -self.kappa_j * one_minus_cos(sin_d, cos_d) - d * d
     }
 }
+
+/// A light's lobe is skipped when its longitudinal weight carries less than e^NEGLIGIBLE_LN_WEIGHT
+/// (8.3e-7) of the mass the same light would give the lobe centred on its peak
+/// ([`LongitudinalWeight::negligible`]: a narrow light far from the lobe in theta). Measured over the
+/// 200 views and tangents of `bench-fast`, the radiance a point loses is at most 1e-7 of its total under
+/// the sunny sky, 1e-6 overcast and 4e-5 in the studio (whose 40 lights include many narrow ones), and
+/// 9 %, 6 % and 21 % of the light-lobe pairs are skipped.
+pub const NEGLIGIBLE_LN_WEIGHT: f32 = -14.0;
 
 /// Newton's search for the weight's peak stops after a step below this (radians). It converges
 /// quadratically: the peak left is within ~1e-6 lambda* of the converged one (the 24000 light-lobe pairs
@@ -488,13 +528,15 @@ pub fn srbf_response_lobe_in_view(
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     // The unit-area Gaussian of standard deviation 2 beta in theta_i; the longitudinal factor holds the rest.
     let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * 2.0 * beta);
-    if scale < 1e-30 {
+    if w.negligible() || scale < 1e-30 {
         return [0.0; 3];
     }
-    let cos_j = light.theta.cos();
+    let (sin_j, cos_j) = light.theta.sin_cos();
     linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
+        let (sin_i, cos_i) = ti.sin_cos();
         let d = (ti - w.peak) / w.lambda;
-        let ln_ratio = (w.ln_w(ti) - w.ln_w_peak + d * d).clamp(-80.0, 20.0);
+        let ln_w = w.ln_w_at(ti, (sin_i, cos_i), (sin_j, cos_j));
+        let ln_ratio = (ln_w - w.ln_w_peak + d * d).clamp(-80.0, 20.0);
         outer_integrand(
             luts,
             table,
@@ -505,6 +547,7 @@ pub fn srbf_response_lobe_in_view(
             phi_o,
             longitudinal,
             ti,
+            (sin_i, cos_i),
             ln_ratio,
         )
     })
