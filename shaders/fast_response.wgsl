@@ -128,14 +128,14 @@ fn longitudinal_factor(l: LongitudinalLobe, theta_i: f32) -> f32 {
     return longitudinal_factor_at(l, theta_i, sin(theta_i), cos(theta_i), 0.0);
 }
 
-// longitudinal_factor times e^(ln_scale) at a node whose sin and cos are known (factor_at): the shape's
-// 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o') from the angles' sines and cosines.
 // 1 - cos x as sin^2 x / (1 + cos x) where cos x > 0: no cancellation near x = 0 (one_minus_cos in
 // fast_response.rs).
 fn one_minus_cos(sin_x: f32, cos_x: f32) -> f32 {
     return select(1.0 - cos_x, sin_x * sin_x / (1.0 + cos_x), cos_x > 0.0);
 }
 
+// longitudinal_factor times e^(ln_scale) at a node whose sin and cos are known (factor_at): the shape's
+// 2 sin^2((theta_i + theta_o')/2) as 1 - cos(theta_i + theta_o') from the angles' sines and cosines.
 fn longitudinal_factor_at(l: LongitudinalLobe, theta_i: f32, sin_i: f32, cos_i: f32, ln_scale: f32) -> f32 {
     let ci = max(cos_i, 0.0);
     if (l.longitudinal == LONGITUDINAL_PUBLISHED) {
@@ -189,10 +189,6 @@ fn longitudinal_ln_w_from(w: LongitudinalWeight, theta: f32, sin_d: f32, cos_d: 
     return -w.kappa_j * one_minus_cos(sin_d, cos_d) - d * d;
 }
 
-fn longitudinal_ln_w(w: LongitudinalWeight, theta: f32) -> f32 {
-    return longitudinal_ln_w_from(w, theta, sin(theta - w.theta_j), cos(theta - w.theta_j));
-}
-
 // At a node whose sin and cos are known, with the light's (LongitudinalWeight::ln_w_at): no cosine
 // per node.
 fn longitudinal_ln_w_at(w: LongitudinalWeight, theta: f32, sin_t: f32, cos_t: f32, sin_j: f32, cos_j: f32) -> f32 {
@@ -202,8 +198,8 @@ fn longitudinal_ln_w_at(w: LongitudinalWeight, theta: f32, sin_t: f32, cos_t: f3
 // A light's lobe is skipped below this (NEGLIGIBLE_LN_WEIGHT in fast_response.rs).
 const NEGLIGIBLE_LN_WEIGHT: f32 = -14.0;
 
-// Whether the weight's mass is under e^NEGLIGIBLE_LN_WEIGHT of a light centred on the lobe's
-// (LongitudinalWeight::negligible).
+// Whether the weight's mass is under e^NEGLIGIBLE_LN_WEIGHT of lambda_M, the lobe's under a light of
+// 1 everywhere (LongitudinalWeight::negligible).
 fn longitudinal_weight_negligible(w: LongitudinalWeight) -> bool {
     return w.ln_w_peak + log(w.lambda / w.lambda_m) < NEGLIGIBLE_LN_WEIGHT;
 }
@@ -238,7 +234,9 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
         return w;
     }
     w.lambda = sqrt(2.0 / curvature);
-    w.ln_w_peak = longitudinal_ln_w(w, t);
+    // As at the quadrature's nodes (from sines and cosines), so that their ratios to it share its
+    // rounding.
+    w.ln_w_peak = longitudinal_ln_w_at(w, t, sin(t), cos(t), sin(theta_j), cos(theta_j));
     return w;
 }
 

@@ -12,7 +12,7 @@ use strandlight::scattering::fast_azimuthal::{
     taylor_attenuation, trt_lobes, tt_lobe,
 };
 use strandlight::scattering::fast_params::FastHairParams;
-use strandlight::scattering::fast_response::{SrbfInFrame, srbf_response};
+use strandlight::scattering::fast_response::{SrbfInFrame, longitudinal_weight, srbf_response};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::marschner::AzimuthalLobe;
 use strandlight::scattering::reference::scatter_fraction;
@@ -437,6 +437,34 @@ fn normalised_longitudinal_is_a_unit_density_and_its_f32_twin_agrees() {
     println!(
         "d'Eon M: worst |integral - 1| {worst_norm:.1e}; f32 twin worst relative difference {worst_twin:.1e}"
     );
+}
+
+/// The light weight's logarithm kappa_j (cos(theta - theta_j) - 1) - ((theta - mu_M) / lambda_M)^2, as
+/// the quadrature's nodes and its peak find it (from the angles' sines and cosines, 1 - cos as
+/// sin^2 / (1 + cos)), against its f64 definition within five light widths of the light, down to the
+/// narrowest light of the table's axis (lambda_j = 0.005, kappa_j = 80000): cos(theta - theta_j) - 1 in
+/// f32 rounded to multiples of 6e-8, 4.8e-3 of the logarithm there.
+#[test]
+fn the_light_weights_logarithm_follows_its_f64_definition() {
+    let mut worst = 0.0f64;
+    for lambda_j in [0.005f32, 0.02, 0.1, 0.5] {
+        for k in 0..100 {
+            let theta_j = -1.4 + 2.8 * (k as f32 + 0.5) / 100.0;
+            let (mu_m, lambda_m) = (theta_j + 0.05, 0.2f32);
+            let w = longitudinal_weight(theta_j, lambda_j, mu_m, lambda_m);
+            for s in -20..=20 {
+                let theta = theta_j + s as f32 * 0.25 * lambda_j;
+                let kappa = 2.0 / (lambda_j as f64).powi(2);
+                let d = (theta as f64 - mu_m as f64) / lambda_m as f64;
+                let exact = kappa * ((theta as f64 - theta_j as f64).cos() - 1.0) - d * d;
+                worst = worst.max((w.ln_w(theta) as f64 - exact).abs());
+            }
+        }
+    }
+    println!(
+        "light weight's ln w against f64 within 5 light widths: worst |difference| {worst:.1e}"
+    );
+    assert!(worst < 1e-3, "worst {worst}");
 }
 
 /// The longitudinal factor (f32, [`LongitudinalLobe::factor`]: the shape from the node's sine and

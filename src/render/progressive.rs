@@ -400,17 +400,12 @@ impl Refinement {
     /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
     /// the previous unit of the kind (`last`: costs are uneven, empty rows and empty sweep slots cost
     /// almost nothing, so one cheap unit must not size a huge next one); at least one, at most what
-    /// remains. Before the kind's first measurement, a quarter of the budget over the guess: the
-    /// guesses are one machine's, and on a slower one the first unit overran the budget by the
-    /// guess's error (lavapipe on a 2-core Zen 3 VM: the grid samples' first unit 114-138 ms, 6.7x
-    /// the guessed cost).
+    /// remains.
     fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
-        let budget = self.budget.as_secs_f64();
-        let (per_item, budget) = match per_item {
-            Some(c) => (c.max(1e-12), budget),
-            None => (guess.max(1e-12), 0.25 * budget),
-        };
-        let n = (budget / per_item).floor().min(2.0 * last.max(1) as f64);
+        let per_item = per_item.unwrap_or(guess).max(1e-12);
+        let n = (self.budget.as_secs_f64() / per_item)
+            .floor()
+            .min(2.0 * last.max(1) as f64);
         (n.min(remaining as f64) as u32)
             .max(1)
             .min(remaining.max(1))

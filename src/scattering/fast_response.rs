@@ -392,13 +392,12 @@ impl LongitudinalWeight {
     /// ln w(theta) without the 1 / (sqrt(2 pi) beta) factor:
     /// kappa_j (cos(theta - theta_j) - 1) - ((theta - mu_M) / lambda_M)^2.
     pub fn ln_w(&self, theta: f32) -> f32 {
-        let (s, c) = (theta - self.theta_j).sin_cos();
-        self.ln_w_from(theta, s, c)
+        self.ln_w_at(theta, theta.sin_cos(), self.theta_j.sin_cos())
     }
 
     /// [`Self::ln_w`] at a quadrature node whose (sin, cos)(theta) are known, with the light's
     /// (sin, cos)(theta_j): cos and sin of theta - theta_j by the difference formulas (no cosine per
-    /// node).
+    /// node; the peak's is found the same way, so the nodes' ratios to it share its rounding).
     pub fn ln_w_at(
         &self,
         theta: f32,
@@ -411,7 +410,8 @@ impl LongitudinalWeight {
     }
 
     /// Whether the weight's mass, e^(ln w(theta*)) lambda*, is under e^NEGLIGIBLE_LN_WEIGHT of lambda_M,
-    /// the mass of a light centred on the lobe's peak (WGSL twin: `longitudinal_weight_negligible`).
+    /// the lobe's own (its weight under a light of 1 everywhere; WGSL twin:
+    /// `longitudinal_weight_negligible`).
     pub fn negligible(&self) -> bool {
         self.ln_w_peak + (self.lambda / self.lambda_m).ln() < NEGLIGIBLE_LN_WEIGHT
     }
@@ -423,8 +423,10 @@ impl LongitudinalWeight {
 }
 
 /// A light's lobe is skipped when its longitudinal weight carries less than e^NEGLIGIBLE_LN_WEIGHT
-/// (8.3e-7) of the mass the same light would give the lobe centred on its peak
-/// ([`LongitudinalWeight::negligible`]: a narrow light far from the lobe in theta). Measured over the
+/// (8.3e-7) of the lobe's own mass lambda_M, its weight under a light of 1 everywhere
+/// ([`LongitudinalWeight::negligible`]: a narrow light far from the lobe in theta; relative to the
+/// same light centred on the lobe, whose mass is about lambda_j for a narrow one, the cut is
+/// e^-14 lambda_M / lambda_j: 6e-5 for beta_R = 7.5 degrees and lambda_j = 0.005). Measured over the
 /// 200 views and tangents of `bench-fast`, the radiance a point loses is at most 1e-7 of its total under
 /// the sunny sky, 1e-6 overcast and 4e-5 in the studio (whose 40 lights include many narrow ones), and
 /// 9 %, 6 % and 21 % of the light-lobe pairs are skipped.
