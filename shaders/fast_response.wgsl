@@ -175,7 +175,9 @@ fn outer_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, cos_th
 // The weight M_t g^c(theta_i; theta_j, lambda_j) in Laplace form.
 struct LongitudinalWeight {
     kappa_j: f32,
-    theta_j: f32,
+    // sin(theta_j) and cos(theta_j) of the light: found once for the peak and every node.
+    sin_j: f32,
+    cos_j: f32,
     mu_m: f32,
     lambda_m: f32,
     peak: f32,
@@ -191,8 +193,8 @@ fn longitudinal_ln_w_from(w: LongitudinalWeight, theta: f32, sin_d: f32, cos_d: 
 
 // At a node whose sin and cos are known, with the light's (LongitudinalWeight::ln_w_at): no cosine
 // per node.
-fn longitudinal_ln_w_at(w: LongitudinalWeight, theta: f32, sin_t: f32, cos_t: f32, sin_j: f32, cos_j: f32) -> f32 {
-    return longitudinal_ln_w_from(w, theta, sin_t * cos_j - cos_t * sin_j, cos_t * cos_j + sin_t * sin_j);
+fn longitudinal_ln_w_at(w: LongitudinalWeight, theta: f32, sin_t: f32, cos_t: f32) -> f32 {
+    return longitudinal_ln_w_from(w, theta, sin_t * w.cos_j - cos_t * w.sin_j, cos_t * w.cos_j + sin_t * w.sin_j);
 }
 
 // A light's lobe is skipped below this (NEGLIGIBLE_LN_WEIGHT in fast_response.rs).
@@ -226,7 +228,7 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
             break;
         }
     }
-    var w = LongitudinalWeight(kappa_j, theta_j, mu_m, lambda_m, t, 0.0, 0.0);
+    var w = LongitudinalWeight(kappa_j, sin(theta_j), cos(theta_j), mu_m, lambda_m, t, 0.0, 0.0);
     if (curvature <= 0.25 * k_m) {
         w.peak = mu_m;
         w.lambda = lambda_m;
@@ -236,16 +238,16 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
     w.lambda = sqrt(2.0 / curvature);
     // As at the quadrature's nodes (from sines and cosines), so that their ratios to it share its
     // rounding.
-    w.ln_w_peak = longitudinal_ln_w_at(w, t, sin(t), cos(t), sin(theta_j), cos(theta_j));
+    w.ln_w_peak = longitudinal_ln_w_at(w, t, sin(t), cos(t));
     return w;
 }
 
-fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, sin_theta_j: f32, cos_theta_j: f32, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
+fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, phi_o: f32, longitudinal: LongitudinalLobe, w: LongitudinalWeight, ti: f32) -> vec3<f32> {
     let sin_i = sin(ti);
     let cos_i = cos(ti);
     let d = (ti - w.peak) / w.lambda;
-    let ln_ratio = clamp(longitudinal_ln_w_at(w, ti, sin_i, cos_i, sin_theta_j, cos_theta_j) - w.ln_w_peak + d * d, -80.0, 20.0);
-    return outer_integrand(params, lobe, light, cos_theta_j, phi_o, longitudinal, ti, sin_i, cos_i, ln_ratio);
+    let ln_ratio = clamp(longitudinal_ln_w_at(w, ti, sin_i, cos_i) - w.ln_w_peak + d * d, -80.0, 20.0);
+    return outer_integrand(params, lobe, light, w.cos_j, phi_o, longitudinal, ti, sin_i, cos_i, ln_ratio);
 }
 
 // The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
@@ -334,15 +336,13 @@ fn srbf_response_lobe_in_view(params: FastHairParams, lobe: u32, longitudinal: L
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     let scale = exp(w.ln_w_peak) / (sqrt(2.0 * PI) * 2.0 * beta);
     // A negligible light's lobe runs no node (its quadrature stays 0): a loop that no lane of a SIMD
-    // group enters is skipped, where lavapipe runs both sides of a branch.
-    let skip = longitudinal_weight_negligible(w) || scale < 1e-30;
-    let m = select(params.quadrature_segments, 0u, skip);
-    let sin_j = sin(light.theta);
-    let cos_j = cos(light.theta);
+    // group enters is skipped, where lavapipe runs both sides of a branch. (A scale under 1e-30 is
+    // negligible too: srbf_response_lobe_in_view in fast_response.rs.)
+    let m = select(params.quadrature_segments, 0u, longitudinal_weight_negligible(w));
     var q = quadrature_start(w.peak, w.lambda);
     for (var s = 1u; s < m; s++) {
         let x = quadrature_sample(s, m, q.mu, q.l);
-        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, sin_j, cos_j, phi_o, longitudinal, w, x));
+        quadrature_node(&q, s, m, x, weighted_integrand(params, lobe, light, phi_o, longitudinal, w, x));
     }
     quadrature_end(&q, m);
     return max(scale * q.out, vec3<f32>(0.0));

@@ -380,7 +380,9 @@ pub fn outer_integrand(
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LongitudinalWeight {
     pub kappa_j: f32,
-    pub theta_j: f32,
+    /// sin(theta_j) and cos(theta_j) of the light: found once for the peak and every node.
+    pub sin_j: f32,
+    pub cos_j: f32,
     pub mu_m: f32,
     pub lambda_m: f32,
     pub peak: f32,
@@ -392,20 +394,15 @@ impl LongitudinalWeight {
     /// ln w(theta) without the 1 / (sqrt(2 pi) beta) factor:
     /// kappa_j (cos(theta - theta_j) - 1) - ((theta - mu_M) / lambda_M)^2.
     pub fn ln_w(&self, theta: f32) -> f32 {
-        self.ln_w_at(theta, theta.sin_cos(), self.theta_j.sin_cos())
+        self.ln_w_at(theta, theta.sin_cos())
     }
 
-    /// [`Self::ln_w`] at a quadrature node whose (sin, cos)(theta) are known, with the light's
-    /// (sin, cos)(theta_j): cos and sin of theta - theta_j by the difference formulas (no cosine per
-    /// node; the peak's is found the same way, so the nodes' ratios to it share its rounding).
-    pub fn ln_w_at(
-        &self,
-        theta: f32,
-        (sin_t, cos_t): (f32, f32),
-        (sin_j, cos_j): (f32, f32),
-    ) -> f32 {
-        let c = cos_t * cos_j + sin_t * sin_j;
-        let s = sin_t * cos_j - cos_t * sin_j;
+    /// [`Self::ln_w`] at a quadrature node whose (sin, cos)(theta) are known: cos and sin of
+    /// theta - theta_j by the difference formulas with the light's (no cosine per node; the peak's is
+    /// found the same way, so the nodes' ratios to it share its rounding).
+    pub fn ln_w_at(&self, theta: f32, (sin_t, cos_t): (f32, f32)) -> f32 {
+        let c = cos_t * self.cos_j + sin_t * self.sin_j;
+        let s = sin_t * self.cos_j - cos_t * self.sin_j;
         self.ln_w_from(theta, s, c)
     }
 
@@ -466,9 +463,11 @@ pub fn longitudinal_weight(
             break;
         }
     }
+    let (sin_j, cos_j) = theta_j.sin_cos();
     let mut w = LongitudinalWeight {
         kappa_j,
-        theta_j,
+        sin_j,
+        cos_j,
         mu_m,
         lambda_m,
         peak: t,
@@ -479,7 +478,6 @@ pub fn longitudinal_weight(
         w.peak = mu_m;
         w.lambda = lambda_m;
         w.ln_w_peak = 0.0; // the ratio w / g(theta; mu_M, lambda_M) is the light's g^c itself
-        w.kappa_j = kappa_j;
         return w;
     }
     // ln w ~ ln w(theta*) - (curvature / 2) (theta - theta*)^2, i.e. a Gaussian of bandwidth sqrt(2 / curvature).
@@ -529,15 +527,16 @@ pub fn srbf_response_lobe_in_view(
     let lambda_m = 2.0 * std::f32::consts::SQRT_2 * beta;
     let w = longitudinal_weight(light.theta, light.lambda, longitudinal.mu, lambda_m);
     // The unit-area Gaussian of standard deviation 2 beta in theta_i; the longitudinal factor holds the rest.
-    let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * 2.0 * beta);
-    if w.negligible() || scale < 1e-30 {
+    // A scale under 1e-30 is negligible too (ln w(theta*) < -67 for any beta below 10^22, and
+    // lambda* < 2 lambda_M).
+    if w.negligible() {
         return [0.0; 3];
     }
-    let (sin_j, cos_j) = light.theta.sin_cos();
+    let scale = w.ln_w_peak.exp() / ((2.0 * PI).sqrt() * 2.0 * beta);
     linear_quadrature(p.quadrature_segments, w.peak, w.lambda, |ti| {
         let (sin_i, cos_i) = ti.sin_cos();
         let d = (ti - w.peak) / w.lambda;
-        let ln_w = w.ln_w_at(ti, (sin_i, cos_i), (sin_j, cos_j));
+        let ln_w = w.ln_w_at(ti, (sin_i, cos_i));
         let ln_ratio = (ln_w - w.ln_w_peak + d * d).clamp(-80.0, 20.0);
         outer_integrand(
             luts,
@@ -545,7 +544,7 @@ pub fn srbf_response_lobe_in_view(
             p,
             lobe,
             light,
-            cos_j,
+            w.cos_j,
             phi_o,
             longitudinal,
             ti,
