@@ -463,12 +463,26 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
             "batch {b}'s parts follow each other from the first segment: {parts:?}"
         );
     }
+    // Then the rows the segments cover, gathered and resolved in bands that follow each other.
+    let repaints = units
+        .iter()
+        .take_while(|u| matches!(u, WorkUnit::Repaint { .. }))
+        .count();
+    let bands: Vec<(u32, u32)> = units[repaints..]
+        .iter()
+        .filter_map(|u| match *u {
+            WorkUnit::RepaintGather { row0, rows } => Some((row0, rows)),
+            _ => None,
+        })
+        .collect();
     assert_eq!(
+        repaints + bands.len(),
         units.len(),
-        units
-            .iter()
-            .filter(|u| matches!(u, WorkUnit::Repaint { .. }))
-            .count()
+        "repaint units, then its gather"
+    );
+    assert!(
+        bands.len() >= 2 && bands.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0),
+        "the gather in bands (a budget far below their cost: {bands:?})"
     );
     let got = live.read_frame(&ctx).expect("read");
     // The same dab through a restart.
@@ -513,7 +527,15 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     assert!(live.repaint_points(&second));
     let units = refine_all(&mut live, &ctx);
     println!("the second dab's repaint after the first's: {units:?}");
-    assert_eq!(units.len(), 2 * batches - 1);
+    let parts = |u: &WorkUnit| matches!(u, WorkUnit::Repaint { .. });
+    assert_eq!(units.iter().filter(|u| parts(u)).count(), 2 * batches - 1);
+    // Each repaint ends with its gather: after the first's, the second's batches, then its gather.
+    let gathers = units
+        .iter()
+        .position(|u| !parts(u))
+        .expect("the first's gather");
+    assert_eq!(gathers, batches - 1);
+    assert!(matches!(units.last(), Some(WorkUnit::RepaintGather { .. })));
     dab(&mut restarted, middle);
     dab(&mut restarted, middle + 1);
     restarted.restart();

@@ -43,20 +43,57 @@ pub struct BrushReport {
     pub follow_up_kept_single: bool,
     /// The follow-up's time per pass (units' submission to completion), milliseconds.
     pub follow_up_pass_ms: std::collections::BTreeMap<&'static str, f64>,
+    /// The longest unit the dabs' repaints (or restarts) and the stroke's convergence submitted,
+    /// submission to completion as the waiting CPU saw it (milliseconds), and which; then the
+    /// follow-up's longest (the renderer's own measure).
+    pub longest_unit_ms: f64,
+    pub longest_unit: String,
+    pub follow_up_longest_unit_ms: f64,
+}
+
+/// The longest unit seen while waiting for each ([`wait_for_unit`]).
+#[derive(Default)]
+struct Longest {
+    ms: f64,
+    unit: String,
+}
+
+/// Waits for what `p` submitted (or what is still running), timing a submitted unit from the return
+/// of `refine` to its completion.
+fn wait_for_unit(
+    ctx: &GpuContext,
+    p: &strandlight::render::progressive::Progress,
+    longest: &mut Longest,
+) -> anyhow::Result<()> {
+    if p.submitted.is_none() && !p.busy {
+        return Ok(());
+    }
+    let t = Instant::now();
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    if let Some(unit) = p.submitted.filter(|_| ms > longest.ms) {
+        *longest = Longest {
+            ms,
+            unit: format!("{unit:?}"),
+        };
+    }
+    Ok(())
 }
 
 /// Refines until converged.
-fn converge(ctx: &GpuContext, renderer: &mut Renderer) -> anyhow::Result<()> {
+fn converge(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    longest: &mut Longest,
+) -> anyhow::Result<()> {
     loop {
         let p = renderer.refine(ctx)?;
         if p.converged {
             return Ok(());
         }
-        if p.submitted.is_some() || p.busy {
-            ctx.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
-        }
+        wait_for_unit(ctx, &p, longest)?;
     }
 }
 
@@ -113,6 +150,7 @@ pub fn brush_run(
     let mut layer = PaintLayer::empty(hair.point_count(), hair.strand_count());
     let mut sigma: Vec<[f32; 3]> = base.to_vec();
     let mut stroke = Stroke::new();
+    let mut longest = Longest::default();
     let (mut cpu, mut visible, mut points) = (Vec::new(), Vec::new(), 0usize);
     for k in 0..dabs {
         let x = cx - 0.5 * length + length * k as f32 / dabs.max(2).saturating_sub(1) as f32;
@@ -142,11 +180,7 @@ pub fn brush_run(
             if p.ready.is_some() || p.converged {
                 break;
             }
-            if p.submitted.is_some() || p.busy {
-                ctx.device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
-            }
+            wait_for_unit(ctx, &p, &mut longest)?;
         }
         // A dab that changed no point (off the hair, or where the stroke has saturated) has nothing
         // to show.
@@ -157,15 +191,17 @@ pub fn brush_run(
     // The stroke ends: the image converges with the new colour, then (as the editor does once it
     // shows) the volume and grid follow.
     let t = Instant::now();
-    converge(ctx, renderer)?;
+    converge(ctx, renderer, &mut longest)?;
     let stroke_converged_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
     let mut follow_up_kept_single = false;
+    let mut follow_up_longest_unit_ms = 0.0;
     let mut follow_up_pass_ms = std::collections::BTreeMap::new();
     if renderer.rebuild_stale_volume() {
         follow_up_kept_single = renderer.keeps_single_scattering();
-        converge(ctx, renderer)?;
+        converge(ctx, renderer, &mut Longest::default())?;
         let stats = renderer.refine_stats();
+        follow_up_longest_unit_ms = stats.longest.as_secs_f64() * 1e3;
         for (name, d) in UNIT_PASSES.iter().zip(stats.pass_time) {
             follow_up_pass_ms.insert(*name, d.as_secs_f64() * 1e3);
         }
@@ -187,5 +223,8 @@ pub fn brush_run(
         visible_dabs: visible.len(),
         visible_ms_max: visible.iter().copied().fold(0.0, f64::max),
         visible_ms_median: median(visible),
+        longest_unit_ms: longest.ms,
+        longest_unit: longest.unit,
+        follow_up_longest_unit_ms,
     })
 }

@@ -27,7 +27,6 @@
 
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
-use super::segment_shading::last_light_batch;
 use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
@@ -43,12 +42,12 @@ pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 /// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
-/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: S1's million in
-/// about 40 ms).
-const GUESS_GRID_SAMPLE_S: f64 = 50e-9;
+/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: 350-500 ns on a
+/// 2-core Zen 3 VM; when the guess was 50 ns S1's 343k samples went in one 110-140 ms unit).
+const GUESS_GRID_SAMPLE_S: f64 = 500e-9;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
-/// A voxel resolved (lavapipe, two cores: 100-180 ns).
-const GUESS_VOXEL_S: f64 = 200e-9;
+/// A voxel resolved (lavapipe, two cores: 100-180 ns, 400-480 ns on a 2-core Zen 3 VM).
+const GUESS_VOXEL_S: f64 = 400e-9;
 /// The fewest voxels a resolve unit and rows a backdrop unit hold (a unit's fixed cost, which a tiny
 /// budget cannot hold, would otherwise shrink them to one of each).
 const MIN_RESOLVE_VOXELS: u32 = 16_384;
@@ -63,6 +62,8 @@ const GUESS_SEGMENT_LIGHT_S: f64 = 10e-6;
 /// A pixel of a shading unit's rows (the claim, gather and resolve; lavapipe, two cores: ~0.7 us
 /// on S1).
 const GUESS_PIXEL_S: f64 = 0.5e-6;
+/// A pixel of a repaint's gather and resolve (lavapipe, two cores: 0.65-0.95 us on S1).
+const GUESS_GATHER_PIXEL_S: f64 = 1e-6;
 /// A shading unit listing fewer segments does not update the cost per segment.
 const MIN_MEASURED_SEGMENTS: u64 = 64;
 /// The row width and the lights of that guess.
@@ -115,13 +116,16 @@ pub enum WorkUnit {
     Preview { row0: u32, rows: u32 },
     /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over
     /// `segments` of the segments at the changed points, from the `first`-th (in parts sized to the
-    /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part); the last
-    /// batch's last part gathers and resolves the image.
+    /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part).
     Repaint {
         batch: u32,
         first: u32,
         segments: u32,
     },
+    /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments cover gathered
+    /// from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
+    /// took 30-60 ms on S1 on lavapipe, which pushed the last part that carried them to 60-95 ms).
+    RepaintGather { row0: u32, rows: u32 },
 }
 
 /// The images a display pass reads: the frame's, and a preview under the frame's first `sharp_rows`
@@ -183,6 +187,10 @@ enum Stage {
         batch: u32,
         first: u32,
     },
+    /// The repaint's rows from `row` gathered and resolved (then converged).
+    RepaintGather {
+        row: u32,
+    },
     Converged,
 }
 
@@ -192,7 +200,7 @@ struct InFlight {
     done: Arc<Mutex<Option<Instant>>>,
     /// The restart it was planned under ([`Refinement::restarts`]).
     restart: u64,
-    /// A repaint's part that ends its list (a dab's new repaint may replace the list meanwhile).
+    /// A repaint's gather that ends its rows.
     repaint_end: bool,
 }
 
@@ -324,8 +332,14 @@ pub struct Refinement {
     /// Measured seconds per listed segment and light of a shading unit, and per pixel of its rows.
     segment_cost: Option<f64>,
     pixel_cost: Option<f64>,
+    /// Measured seconds per pixel of a repaint's gather (and resolve).
+    gather_cost: Option<f64>,
     /// Items of the last grid unit.
     grid_last: u32,
+    /// Workgroups the device runs side by side when that is a handful (a software rasteriser's
+    /// threads: lavapipe gives each thread whole workgroups), else 1. A grid unit of fewer entries
+    /// (one workgroup each) than a multiple of it leaves threads idle.
+    parallel_workgroups: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
     /// When the plan was last restarted, and how many times (a finished unit planned before the
@@ -347,6 +361,19 @@ pub struct Refinement {
     preview_shading: Duration,
 }
 
+/// [`Refinement::parallel_workgroups`] of the context's device: a software adapter's threads
+/// (lavapipe runs `LP_NUM_THREADS`, by default one per core), 1 on hardware.
+fn parallel_workgroups(ctx: &GpuContext) -> u32 {
+    if ctx.adapter.get_info().device_type != wgpu::DeviceType::Cpu {
+        return 1;
+    }
+    std::env::var("LP_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<u32>().ok())
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32))
+        .clamp(1, 64)
+}
+
 impl Default for Refinement {
     fn default() -> Self {
         Self {
@@ -357,6 +384,8 @@ impl Default for Refinement {
             shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
+            gather_cost: None,
+            parallel_workgroups: 1,
             samples_cost: None,
             volume_cost: None,
             resolve_cost: None,
@@ -386,6 +415,14 @@ impl Default for Refinement {
 }
 
 impl Refinement {
+    /// A new plan's state for the context's device.
+    pub(super) fn for_device(ctx: &GpuContext) -> Self {
+        Self {
+            parallel_workgroups: parallel_workgroups(ctx),
+            ..Self::default()
+        }
+    }
+
     /// The longest time one unit should take.
     pub(super) fn budget(&self) -> Duration {
         self.budget
@@ -498,7 +535,7 @@ impl Refinement {
             }
             WorkUnit::GridSamples { .. } | WorkUnit::ShadowGrid { .. } => 2,
             WorkUnit::Visibility { .. } | WorkUnit::Backdrop { .. } => 3,
-            WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } => 4,
+            WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } | WorkUnit::RepaintGather { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
         let seconds = elapsed.as_secs_f64();
@@ -546,10 +583,15 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.resolve_cost = ema(self.resolve_cost, per);
             }
-            // Its last part's gather and resolve ride along: an overstatement.
             WorkUnit::Repaint { .. } => {
                 let lights = batch.map_or(1, |b| b.1);
                 self.segments_measured(seconds, lights, listed);
+            }
+            // The gather and resolve of its rows: the cost per pixel.
+            WorkUnit::RepaintGather { .. } => {
+                if let Some((_, pixels)) = listed.filter(|l| l.1 > 0) {
+                    self.gather_cost = ema(self.gather_cost, seconds / pixels as f64);
+                }
             }
             WorkUnit::DensityPyramid
             | WorkUnit::Visibility { .. }
@@ -692,7 +734,7 @@ impl Renderer {
                     && !self.refinement.preview_owed
                     && self.repaint_pending.is_empty()
             }
-            Stage::Repaint { .. } => false,
+            Stage::Repaint { .. } | Stage::RepaintGather { .. } => false,
             _ => self.single_kept,
         };
         self.restart_as_refinement(change);
@@ -712,7 +754,10 @@ impl Renderer {
             && self.segment_targets.is_some()
             && self.visibility_valid
             && !r.preview_owed
-            && matches!(r.stage, Stage::Converged | Stage::Repaint { .. })
+            && matches!(
+                r.stage,
+                Stage::Converged | Stage::Repaint { .. } | Stage::RepaintGather { .. }
+            )
             && self.shading_pass.frame_batches().next().is_some();
         if !ready {
             return false;
@@ -737,6 +782,7 @@ impl Renderer {
                 // let it finish while the pointer moves).
                 self.repaint_pending.extend(segments);
             }
+            Stage::RepaintGather { .. } => self.repaint_pending.extend(segments),
             stage => {
                 // Converged, or planned and not started: one repaint of them all.
                 if stage != Stage::Converged {
@@ -877,10 +923,7 @@ impl Renderer {
                     || (batch + 1 == first_pass && row0 + rows >= self.settings.height);
                 after.then_some(ImageReady::Full)
             }
-            WorkUnit::Repaint { batch, .. } => {
-                let batches = self.shading_pass.frame_batches().count() as u32;
-                (batch + 1 >= batches && repaint_end).then_some(ImageReady::Full)
-            }
+            WorkUnit::RepaintGather { .. } => repaint_end.then_some(ImageReady::Full),
             _ => None,
         };
         let r = &mut self.refinement;
@@ -942,8 +985,8 @@ impl Renderer {
             submitted: Instant::now(),
             done,
             restart: self.refinement.restarts,
-            repaint_end: matches!(unit, WorkUnit::Repaint { first, segments, .. }
-                if (first + segments) as usize >= self.repaint.len()),
+            repaint_end: matches!(unit, WorkUnit::RepaintGather { row0, rows }
+                if row0 + rows >= self.repaint_rows.end),
         });
         self.refinement.stats.units += 1;
         Ok(self.progress(Some(unit), false, ready))
@@ -1139,12 +1182,14 @@ impl Renderer {
             r.samples_done += count;
             return Some(WorkUnit::GridSamples { first, count });
         }
-        let count = r.items(
-            r.grid_cost,
-            GUESS_GRID_ENTRY_S,
-            r.grid_last,
-            target - r.grid_done,
-        );
+        let remaining = target - r.grid_done;
+        let mut count = r.items(r.grid_cost, GUESS_GRID_ENTRY_S, r.grid_last, remaining);
+        // Whole rounds of the device's side-by-side workgroups (an entry is one workgroup): on
+        // lavapipe on two cores three entries took as long as four (40-50 ms against the two's 21).
+        let p = r.parallel_workgroups.max(1);
+        if count > p && count < remaining {
+            count -= count % p;
+        }
         r.grid_last = count;
         let first = r.grid_done;
         r.grid_done += count;
@@ -1402,13 +1447,36 @@ impl Renderer {
                         first: 0,
                     }
                 } else {
-                    Stage::Converged
+                    Stage::RepaintGather {
+                        row: self.repaint_rows.start,
+                    }
                 };
                 Some(WorkUnit::Repaint {
                     batch,
                     first,
                     segments: count,
                 })
+            }
+            Stage::RepaintGather { row } => {
+                // Bands of the rows at the measured cost per pixel (one unit of no rows when the
+                // segments leave none on screen: it still ends the repaint).
+                let end = self.repaint_rows.end.max(row);
+                let r = &mut self.refinement;
+                let width = self.settings.width.max(1) as f64;
+                let rows = r
+                    .items(
+                        r.gather_cost.map(|c| c * width),
+                        GUESS_GATHER_PIXEL_S * width,
+                        u32::MAX / 2,
+                        end - row,
+                    )
+                    .min(end - row);
+                r.stage = if row + rows < end {
+                    Stage::RepaintGather { row: row + rows }
+                } else {
+                    Stage::Converged
+                };
+                Some(WorkUnit::RepaintGather { row0: row, rows })
             }
             Stage::Converged => {
                 // Dabs that came during a repaint.
@@ -1441,6 +1509,9 @@ impl Renderer {
             }
             WorkUnit::Repaint { segments, .. } if !self.single_kept => {
                 return Some((segments as u64, 0));
+            }
+            WorkUnit::RepaintGather { rows, .. } => {
+                return Some((0, rows as u64 * self.settings.width as u64));
             }
             _ => return None,
         };
@@ -1593,26 +1664,26 @@ impl Renderer {
                     ctx.queue
                         .write_buffer(&s.work_count, 0, bytemuck::bytes_of(&count));
                 }
-                let last_part = end as usize >= self.repaint.len();
-                // The gather and resolve over the rows the segments cover.
-                let rows = self.repaint_rows.clone();
+                let inputs = self.shading_inputs();
+                self.shading_pass.encode_repaint(device, enc, &inputs, b);
+            }
+            WorkUnit::RepaintGather { row0, rows } => {
+                // The last batch's flags (what the segments hold) over the band.
+                let Some(last) = self.shading_pass.frame_batches().last() else {
+                    return;
+                };
+                if rows == 0 {
+                    return;
+                }
                 let b = ShadeBatch {
-                    row0: rows.start,
-                    rows: rows.len() as u32,
-                    ..*b
+                    row0,
+                    rows,
+                    ..*last
                 };
                 let inputs = self.shading_inputs();
-                self.shading_pass.encode_repaint(
-                    device,
-                    enc,
-                    &inputs,
-                    &self.targets,
-                    &b,
-                    last_part,
-                );
-                if last_part && last_light_batch(&b) && !rows.is_empty() {
-                    self.encode_resolve(device, enc, rows, (false, false));
-                }
+                self.shading_pass
+                    .encode_repaint_gather(device, enc, &inputs, &self.targets, &b);
+                self.encode_resolve(device, enc, row0..row0 + rows, (false, false));
             }
             WorkUnit::Shade { batch, row0, rows } => {
                 let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {

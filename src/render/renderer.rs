@@ -623,7 +623,7 @@ impl Renderer {
             point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
-            refinement: Refinement::default(),
+            refinement: Refinement::for_device(ctx),
             preview_mode: PreviewMode::Off,
             preview: None,
             visibility_valid: false,

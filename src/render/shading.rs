@@ -346,17 +346,14 @@ impl ShadingPass {
     }
 
     /// A repaint's light batch: the segments listed in the segment targets' work list (written by
-    /// the caller) shaded again, no claim; with `gather`, after the frame's last light batch, rows
-    /// `batch.row0 .. + batch.rows` of the components gathered from the segments (a repaint's last
-    /// part).
+    /// the caller) shaded again, no claim (the rows gather after the last batch:
+    /// [`Self::encode_repaint_gather`]).
     pub fn encode_repaint(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         inputs: &ShadingInputs,
-        targets: &FrameTargets,
         batch: &ShadeBatch,
-        gather: bool,
     ) {
         let Some(segments) = inputs.segment_targets else {
             return;
@@ -364,11 +361,25 @@ impl ShadingPass {
         let uniform = batch_uniform(device, batch);
         self.segments
             .encode_listed(device, encoder, inputs, segments, &uniform);
-        if gather && last_light_batch(batch) {
-            let size = (targets.width, batch.rows);
-            self.segments.encode_gather(
-                device, encoder, inputs, targets, segments, &uniform, size, None,
-            );
-        }
+    }
+
+    /// A repaint's gather: rows [batch.row0, + batch.rows) of the components from the segments'
+    /// radiance (`batch` the last light batch's, over the rows).
+    pub fn encode_repaint_gather(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        targets: &FrameTargets,
+        batch: &ShadeBatch,
+    ) {
+        let Some(segments) = inputs.segment_targets else {
+            return;
+        };
+        let uniform = batch_uniform(device, batch);
+        let size = (targets.width, batch.rows);
+        self.segments.encode_gather(
+            device, encoder, inputs, targets, segments, &uniform, size, None,
+        );
     }
 }
