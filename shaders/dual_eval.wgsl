@@ -32,5 +32,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     dual_results[4u * i] = vec4<f32>(global_response_lobe(q.params, 0u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
     dual_results[4u * i + 1u] = vec4<f32>(global_response_lobe(q.params, 1u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
     dual_results[4u * i + 2u] = vec4<f32>(global_response_lobe(q.params, 2u, light, q.theta_o, q.phi_o, q.sigma_f2), 0.0);
-    dual_results[4u * i + 3u] = vec4<f32>(local_response(q.params, light, q.theta_o, q.phi_o, q.sigma_f2, q.depth_behind), 0.0);
+    dual_results[4u * i + 3u] = vec4<f32>(local_response(q.params, dual_cells(q.params.sigma_a.xyz), light, q.theta_o, q.phi_o, q.sigma_f2, q.depth_behind), 0.0);
 }

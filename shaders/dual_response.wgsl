@@ -1,8 +1,9 @@
 // Multiple scattering per SRBF light by dual scattering (Xu 2011 Sec. 4.3, Zinke 2008): twin of
-// src/scattering/dual_response.rs and of DualTables::lookup / mean_delta_sigma in dual_terms.rs.
+// src/scattering/dual_response.rs and of DualTables::backscatter_in_cell / mean_delta_sigma in dual_terms.rs.
 // Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response. The includer
 // binds `dual_tables`: one row per sample of the absorption axis (DUAL_ROW vec4 each), a row holding
-// DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample; one absorption: component 0) followed
+// DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample; one absorption: component 0, and
+// for A_b and a_f their logarithms, DualRow::ln_big_a_b and ln_a_f, in component 1) followed
 // by (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b). Each channel reads the rows at
 // its own sigma_a (DualTables::lookup).
 
@@ -35,34 +36,24 @@ fn dual_sigma_cell(s: f32) -> DualCell {
     return DualCell(j, y - f32(j));
 }
 
-// DualRow::lookup of one row, term k (0 = A_b, 1 = Delta_b, 2 = sigma_b, 3 = a_f).
-fn dual_row_lookup(row: u32, k: u32, theta: f32) -> f32 {
+// DualRow::ln_backscatter_at of one row: ln A_b (k = 0) or ln a_f (k = 3) at theta, linear between
+// the samples (the texels' .y).
+fn dual_row_ln(row: u32, k: u32, theta: f32) -> f32 {
     let x = dual_position(theta);
     let i = min(u32(x), DUAL_SAMPLES - 2u);
     let w = x - f32(i);
     let base = row * DUAL_ROW;
-    return mix(dual_tables[base + 4u * i + k].x, dual_tables[base + 4u * (i + 1u) + k].x, w);
+    return mix(dual_tables[base + 4u * i + k].y, dual_tables[base + 4u * (i + 1u) + k].y, w);
 }
-
-// geometric_mix (dual_terms.rs): A_b and a_f fall off about exponentially with the absorption.
-fn geometric_mix(a: f32, b: f32, w: f32) -> f32 {
-    if (a > 0.0 && b > 0.0) {
-        return exp(mix(log(a), log(b), w));
-    }
-    return mix(a, b, w);
+// DualTables::backscatter_in_cell: A_b (k = 0) or a_f (k = 3) at theta and one channel's absorption
+// cell, log-linear in theta and along the axis.
+fn dual_backscatter(k: u32, theta: f32, c: DualCell) -> f32 {
+    return exp(mix(dual_row_ln(c.row, k, theta), dual_row_ln(c.row + 1u, k, theta), c.w));
 }
-
-// DualTables::lookup, term k, at theta and the axis cell of one channel's absorption: geometric
-// between the axis' rows for A_b and a_f, linear for the angles.
-fn dual_lookup(k: u32, theta: f32, c: DualCell) -> f32 {
-    let a = dual_row_lookup(c.row, k, theta);
-    let b = dual_row_lookup(c.row + 1u, k, theta);
-    if (k == 0u || k == 3u) {
-        return geometric_mix(a, b, c.w);
-    }
-    return mix(a, b, c.w);
+// The axis cells of a point's three channels (found once per point: local_response reads them).
+fn dual_cells(sigma_a: vec3<f32>) -> array<DualCell, 3> {
+    return array<DualCell, 3>(dual_sigma_cell(sigma_a.x), dual_sigma_cell(sigma_a.y), dual_sigma_cell(sigma_a.z));
 }
-
 fn dual_sat(row: u32, k: u32, x: f32) -> f32 {
     let i = min(u32(x), DUAL_SAMPLES - 1u);
     let w = x - f32(i);
@@ -71,14 +62,14 @@ fn dual_sat(row: u32, k: u32, x: f32) -> f32 {
 }
 
 // DualRow::mean_delta_sigma of one row: means of Delta_b and sigma_b over theta in [lo, hi] (Xu Eq. 31).
+// The CPU twin reads the sample at the middle of a window under 1e-4 entries; local_response's
+// windows are 2 forward_spread >= 2e-3 rad wide, at least 0.04 entries after any clamp at a pole
+// (their middle lies within [-pi/2, pi/2]), so that branch (which lavapipe would run beside this one)
+// is left out here.
 fn dual_row_mean(row: u32, lo: f32, hi: f32) -> vec2<f32> {
     let a = dual_position(min(lo, hi)) + 0.5;
     let b = dual_position(max(lo, hi)) + 0.5;
-    if (b - a < 1e-4) {
-        let t = 0.5 * (lo + hi);
-        return vec2<f32>(dual_row_lookup(row, 1u, t), dual_row_lookup(row, 2u, t));
-    }
-    return vec2<f32>(dual_sat(row, 0u, b) - dual_sat(row, 0u, a), dual_sat(row, 1u, b) - dual_sat(row, 1u, a)) / (b - a);
+    return vec2<f32>(dual_sat(row, 0u, b) - dual_sat(row, 0u, a), dual_sat(row, 1u, b) - dual_sat(row, 1u, a)) / max(b - a, 1e-4);
 }
 
 // DualTables::mean_delta_sigma for one channel, at the axis cell of its absorption: (Delta_b, sigma_b).
@@ -124,7 +115,7 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_table_box(d.lobe, p.sigma_a.xyz, theta_d, d.dphi);
     }
-    let a = dual_lookup(0u, theta_d, d.cell) * backscatter_depth_fraction(dual_lookup(3u, theta_d, d.cell), d.depth_behind);
+    let a = dual_backscatter(0u, theta_d, d.cell) * backscatter_depth_fraction(dual_backscatter(3u, theta_d, d.cell), d.depth_behind);
     return vec3<f32>(w * a);
 }
 
@@ -166,16 +157,18 @@ fn global_response_lobe_in_view(p: FastHairParams, lobe: u32, longitudinal: Long
 }
 
 // M^L per unit light power (Xu Eq. 29-31).
-// depth_behind: optical depth of the hair behind the point along the light's travel (DEPTH_UNBOUNDED: Zinke's).
-fn local_response(p: FastHairParams, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32, depth_behind: f32) -> vec3<f32> {
+// cells: dual_cells of the point's absorption p.sigma_a; depth_behind: optical depth of the hair behind
+// the point along the light's travel (DEPTH_UNBOUNDED: Zinke's).
+fn local_response(p: FastHairParams, cells: array<DualCell, 3>, light: SrbfInFrame, theta_o: f32, phi_o: f32, sigma_f2: f32, depth_behind: f32) -> vec3<f32> {
     let sigma = forward_spread(sigma_f2, light.lambda);
     let azimuthal = (PI - abs(wrap_angle(light.phi - phi_o))) / (PI * PI);
     let lo = 0.5 * (theta_o - (light.theta + sigma));
     let hi = 0.5 * (theta_o - (light.theta - sigma));
     var out = vec3<f32>(0.0);
+    var cs = cells;
     for (var c = 0u; c < 3u; c++) {
-        // Each channel at the point's own absorption (its axis cell found once).
-        let cell = dual_sigma_cell(p.sigma_a[c]);
+        // Each channel at the point's own absorption (its axis cell found once per point).
+        let cell = cs[c];
         let ds = mean_delta_sigma(lo, hi, cell);
         let sb = max(ds.y, 1e-3);
         // Zinke's back lobe as M with tilt Delta_b / 2 and width sigma_b / 2 (dual_response.rs).

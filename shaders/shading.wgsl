@@ -76,6 +76,8 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
     let frame = fiber_frame(sp.tangent);
     let o = fiber_angles(frame, omega_o);
     let lobes = view_lobes(p, o.x);
+    // The dual tables' absorption cells of the point's channels (the local term's).
+    let cells = dual_cells(sp.sigma_a);
     var out = LobeRadiance(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var j = first; j < first + count; j++) {
         let l = lights[j];
@@ -110,7 +112,7 @@ fn shade_point(sp: ShadingPoint, omega_o: vec3<f32>, first: u32, count: u32, sha
             // Part 0 the direct light's local term (no spread), part 1 the scattered light's.
             let spread_apart = scattered && !(s2 == 0.0 && lit);
             for (var part = select(1u, 0u, lit); part < select(1u, 2u, spread_apart); part++) {
-                let v = local_response(p, light, o.x, o.y, select(0.0, s2, part == 1u), sh.depth_behind);
+                let v = local_response(p, cells, light, o.x, o.y, select(0.0, s2, part == 1u), sh.depth_behind);
                 if (part == 0u) {
                     local_direct = v;
                 } else {

@@ -408,7 +408,7 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
     let base = HairParams::default();
     let t = DualTables::build(&base, XU_ROOTS);
     let mut rng = common::Uniform::new(7);
-    let mut errors: [Vec<f64>; 4] = Default::default();
+    let mut errors: [Vec<f64>; 6] = Default::default();
     for _ in 0..400 {
         let sigma = (rng.random_range(0.0..1.0) * (8.0f32 / 0.01).ln()).exp() * 0.01;
         let theta = rng.random_range(-1.4..1.4);
@@ -426,10 +426,21 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
         // Shifts and widths are angles: relative to the lobe's width.
         errors[2].push(rel(got.delta_b[0], want.delta_b[0], want.sigma_b[0]));
         errors[3].push(rel(got.sigma_b[0], want.sigma_b[0], want.sigma_b[0]));
+        // M^L's reading: log-linear in theta and along the axis, from the rows' logarithms.
+        let (big_a_b, a_f) = t.backscatter_at(theta, sigma);
+        errors[4].push(rel(big_a_b, want.big_a_b[0], want.big_a_b[0]));
+        errors[5].push(rel(a_f, want.a_f[0], want.a_f[0]));
     }
-    for (name, e) in ["A_b", "a_f", "Delta_b", "sigma_b"]
-        .iter()
-        .zip(errors.iter_mut())
+    for (name, e) in [
+        "A_b",
+        "a_f",
+        "Delta_b",
+        "sigma_b",
+        "A_b (M^L's log-linear reading)",
+        "a_f (M^L's log-linear reading)",
+    ]
+    .iter()
+    .zip(errors.iter_mut())
     {
         e.sort_by(f64::total_cmp);
         let (median, p95, max) = (e[e.len() / 2], e[e.len() * 95 / 100], e[e.len() - 1]);

@@ -15,11 +15,16 @@ pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
     let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
     let mut out = Vec::with_capacity(t.rows.len() * DUAL_ROW);
     for row in &t.rows {
-        out.extend(
-            row.samples
-                .iter()
-                .flat_map(|s| [v4(s.big_a_b), v4(s.delta_b), v4(s.sigma_b), v4(s.a_f)]),
-        );
+        // A_b and a_f with their logarithms in .y (M^L's log-linear reading).
+        let with_ln = |v: f32, ln: f32| [v, ln, 0.0, 0.0];
+        out.extend(row.samples.iter().enumerate().flat_map(|(i, s)| {
+            [
+                with_ln(s.big_a_b[0], row.ln_big_a_b[i]),
+                v4(s.delta_b),
+                v4(s.sigma_b),
+                with_ln(s.a_f[0], row.ln_a_f[i]),
+            ]
+        }));
         for (d, s) in row.sat_delta.iter().zip(&row.sat_sigma) {
             out.push(v4(*d));
             out.push(v4(*s));

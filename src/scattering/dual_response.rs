@@ -10,7 +10,7 @@
 //! pi lambda_j^2 (1 - e^(-4 / lambda_j^2)) and radiance.
 
 use super::azimuthal_table::AzimuthalTable;
-use super::dual_terms::{DualTables, HairBehind};
+use super::dual_terms::{DualTables, HairBehind, sigma_cell};
 use super::fast_azimuthal::Rgb32;
 use super::fast_params::FastHairParams;
 use super::fast_response::{LongitudinalLobe, SrbfInFrame, gaussian_product, linear_quadrature};
@@ -145,16 +145,17 @@ pub fn local_response_behind(
     let azimuthal = (PI - wrap_angle_f32(light.phi - phi_o).abs()) / (PI * PI);
     let lo = 0.5 * (theta_o - (light.theta + sigma));
     let hi = 0.5 * (theta_o - (light.theta - sigma));
-    // Each channel at the point's own absorption (a painted strand's, not the hair's mean).
-    let sigma_a = p.sigma_a_rgb();
-    let (delta, sig_b) = tables.mean_delta_sigma(lo, hi, sigma_a);
+    // Each channel at the point's own absorption (a painted strand's, not the hair's mean), its axis
+    // cell found once.
+    let cells = p.sigma_a_rgb().map(sigma_cell);
     let mut out = [0.0; 3];
     for c in 0..3 {
-        let sb = sig_b[c].max(1e-3);
+        let (delta_c, sig_b_c) = tables.mean_delta_sigma_in_cell(lo, hi, cells[c]);
+        let sb = sig_b_c.max(1e-3);
         // Zinke's back lobe g(theta_i + theta_o - Delta_b; sigma_b) is M with tilt Delta_b / 2 and width sigma_b / 2:
         // published, its explicit factor 2 (Eq. 10) and cos^2/cos^2(theta_d); normalised, d'Eon's M of variance
         // sigma_b^2.
-        let back = LongitudinalLobe::new(p.longitudinal, theta_o, 0.5 * delta[c], 0.5 * sb);
+        let back = LongitudinalLobe::new(p.longitudinal, theta_o, 0.5 * delta_c, 0.5 * sb);
         let (scale, mu, l) = gaussian_product(light.theta, SQRT_2 * sigma, back.mu, SQRT_2 * sb);
         let k = azimuthal * scale / (2.0 * PI * sigma * sb * light.theta.cos().max(1e-3));
         if k < 1e-30 {
@@ -166,7 +167,7 @@ pub fn local_response_behind(
             l,
             |ti| {
                 let theta_d = 0.5 * (theta_o - ti);
-                let (big_a_b, a_f) = tables.backscatter_at(theta_d, sigma_a[c]);
+                let (big_a_b, a_f) = tables.backscatter_in_cell(theta_d, cells[c]);
                 let a = big_a_b * behind.fraction(a_f);
                 [a * back.factor(ti); 3]
             },
