@@ -5,7 +5,7 @@
 // DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample; one absorption: component 0, and
 // for A_b and a_f their logarithms, DualRow::ln_big_a_b and ln_a_f, in component 1) followed
 // by (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b). Each channel reads the rows at
-// its own sigma_a (DualTables::lookup).
+// its own sigma_a (DualTables::backscatter_in_cell, mean_delta_sigma_in_cell).
 
 const DUAL_SAMPLES: u32 = 128u;
 const DUAL_ROW: u32 = 4u * DUAL_SAMPLES + 2u * (DUAL_SAMPLES + 1u);
@@ -63,9 +63,9 @@ fn dual_sat(row: u32, k: u32, x: f32) -> f32 {
 
 // DualRow::mean_delta_sigma of one row: means of Delta_b and sigma_b over theta in [lo, hi] (Xu Eq. 31).
 // The CPU twin reads the sample at the middle of a window under 1e-4 entries; local_response's
-// windows are 2 forward_spread >= 2e-3 rad wide, at least 0.04 entries after any clamp at a pole
-// (their middle lies within [-pi/2, pi/2]), so that branch (which lavapipe would run beside this one)
-// is left out here.
+// windows are forward_spread >= 1e-3 rad wide (0.04 entries), at least half of that after a clamp at
+// a pole (their middle lies within [-pi/2, pi/2]), so that branch (which lavapipe would run beside
+// this one) is left out here.
 fn dual_row_mean(row: u32, lo: f32, hi: f32) -> vec2<f32> {
     let a = dual_position(min(lo, hi)) + 0.5;
     let b = dual_position(max(lo, hi)) + 0.5;

@@ -408,7 +408,7 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
     let base = HairParams::default();
     let t = DualTables::build(&base, XU_ROOTS);
     let mut rng = common::Uniform::new(7);
-    let mut errors: [Vec<f64>; 6] = Default::default();
+    let mut errors: [Vec<f64>; 8] = Default::default();
     for _ in 0..400 {
         let sigma = (rng.random_range(0.0..1.0) * (8.0f32 / 0.01).ln()).exp() * 0.01;
         let theta = rng.random_range(-1.4..1.4);
@@ -426,18 +426,24 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
         // Shifts and widths are angles: relative to the lobe's width.
         errors[2].push(rel(got.delta_b[0], want.delta_b[0], want.sigma_b[0]));
         errors[3].push(rel(got.sigma_b[0], want.sigma_b[0], want.sigma_b[0]));
-        // M^L's reading: log-linear in theta and along the axis, from the rows' logarithms.
+        // Against the exact terms at theta itself: M^L's reading (log-linear in theta and along the
+        // axis, from the rows' logarithms) and the linear reading in theta.
+        let exact = dual_sample(&p, XU_ROOTS, theta as f64);
         let (big_a_b, a_f) = t.backscatter_at(theta, sigma);
-        errors[4].push(rel(big_a_b, want.big_a_b[0], want.big_a_b[0]));
-        errors[5].push(rel(a_f, want.a_f[0], want.a_f[0]));
+        errors[4].push(rel(big_a_b, exact.big_a_b[0], exact.big_a_b[0]));
+        errors[5].push(rel(a_f, exact.a_f[0], exact.a_f[0]));
+        errors[6].push(rel(got.big_a_b[0], exact.big_a_b[0], exact.big_a_b[0]));
+        errors[7].push(rel(got.a_f[0], exact.a_f[0], exact.a_f[0]));
     }
     for (name, e) in [
         "A_b",
         "a_f",
         "Delta_b",
         "sigma_b",
-        "A_b (M^L's log-linear reading)",
-        "a_f (M^L's log-linear reading)",
+        "A_b at theta, M^L's log-linear reading",
+        "a_f at theta, M^L's log-linear reading",
+        "A_b at theta, the linear reading",
+        "a_f at theta, the linear reading",
     ]
     .iter()
     .zip(errors.iter_mut())
@@ -447,6 +453,13 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
         println!(
             "{name}: absorption axis against the exact absorption: median {median:.2e}, p95 {p95:.2e}, max {max:.2e}"
         );
-        assert!(p95 < 0.01 && max < 0.02, "{name}: p95 {p95}, max {max}");
+        // The linear reading in theta (the tables' `lookup`, M^L's before) is printed for comparison:
+        // at the exact theta its A_b p95 is 1.0 %, the log-linear reading's 0.84 %.
+        let bound = if name.ends_with("the linear reading") {
+            0.015
+        } else {
+            0.01
+        };
+        assert!(p95 < bound && max < 0.02, "{name}: p95 {p95}, max {max}");
     }
 }

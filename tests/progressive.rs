@@ -435,14 +435,14 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     let events = refine_events(&mut live, &ctx);
     let units: Vec<WorkUnit> = events.iter().filter_map(|e| e.0).collect();
     println!("repaint of {} points: {units:?}", changed.len());
-    // The full image is ready once, after the last batch's last part.
+    // The full image is ready once, after the last gather band.
     let ready: Vec<usize> = (0..events.len())
         .filter(|&i| events[i].1 == Some(ImageReady::Full))
         .collect();
     let last_unit = events.iter().rposition(|e| e.0.is_some());
     assert!(
         ready.len() == 1 && last_unit.is_some_and(|u| ready[0] > u),
-        "one full image, after the last part: ready at {ready:?}, last unit at {last_unit:?}"
+        "one full image, after the gather: ready at {ready:?}, last unit at {last_unit:?}"
     );
     let batches = lights.len().div_ceil(16);
     assert!(units.len() >= 2 * batches, "each batch in parts");
@@ -548,6 +548,44 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     println!("a small dab moved the image by {moved:.1e}");
     assert!(moved > 0.0, "the small dab shows");
     assert_eq!(difference(&want, &got), 0.0, "a small dab's repaint");
+    // A dab while a repaint's gather is under way waits for it, then repaints; against a restart.
+    let third = dab(&mut live, middle + 2);
+    assert!(live.repaint_points(&third));
+    loop {
+        let p = live.refine(&ctx).expect("refine");
+        assert!(!p.converged, "the repaint ends with its gather");
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+        if matches!(p.submitted, Some(WorkUnit::RepaintGather { .. })) {
+            break;
+        }
+    }
+    let fourth = dab(&mut live, middle + 3);
+    assert!(live.repaint_points(&fourth));
+    let units = refine_all(&mut live, &ctx);
+    println!("a dab during the gather: {units:?}");
+    let first_part = units
+        .iter()
+        .position(|u| matches!(u, WorkUnit::Repaint { .. }))
+        .expect("the waiting dab's repaint");
+    assert!(
+        first_part > 0
+            && units[..first_part]
+                .iter()
+                .all(|u| matches!(u, WorkUnit::RepaintGather { .. })),
+        "the gather under way (bands of a row or two at this budget) ends first"
+    );
+    assert!(matches!(units.last(), Some(WorkUnit::RepaintGather { .. })));
+    dab(&mut restarted, middle + 2);
+    dab(&mut restarted, middle + 3);
+    restarted.restart();
+    refine_all(&mut restarted, &ctx);
+    let (got, want) = (
+        live.read_frame(&ctx).expect("read"),
+        restarted.read_frame(&ctx).expect("read"),
+    );
+    assert_eq!(difference(&want, &got), 0.0, "a dab during a gather");
     // Still refining: refused.
     live.set_camera(&ctx, &scene.camera);
     assert!(!live.repaint_points(&changed));

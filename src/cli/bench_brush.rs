@@ -11,7 +11,7 @@ use strandlight::paint::brush::{Stroke, effective, eumelanin_unit};
 use strandlight::paint::pick::{Picker, ViewDepth};
 use strandlight::paint::{Brush, PaintLayer};
 use strandlight::render::Renderer;
-use strandlight::render::progressive::UNIT_PASSES;
+use strandlight::render::progressive::{Progress, UNIT_PASSES, WorkUnit};
 
 #[derive(Serialize)]
 pub struct BrushReport {
@@ -51,33 +51,39 @@ pub struct BrushReport {
     pub follow_up_longest_unit_ms: f64,
 }
 
-/// The longest unit seen while waiting for each ([`wait_for_unit`]).
+/// The longest unit seen ([`Longest::submitted`], [`wait_for_unit`]).
 #[derive(Default)]
 struct Longest {
     ms: f64,
     unit: String,
+    /// The unit submitted last and when `refine` returned it (a unit submitted by the call that
+    /// showed a dab is waited for at the next dab).
+    in_flight: Option<(WorkUnit, Instant)>,
 }
 
-/// Waits for what `p` submitted (or what is still running), timing a submitted unit from the return
-/// of `refine` to its completion.
-fn wait_for_unit(
-    ctx: &GpuContext,
-    p: &strandlight::render::progressive::Progress,
-    longest: &mut Longest,
-) -> anyhow::Result<()> {
+impl Longest {
+    /// Notes what a `refine` call submitted.
+    fn submitted(&mut self, p: &Progress) {
+        if let Some(unit) = p.submitted {
+            self.in_flight = Some((unit, Instant::now()));
+        }
+    }
+}
+
+/// Waits for what `p` submitted (or what is still running), timing the unit in flight from the
+/// return of the `refine` that submitted it to its completion.
+fn wait_for_unit(ctx: &GpuContext, p: &Progress, longest: &mut Longest) -> anyhow::Result<()> {
     if p.submitted.is_none() && !p.busy {
         return Ok(());
     }
-    let t = Instant::now();
     ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
-    let ms = t.elapsed().as_secs_f64() * 1e3;
-    if let Some(unit) = p.submitted.filter(|_| ms > longest.ms) {
-        *longest = Longest {
-            ms,
-            unit: format!("{unit:?}"),
-        };
+    if let Some((unit, t)) = longest.in_flight.take() {
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        if ms > longest.ms {
+            (longest.ms, longest.unit) = (ms, format!("{unit:?}"));
+        }
     }
     Ok(())
 }
@@ -90,6 +96,7 @@ fn converge(
 ) -> anyhow::Result<()> {
     loop {
         let p = renderer.refine(ctx)?;
+        longest.submitted(&p);
         if p.converged {
             return Ok(());
         }
@@ -177,6 +184,7 @@ pub fn brush_run(
         // Refine until the dab shows (its preview, or the full image without one).
         loop {
             let p = renderer.refine(ctx)?;
+            longest.submitted(&p);
             if p.ready.is_some() || p.converged {
                 break;
             }

@@ -10,7 +10,10 @@ use wgpu::util::DeviceExt;
 
 /// Per row of the absorption axis ([`DUAL_ROW`] vec4): A_b, Delta_b, sigma_b, a_f per sample (4 vec4),
 /// then the prefix sums of Delta_b and sigma_b (2 vec4 per entry), as `dual_response.wgsl` reads them.
-/// A row's channels are equal (one absorption); the shader reads component 0.
+/// A row's channels are equal (one absorption): A_b's and a_f's texels are (value, its logarithm
+/// [`crate::scattering::dual_terms::DualRow::ln_big_a_b`] / `ln_a_f`, 0, 0), and the shader reads the logarithms and the prefix sums'
+/// component 0 (the values and the per-sample Delta_b and sigma_b stay for the CPU's layout; unread
+/// there).
 pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
     let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
     let mut out = Vec::with_capacity(t.rows.len() * DUAL_ROW);

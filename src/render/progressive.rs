@@ -362,7 +362,7 @@ pub struct Refinement {
 }
 
 /// [`Refinement::parallel_workgroups`] of the context's device: a software adapter's threads
-/// (lavapipe runs `LP_NUM_THREADS`, by default one per core), 1 on hardware.
+/// (lavapipe runs `LP_NUM_THREADS`, by default one per core, at most 32), 1 on hardware.
 fn parallel_workgroups(ctx: &GpuContext) -> u32 {
     if ctx.adapter.get_info().device_type != wgpu::DeviceType::Cpu {
         return 1;
@@ -371,7 +371,7 @@ fn parallel_workgroups(ctx: &GpuContext) -> u32 {
         .ok()
         .and_then(|v| v.trim().parse::<u32>().ok())
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32))
-        .clamp(1, 64)
+        .clamp(1, 32)
 }
 
 impl Default for Refinement {
@@ -744,7 +744,8 @@ impl Renderer {
     /// A brush dab on an image converged by segment: the segments that join the changed points
     /// `changed` are shaded again under every light ([`WorkUnit::Repaint`] units, light batch by light
     /// batch, each in parts sized to the budget) and
-    /// the image is gathered from the segments, in place of a restart. The dab shows at full
+    /// the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of a
+    /// restart. The dab shows at full
     /// resolution after work on its segments alone; every other segment's radiance depends on its
     /// own points only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
     /// False, nothing planned, when the image is not converged by segment: the caller restarts.
@@ -1167,6 +1168,7 @@ impl Renderer {
     /// are built.
     fn grid_unit(&mut self, target: u32) -> Option<WorkUnit> {
         let samples = self.shadow_grid.sample_count();
+        let group = self.shadow_grid_inputs().light_group;
         let r = &mut self.refinement;
         if r.grid_done >= target {
             return None;
@@ -1184,10 +1186,11 @@ impl Renderer {
         }
         let remaining = target - r.grid_done;
         let mut count = r.items(r.grid_cost, GUESS_GRID_ENTRY_S, r.grid_last, remaining);
-        // Whole rounds of the device's side-by-side workgroups (an entry is one workgroup): on
-        // lavapipe on two cores three entries took as long as four (40-50 ms against the two's 21).
+        // Whole rounds of the device's side-by-side workgroups where an entry is one workgroup (a
+        // unit within one light group: `ShadowGridPass::encode`): on lavapipe on two cores three
+        // entries took as long as four (40-50 ms against the two's 21).
         let p = r.parallel_workgroups.max(1);
-        if count > p && count < remaining {
+        if count > p && count <= group && count < remaining {
             count -= count % p;
         }
         r.grid_last = count;
@@ -1471,6 +1474,12 @@ impl Renderer {
                         end - row,
                     )
                     .min(end - row);
+                // Whole workgroups (8 rows) unless it is the last band.
+                let rows = if rows >= 8 && row + rows < end {
+                    rows - rows % 8
+                } else {
+                    rows
+                };
                 r.stage = if row + rows < end {
                     Stage::RepaintGather { row: row + rows }
                 } else {

@@ -221,7 +221,9 @@ pub struct DualRow {
 }
 
 /// ln of a term that falls off about exponentially (A_b, a_f), floored at 1e-30 (a row of strong
-/// absorption underflows to 0 in f32): e^(-69) contributes nothing a pixel shows.
+/// absorption underflows to 0 in f32): e^(-69) contributes nothing a pixel shows. Where a sample is 0
+/// the log-linear reading moves geometrically towards 1e-30 where `geometric_mix` fell back to linear
+/// interpolation: values under 1e-30 either way.
 pub fn ln_floored(v: f32) -> f32 {
     v.max(1e-30).ln()
 }
