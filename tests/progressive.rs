@@ -538,12 +538,7 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     assert!(matches!(units.last(), Some(WorkUnit::RepaintGather { .. })));
     dab(&mut restarted, middle);
     dab(&mut restarted, middle + 1);
-    restarted.restart();
-    refine_all(&mut restarted, &ctx);
-    let (got, want) = (
-        live.read_frame(&ctx).expect("read"),
-        restarted.read_frame(&ctx).expect("read"),
-    );
+    let (got, want) = frames_after_restart(&live, &mut restarted, &ctx);
     let moved = difference(&before_small, &got);
     println!("a small dab moved the image by {moved:.1e}");
     assert!(moved > 0.0, "the small dab shows");
@@ -579,12 +574,7 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     assert!(matches!(units.last(), Some(WorkUnit::RepaintGather { .. })));
     dab(&mut restarted, middle + 2);
     dab(&mut restarted, middle + 3);
-    restarted.restart();
-    refine_all(&mut restarted, &ctx);
-    let (got, want) = (
-        live.read_frame(&ctx).expect("read"),
-        restarted.read_frame(&ctx).expect("read"),
-    );
+    let (got, want) = frames_after_restart(&live, &mut restarted, &ctx);
     assert_eq!(difference(&want, &got), 0.0, "a dab during a gather");
     // Still refining: refused.
     live.set_camera(&ctx, &scene.camera);
@@ -719,6 +709,20 @@ fn refine_events(r: &mut Renderer, ctx: &GpuContext) -> Vec<Event> {
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("poll");
     }
+}
+
+/// `restarted` restarted and refined to convergence: (the frame of `live`, the restart's frame).
+fn frames_after_restart(
+    live: &Renderer,
+    restarted: &mut Renderer,
+    ctx: &GpuContext,
+) -> (Frame, Frame) {
+    restarted.restart();
+    refine_all(restarted, ctx);
+    (
+        live.read_frame(ctx).expect("read"),
+        restarted.read_frame(ctx).expect("read"),
+    )
 }
 
 /// Sum of the beauty's RGB over the image, per unit of image area (a preview pixel covers factor^2
