@@ -19,12 +19,12 @@ use super::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
 use crate::envmap::EnvMap;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
-    dual_scattering_components, global_response_lobe, local_response_behind,
+    dual_scattering_components, global_response_lobe_in_view, local_response_behind,
 };
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::dual_terms::HairBehind;
 use crate::scattering::fast_params::FastHairParams;
-use crate::scattering::fast_response::SrbfInFrame;
+use crate::scattering::fast_response::{LongitudinalLobe, SrbfInFrame};
 use crate::scattering::frame::{FiberAngles, FiberFrame};
 use crate::scattering::marschner::scattering_s;
 use crate::scattering::params::{CausticModel, HairParams, ModelVariant};
@@ -157,21 +157,28 @@ fn dual_directional(
     };
     // The direct part's local term weighs with the direct fraction (0 or 1 per ray).
     let local_direct = if f.direct_fraction > 0.0 {
-        local_response_behind(&fp, d.dual, light, theta_o, phi_o, 0.0, behind)
+        local_response_behind(&fp, d.dual, light, theta_o, phi_o, [0.0; 3], behind)
     } else {
         [0.0; 3]
     };
     let (mut global, mut local) = ([0.0f32; 3], [0.0f32; 3]);
     if f.direct_fraction < 1.0 {
         // Each channel with its own sigma_f^2 (the renderer uses their mean).
-        for c in 0..3 {
-            let s2 = f.sigma_f2[c];
-            for t in 0..3 {
-                global[c] +=
-                    global_response_lobe(d.azimuthal, &fp, t, light, theta_o, phi_o, s2)[c];
+        for t in 0..3 {
+            let longitudinal = LongitudinalLobe::of_lobe(&fp, t, theta_o);
+            for c in 0..3 {
+                global[c] += global_response_lobe_in_view(
+                    d.azimuthal,
+                    &fp,
+                    t,
+                    &longitudinal,
+                    light,
+                    phi_o,
+                    f.sigma_f2[c],
+                )[c];
             }
-            local[c] = local_response_behind(&fp, d.dual, light, theta_o, phi_o, s2, behind)[c];
         }
+        local = local_response_behind(&fp, d.dual, light, theta_o, phi_o, f.sigma_f2, behind);
     }
     dual_scattering_components(
         &fp,

@@ -126,30 +126,32 @@ pub fn local_response(
         light,
         theta_o,
         phi_o,
-        sigma_f2,
+        [sigma_f2; 3],
         HairBehind::OpticalDepth(depth_behind),
     )
 }
 
-/// [`local_response`] with the hair behind the point given either way.
+/// [`local_response`] with the hair behind the point given either way, and each channel's own
+/// forward spread sigma_f^2 (the reference's shadow rays carry one per channel; the renderer their
+/// mean).
 pub fn local_response_behind(
     p: &FastHairParams,
     tables: &DualTables,
     light: SrbfInFrame,
     theta_o: f32,
     phi_o: f32,
-    sigma_f2: f32,
+    sigma_f2: Rgb32,
     behind: HairBehind,
 ) -> Rgb32 {
-    let sigma = forward_spread(sigma_f2, light.lambda);
     let azimuthal = (PI - wrap_angle_f32(light.phi - phi_o).abs()) / (PI * PI);
-    let lo = 0.5 * (theta_o - (light.theta + sigma));
-    let hi = 0.5 * (theta_o - (light.theta - sigma));
     // Each channel at the point's own absorption (a painted strand's, not the hair's mean), its axis
     // cell found once.
     let cells = p.sigma_a_rgb().map(sigma_cell);
     let mut out = [0.0; 3];
     for c in 0..3 {
+        let sigma = forward_spread(sigma_f2[c], light.lambda);
+        let lo = 0.5 * (theta_o - (light.theta + sigma));
+        let hi = 0.5 * (theta_o - (light.theta - sigma));
         let (delta_c, sig_b_c) = tables.mean_delta_sigma_in_cell(lo, hi, cells[c]);
         let sb = sig_b_c.max(1e-3);
         // Zinke's back lobe g(theta_i + theta_o - Delta_b; sigma_b) is M with tilt Delta_b / 2 and width sigma_b / 2:

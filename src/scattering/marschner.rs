@@ -224,6 +224,12 @@ impl AzimuthalLobe {
         let h = h.clamp(-1.0, 1.0);
         let gamma_i = h.asin();
         let gamma_t = (h / self.eta_perp).clamp(-1.0, 1.0).asin();
+        self.attenuation_a_p_at(h, gamma_i, gamma_t)
+    }
+
+    /// [`AzimuthalLobe::attenuation_a_p`] at h in [-1, 1] with its angles gamma_i = asin h and
+    /// gamma_t = asin(h / eta') already known (an integral over gamma_i has them).
+    pub fn attenuation_a_p_at(&self, h: f64, gamma_i: f64, gamma_t: f64) -> Rgb {
         let (f_ext, f_int) = match self.fresnel {
             FresnelModel::Exact => (
                 fresnel_bravais(self.eta_perp, self.eta_par, gamma_i),

@@ -39,6 +39,33 @@ impl SrbfLight64 {
             + theta.cos() * self.theta.cos() * (phi - self.phi).cos();
         (2.0 * (d - 1.0) / (self.lambda * self.lambda)).exp()
     }
+
+    /// G along the circle of inclination theta (an inner integral's), its products of sines and
+    /// cosines found once.
+    pub fn at_theta(&self, theta: f64) -> SrbfOnCircle {
+        SrbfOnCircle {
+            sin_sin: theta.sin() * self.theta.sin(),
+            cos_cos: theta.cos() * self.theta.cos(),
+            phi: self.phi,
+            two_over_lambda2: 2.0 / (self.lambda * self.lambda),
+        }
+    }
+}
+
+/// [`SrbfLight64::eval`] at a fixed inclination.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SrbfOnCircle {
+    sin_sin: f64,
+    cos_cos: f64,
+    phi: f64,
+    two_over_lambda2: f64,
+}
+
+impl SrbfOnCircle {
+    pub fn eval(&self, phi: f64) -> f64 {
+        let d = self.sin_sin + self.cos_cos * (phi - self.phi).cos();
+        ((d - 1.0) * self.two_over_lambda2).exp()
+    }
 }
 
 /// Relative tolerance of the nested integrals (the result is good to ~1e-5 relative, or 1e-10 of the
@@ -59,10 +86,14 @@ fn sorted_in(mut v: Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
 /// inner(theta_i) = integral over phi_i of G(theta_i, phi_i) N_p(phi_o - phi_i) for a circular fiber (h form).
 fn inner_h(az: &AzimuthalLobe, light: &SrbfLight64, theta_i: f64, phi_o: f64, ch: usize) -> f64 {
     let p = az.p();
+    let g = light.at_theta(theta_i);
+    // Over gamma_i = t in [-pi/2, pi/2]: h = sin t, and gamma_i is t itself (phi_p's and A_p's
+    // arcsines of h, found once).
     let integrand = |t: f64| {
         let h = t.sin();
-        let phi = phi_p(p, h, az.eta_perp);
-        0.5 * az.attenuation_a_p(h)[ch] * light.eval(theta_i, phi_o - phi) * t.cos()
+        let gamma_t = (h / az.eta_perp).clamp(-1.0, 1.0).asin();
+        let phi = 2.0 * p as f64 * gamma_t - 2.0 * t + p as f64 * PI;
+        0.5 * az.attenuation_a_p_at(h, t, gamma_t)[ch] * g.eval(phi_o - phi) * t.cos()
     };
     // Split at the offsets whose exit azimuth hits the light's centre and its azimuthal width.
     let lp = light.lambda / (theta_i.cos() * light.theta.cos()).max(1e-12).sqrt();
@@ -114,9 +145,10 @@ fn inner_phi_eccentric(
     phi_o: f64,
     ch: usize,
 ) -> f64 {
+    let g = light.at_theta(theta_i);
     let integrand = |phi: f64| {
         let az = AzimuthalLobe::new(params, variant, Lobe::TRT, theta_d, phi_o - 0.5 * phi);
-        az.azimuthal_n_p_roots(phi)[ch] * light.eval(theta_i, phi_o - phi)
+        az.azimuthal_n_p_roots(phi)[ch] * g.eval(phi_o - phi)
     };
     let lp = light.lambda / (theta_i.cos() * light.theta.cos()).max(1e-12).sqrt();
     let mut breaks = Vec::new();

@@ -61,6 +61,27 @@ pub fn trilinear(
     let base = q.floor();
     let f = q - base;
     let (mut a, mut m) = (0.0, [0.0; 6]);
+    let inside = (0..3).all(|ax| base[ax] >= 0.0 && base[ax] + 1.0 < dims[ax] as f32);
+    if inside {
+        // All eight corners in the grid (the common case): the same sums in the same order as
+        // below, without the per-corner bounds tests.
+        let v0 = (base.z as usize * dims[1] + base.y as usize) * dims[0] + base.x as usize;
+        let (sy, sz) = (dims[0], dims[0] * dims[1]);
+        let wx = [1.0 - f.x, f.x];
+        let wy = [1.0 - f.y, f.y];
+        let wz = [1.0 - f.z, f.z];
+        for corner in 0..8 {
+            let (ox, oy, oz) = (corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+            let v = v0 + ox + oy * sy + oz * sz;
+            let w = 1.0 * wx[ox] * wy[oy] * wz[oz];
+            a += w * extinction[v];
+            let t = &tensor[v];
+            for c in 0..6 {
+                m[c] += w * t[c];
+            }
+        }
+        return (a, m);
+    }
     for corner in 0..8 {
         let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
         let idx = [0, 1, 2].map(|ax| base[ax] as i64 + o[ax] as i64);

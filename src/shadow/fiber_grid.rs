@@ -42,7 +42,60 @@ pub struct FiberGrid {
     pub dims: [usize; 3],
     /// cell_start[c]..cell_start[c + 1] index `cell_items` for cell c.
     cell_start: Vec<u32>,
-    cell_items: Vec<u32>,
+    /// Each cell's segments, in the form the ray test reads (a cell's items are contiguous).
+    cell_items: Vec<CellItem>,
+}
+
+/// A segment as the ray test reads it: its start a, its extent e = b - a, e.e and radius^2, and its
+/// index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CellItem {
+    a: Vec3,
+    e: Vec3,
+    e_dot_e: f32,
+    radius2: f32,
+    segment: u32,
+}
+
+impl CellItem {
+    fn new(segment: u32, s: &FiberSegment) -> Self {
+        let e = s.b - s.a;
+        Self {
+            a: s.a,
+            e,
+            e_dot_e: e.dot(e),
+            radius2: s.radius * s.radius,
+            segment,
+        }
+    }
+
+    /// Closest approach of the ray o + t d (d unit): Some((t, u)) when the ray passes within the
+    /// radius at a point u in [0, 1) of the segment. Rays parallel to the fiber never cross it.
+    #[inline]
+    fn intersect(&self, o: Vec3, d: Vec3) -> Option<(f32, f32)> {
+        let (e, c) = (self.e, self.e_dot_e);
+        let w0 = o - self.a;
+        let b = d.dot(e);
+        let denom = c - b * b;
+        if denom <= 1e-10 * c {
+            return None;
+        }
+        // The lines' distance is |w0 . (d x e)| / |d x e|, and |d x e|^2 = c - b^2: most segments
+        // a ray meets in a cell pass far from it, and leave here without a division (with a margin,
+        // so the test below decides every near case as it would alone).
+        let w = w0.dot(d.cross(e));
+        if w * w > 1.25 * self.radius2 * denom {
+            return None;
+        }
+        let (dd, ee) = (d.dot(w0), e.dot(w0));
+        let t = (b * ee - c * dd) / denom;
+        let u = (ee - b * dd) / denom;
+        if !(0.0..1.0).contains(&u) {
+            return None;
+        }
+        let gap = w0 + d * t - e * u;
+        (gap.length_squared() < self.radius2).then_some((t, u))
+    }
 }
 
 /// Cells per axis at most.
@@ -97,58 +150,56 @@ impl FiberGrid {
                 (cell_of(s.a.min(s.b) - r), cell_of(s.a.max(s.b) + r))
             })
             .collect();
-        let each = |(q0, q1): ([usize; 3], [usize; 3]), f: &mut dyn FnMut(usize)| {
+        // A segment is listed in the cells its capsule can reach: those whose box, grown by the
+        // radius, the segment meets. A crossing's closest approach lies inside the capsule, so the
+        // cell that holds it lists the segment; a diagonal segment's bounds hold several times the
+        // cells its capsule reaches.
+        let each = |k: usize, f: &mut dyn FnMut(usize)| {
+            let ((q0, q1), s) = (ranges[k], &segments[k]);
+            let grow = Vec3::splat(s.radius + 1e-3 * cell);
             for z in q0[2]..=q1[2] {
                 for y in q0[1]..=q1[1] {
                     for x in q0[0]..=q1[0] {
-                        f(index([x, y, z]));
+                        let c0 = lo + cell * Vec3::new(x as f32, y as f32, z as f32);
+                        if segment_meets_box(s.a, s.b, c0 - grow, c0 + Vec3::splat(cell) + grow) {
+                            f(index([x, y, z]));
+                        }
                     }
                 }
             }
         };
-        for &r in &ranges {
-            each(r, &mut |c| counts[c + 1] += 1);
+        for k in 0..segments.len() {
+            each(k, &mut |c| counts[c + 1] += 1);
         }
         for c in 1..counts.len() {
             counts[c] += counts[c - 1];
         }
         let mut fill = counts.clone();
         let mut items = vec![0u32; *counts.last().unwrap_or(&0) as usize];
-        for (k, &r) in ranges.iter().enumerate() {
-            each(r, &mut |c| {
+        for k in 0..segments.len() {
+            each(k, &mut |c| {
                 items[fill[c] as usize] = k as u32;
                 fill[c] += 1;
             });
         }
+        let cell_items = items
+            .into_iter()
+            .map(|k| CellItem::new(k, &segments[k as usize]))
+            .collect();
         Self {
             segments,
             origin: lo,
             cell,
             dims,
             cell_start: counts,
-            cell_items: items,
+            cell_items,
         }
     }
 
     /// Closest approach of the ray o + t d (d unit) to segment k: Some((t, u)) when the ray passes within
     /// the radius at a point u in [0, 1) of the segment. Rays parallel to the fiber never cross it.
     pub fn intersect(&self, k: u32, o: Vec3, d: Vec3) -> Option<(f32, f32)> {
-        let s = &self.segments[k as usize];
-        let e = s.b - s.a;
-        let w0 = o - s.a;
-        let (b, c) = (d.dot(e), e.dot(e));
-        let (dd, ee) = (d.dot(w0), e.dot(w0));
-        let denom = c - b * b;
-        if denom <= 1e-10 * c {
-            return None;
-        }
-        let t = (b * ee - c * dd) / denom;
-        let u = (ee - b * dd) / denom;
-        if !(0.0..1.0).contains(&u) {
-            return None;
-        }
-        let gap = w0 + d * t - e * u;
-        (gap.length_squared() < s.radius * s.radius).then_some((t, u))
+        CellItem::new(k, &self.segments[k as usize]).intersect(o, d)
     }
 
     /// Calls `visit` for every crossing of the ray o + t d (d unit), t > t_min, in increasing cell order
@@ -189,20 +240,29 @@ impl FiberGrid {
         }
         let mut t_in = entry;
         loop {
-            let axis = (0..3)
-                .min_by(|&i, &j| t_next[i].total_cmp(&t_next[j]))
-                .unwrap_or(0);
+            // The axis whose boundary comes first (the lowest on ties).
+            let axis = if t_next[0] <= t_next[1] {
+                if t_next[0] <= t_next[2] { 0 } else { 2 }
+            } else if t_next[1] <= t_next[2] {
+                1
+            } else {
+                2
+            };
             let t_out = t_next[axis].min(exit);
             let c = (q[2] * dims[1] + q[1]) * dims[0] + q[0];
             let items =
                 &self.cell_items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
-            for &k in items {
-                if let Some((t, u)) = self.intersect(k, o, d)
+            for item in items {
+                if let Some((t, u)) = item.intersect(o, d)
                     && t > t_min
                     && t >= t_in
                     && t < t_out
                 {
-                    visit(Crossing { segment: k, t, u });
+                    visit(Crossing {
+                        segment: item.segment,
+                        t,
+                        u,
+                    });
                 }
             }
             if t_out >= exit {
@@ -217,4 +277,25 @@ impl FiberGrid {
             t_next[axis] += t_delta[axis];
         }
     }
+}
+
+/// Whether the segment ab meets the box [lo, hi] (slabs).
+fn segment_meets_box(a: Vec3, b: Vec3, lo: Vec3, hi: Vec3) -> bool {
+    let e = b - a;
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for ax in 0..3 {
+        if e[ax].abs() < 1e-20 {
+            if a[ax] < lo[ax] || a[ax] > hi[ax] {
+                return false;
+            }
+        } else {
+            let (ta, tb) = ((lo[ax] - a[ax]) / e[ax], (hi[ax] - a[ax]) / e[ax]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
 }
