@@ -1032,3 +1032,80 @@ fn a_coarse_preview_of_dense_hair_draws_a_quarter_of_the_strands_four_times_as_w
         "the preview's radiance is the frame's"
     );
 }
+
+/// The preview's divisor changed after the frame's plan had begun (the automatic divisor adapts to
+/// the first preview's time, after it): once the image converges the plan draws the preview's
+/// visibility at the new divisor, so that the next change's preview only shades (on lavapipe the
+/// redraw was 140 ms of S1's first edit's 300 ms preview). The image is the same; the preview the
+/// next change shows is the one a preview drawn then would show.
+#[test]
+fn a_converged_plan_draws_the_next_previews_visibility() {
+    let ctx = context();
+    let luts = Luts::default_tables();
+    let lights = sunny_lights();
+    let scene = small_bob(true);
+    let new = || bob_renderer(&ctx, &luts, &scene, &scene.hair, &scene.sigma_a, &lights);
+    let (mut prepared, mut fresh) = (new(), new());
+    for r in [&mut prepared, &mut fresh] {
+        r.set_preview(PreviewMode::Fixed(3));
+        refine_all(r, &ctx);
+    }
+    let converged = prepared.read_frame(&ctx).expect("read");
+    prepared.set_preview(PreviewMode::Fixed(4));
+    let units = refine_all(&mut prepared, &ctx);
+    let last_shade = units
+        .iter()
+        .rposition(|u| matches!(u, WorkUnit::Shade { .. }))
+        .expect("the frame is shaded again");
+    let drawn = units[last_shade..]
+        .iter()
+        .filter(|u| matches!(u, WorkUnit::PreviewVisibility { .. }))
+        .count();
+    println!(
+        "after the divisor's change: {} units, the last {:?}; {drawn} preview visibility units after the last shading",
+        units.len(),
+        units.last()
+    );
+    assert!(
+        drawn > 0,
+        "the preview's visibility is drawn after convergence"
+    );
+    assert!(matches!(
+        units.last(),
+        Some(WorkUnit::PreviewVisibility { .. })
+    ));
+    assert_eq!(
+        difference(&converged, &prepared.read_frame(&ctx).expect("read")),
+        0.0,
+        "the image is unchanged"
+    );
+    assert!(refine_all(&mut prepared, &ctx).is_empty(), "then converged");
+
+    // A change: the prepared renderer's preview only shades; the other draws its visibility first.
+    let mut params = scene.look.params;
+    params.beta_r *= 0.8;
+    let look = strandlight::render::HairLook::new(params);
+    fresh.set_preview(PreviewMode::Fixed(4));
+    let mut previews = Vec::new();
+    for r in [&mut prepared, &mut fresh] {
+        r.set_params(&ctx, &look);
+        let events = refine_events(r, &ctx);
+        let at = events
+            .iter()
+            .position(|e| e.1 == Some(ImageReady::Preview))
+            .expect("a preview");
+        let drawn = events[..at]
+            .iter()
+            .filter(|e| matches!(e.0, Some(WorkUnit::PreviewVisibility { .. })))
+            .count();
+        println!("preview after {} units, {drawn} of its visibility", at + 1);
+        previews.push((
+            drawn,
+            r.read_preview(&ctx).expect("read").expect("a preview").0,
+        ));
+    }
+    assert_eq!(previews[0].0, 0, "the prepared preview only shades");
+    assert!(previews[1].0 > 0);
+    assert_eq!((previews[0].1.width, previews[0].1.height), (12, 9));
+    assert_eq!(difference(&previews[0].1, &previews[1].1), 0.0);
+}

@@ -27,6 +27,7 @@
 
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
+use super::segment_shading::last_light_batch;
 use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
@@ -150,6 +151,11 @@ pub enum ImageReady {
 enum Stage {
     /// The preview's visibility from segment `first`.
     PreviewVisibility {
+        first: u32,
+    },
+    /// After convergence, the preview's visibility at a divisor adapted since it was drawn, from
+    /// segment `first` (then converged again): the next change's preview only shades.
+    PreparePreview {
         first: u32,
     },
     Preview {
@@ -291,6 +297,22 @@ impl Bands {
     }
 }
 
+impl Stage {
+    /// The image is converged (the plan may still draw the preview's visibility for the next
+    /// change).
+    fn image_converged(self) -> bool {
+        matches!(self, Stage::Converged | Stage::PreparePreview { .. })
+    }
+}
+
+/// A light batch as a band's sizing sees it: its lights, and whether it gathers the band's segments
+/// into pixels (and resolves them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BandShape {
+    lights: u32,
+    gathers: bool,
+}
+
 /// Where progressive refinement stands (owned by the [`Renderer`]).
 pub struct Refinement {
     stage: Stage,
@@ -334,6 +356,10 @@ pub struct Refinement {
     pixel_cost: Option<f64>,
     /// Measured seconds per pixel of a repaint's gather (and resolve).
     gather_cost: Option<f64>,
+    /// Measured seconds per pixel that a shading unit which gathers (by segment, the last light
+    /// batch's and the preview's) costs over the others (S1's top band, no segments: 25 ms under a
+    /// light batch, 63 ms under the last).
+    batch_gather_cost: Option<f64>,
     /// Items of the last grid unit.
     grid_last: u32,
     /// Workgroups the device runs side by side when that is a handful (a software rasteriser's
@@ -385,6 +411,7 @@ impl Default for Refinement {
             budget: DEFAULT_UNIT_BUDGET,
             grid_cost: None,
             gather_cost: None,
+            batch_gather_cost: None,
             parallel_workgroups: 1,
             samples_cost: None,
             volume_cost: None,
@@ -522,7 +549,7 @@ impl Refinement {
         unit: WorkUnit,
         elapsed: Duration,
         batch: Option<(u32, u32)>,
-        listed: Option<(u64, u64)>,
+        (listed, gathers): (Option<(u64, u64)>, bool),
     ) {
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
@@ -552,13 +579,13 @@ impl Refinement {
                 let (slot, lights) = batch.unwrap_or((0, 1));
                 let per_light = seconds / lights.max(1) as f64;
                 self.bands[slot_bands(slot)].measured(row0, rows, per_light);
-                self.segments_measured(seconds, lights, listed);
+                self.segments_measured(seconds, lights, listed, gathers);
             }
             WorkUnit::Preview { row0, rows } => {
                 self.preview_shading += elapsed;
                 self.preview_bands.measured(row0, rows, seconds);
                 let lights = batch.map_or(1, |b| b.1);
-                self.segments_measured(seconds, lights, listed);
+                self.segments_measured(seconds, lights, listed, gathers);
             }
             WorkUnit::Volume { count, .. } => {
                 let per = seconds / count.max(1) as f64;
@@ -585,7 +612,7 @@ impl Refinement {
             }
             WorkUnit::Repaint { .. } => {
                 let lights = batch.map_or(1, |b| b.1);
-                self.segments_measured(seconds, lights, listed);
+                self.segments_measured(seconds, lights, listed, false);
             }
             // The gather and resolve of its rows: the cost per pixel.
             WorkUnit::RepaintGather { .. } => {
@@ -600,39 +627,77 @@ impl Refinement {
     }
 
     /// A shading unit under `lights` lights took `seconds` over `listed` = (segments, pixels): a
-    /// unit of a few segments measures the cost per pixel (the claim, gather and resolve), the
-    /// others the cost per segment and light past it.
-    fn segments_measured(&mut self, seconds: f64, lights: u32, listed: Option<(u64, u64)>) {
+    /// unit of a few segments measures the cost per pixel (the claim; with `gathers`, what the
+    /// gather and resolve add to it), the others the cost per segment and light past it.
+    fn segments_measured(
+        &mut self,
+        seconds: f64,
+        lights: u32,
+        listed: Option<(u64, u64)>,
+        gathers: bool,
+    ) {
         let Some((segments, pixels)) = listed else {
             return;
         };
+        let pixel = self.pixel_cost.unwrap_or(GUESS_PIXEL_S);
+        let gather = match gathers {
+            true => self.batch_gather_cost.unwrap_or(GUESS_GATHER_PIXEL_S),
+            false => 0.0,
+        };
         if segments < MIN_MEASURED_SEGMENTS {
-            if pixels > 0 {
-                self.pixel_cost = ema(self.pixel_cost, seconds / pixels as f64);
+            // Only where the segments' own part is small: a preview row of 42 segments under 40
+            // lights took 10 ms, and taken for its 45 pixels' cost it made a pixel 400 times dearer
+            // than it is (every later band then held one row).
+            let listed = (lights.max(1) as u64 * segments) as f64
+                * self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S);
+            if pixels > 0 && listed < 0.25 * seconds {
+                let per = (seconds - listed) / pixels as f64;
+                if gathers {
+                    // At once up, slowly down: the same band's gather took 0.3 to 0.9 us a pixel
+                    // from one run to the next, and a band sized at the lower overran by 60 %.
+                    let past = (per - pixel).max(0.1 * per);
+                    self.batch_gather_cost = Some(match self.batch_gather_cost {
+                        Some(c) if c > past => 0.8 * c + 0.2 * past,
+                        _ => past,
+                    });
+                } else {
+                    self.pixel_cost = ema(self.pixel_cost, per);
+                }
             }
             return;
         }
-        let fixed = pixels as f64 * self.pixel_cost.unwrap_or(0.0);
+        let fixed = pixels as f64 * (pixel + gather);
         let per = (seconds - fixed).max(0.5 * seconds) / (lights.max(1) as u64 * segments) as f64;
         self.segment_cost = ema(self.segment_cost, per);
     }
 
-    /// Rows of a band from `row` (of `height`, `width` pixels a row) under `lights` lights by
-    /// `counts`, the segments each row lists: as many as `budget` seconds hold at the measured costs
-    /// per segment and light and per pixel; at least one, whole workgroups (8 rows) where the
-    /// budget allows.
+    /// Rows of a band from `row` (of `height`, `width` pixels a row) by `counts`, the segments
+    /// each row lists, under each of `shapes` (the light batches that shade the band): as many as
+    /// `budget` seconds hold under the dearest at the measured costs per segment and light, per
+    /// pixel and per pixel gathered; at least one, whole workgroups (8 rows) where the budget
+    /// allows.
     fn segment_band_rows(
         &self,
         counts: &[u32],
         (row, height, width): (u32, u32, u32),
-        lights: u32,
+        shapes: &[BandShape],
         budget: f64,
     ) -> u32 {
-        let cost = self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S) * lights.max(1) as f64;
-        let row_cost = self.pixel_cost.unwrap_or(GUESS_PIXEL_S) * width as f64;
+        let segment = self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S);
+        let pixel = self.pixel_cost.unwrap_or(GUESS_PIXEL_S) * width as f64;
+        let gather = self.batch_gather_cost.unwrap_or(GUESS_GATHER_PIXEL_S) * width as f64;
+        let row_cost = |n: f64| {
+            shapes
+                .iter()
+                .map(|b| {
+                    let gathered = if b.gathers { gather } else { 0.0 };
+                    n * segment * b.lights.max(1) as f64 + pixel + gathered
+                })
+                .fold(0.0, f64::max)
+        };
         let (mut t, mut n) = (0.0, 0u32);
         for r in row..height {
-            let c = counts.get(r as usize).copied().unwrap_or(0) as f64 * cost + row_cost;
+            let c = row_cost(counts.get(r as usize).copied().unwrap_or(0) as f64);
             if n > 0 && t + c > budget {
                 break;
             }
@@ -728,7 +793,7 @@ impl Renderer {
         // Converged, or kept already (a plan shading multiple scattering alone, its single
         // scattering untouched); not in the middle of a repaint (its segments part-way).
         let keep = match self.refinement.stage {
-            Stage::Converged => {
+            Stage::Converged | Stage::PreparePreview { .. } => {
                 self.by_segment
                     && self.settings.multiple_scattering
                     && !self.refinement.preview_owed
@@ -757,7 +822,10 @@ impl Renderer {
             && !r.preview_owed
             && matches!(
                 r.stage,
-                Stage::Converged | Stage::Repaint { .. } | Stage::RepaintGather { .. }
+                Stage::Converged
+                    | Stage::PreparePreview { .. }
+                    | Stage::Repaint { .. }
+                    | Stage::RepaintGather { .. }
             )
             && self.shading_pass.frame_batches().next().is_some();
         if !ready {
@@ -786,7 +854,7 @@ impl Renderer {
             Stage::RepaintGather { .. } => self.repaint_pending.extend(segments),
             stage => {
                 // Converged, or planned and not started: one repaint of them all.
-                if stage != Stage::Converged {
+                if !stage.image_converged() {
                     segments.append(&mut self.repaint);
                 }
                 segments.append(&mut self.repaint_pending);
@@ -832,7 +900,7 @@ impl Renderer {
     /// Whether the refinement under way shades multiple scattering alone, keeping the segments'
     /// single scattering ([`Renderer::set_tables`] after the image converged).
     pub fn keeps_single_scattering(&self) -> bool {
-        self.single_kept && self.refinement.stage != Stage::Converged
+        self.single_kept && !self.refinement.stage.image_converged()
     }
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
@@ -908,7 +976,9 @@ impl Renderer {
             _ => None,
         };
         let listed = self.listed_segments(unit);
-        self.refinement.measured(unit, elapsed, batch, listed);
+        let gathers = self.unit_gathers(unit);
+        self.refinement
+            .measured(unit, elapsed, batch, (listed, gathers));
         let ready = match unit {
             WorkUnit::Preview { row0, rows } => {
                 let height = self.preview.as_ref().map_or(0, |p| p.targets.height);
@@ -1094,6 +1164,36 @@ impl Renderer {
     }
 
     /// Frame batch `batch`'s K-buffer slot and light count.
+    /// Whether a batch gathers its rows' segments into pixels (by segment, the last light batch).
+    fn batch_gathers(&self, b: &ShadeBatch) -> bool {
+        self.by_segment && b.flags & FLAG_SEGMENTS != 0 && last_light_batch(b)
+    }
+
+    /// Whether the unit gathers (the last light batch's units by segment, and the preview's).
+    fn unit_gathers(&self, unit: WorkUnit) -> bool {
+        match unit {
+            WorkUnit::Shade { batch, .. } => self
+                .shading_pass
+                .frame_batches()
+                .nth(batch as usize)
+                .is_some_and(|b| self.batch_gathers(b)),
+            WorkUnit::Preview { .. } => self.by_segment,
+            _ => false,
+        }
+    }
+
+    /// The first pass's light batches as its bands' sizing sees them.
+    fn first_pass_shapes(&self) -> Vec<BandShape> {
+        self.shading_pass
+            .frame_batches()
+            .take_while(|b| b.slot == 0)
+            .map(|b| BandShape {
+                lights: b.count,
+                gathers: self.batch_gathers(b),
+            })
+            .collect()
+    }
+
     fn batch_shape(&self, batch: u32) -> Option<(u32, u32)> {
         self.shading_pass
             .frame_batches()
@@ -1249,6 +1349,21 @@ impl Renderer {
                 };
                 Some(WorkUnit::PreviewVisibility { first, count })
             }
+            Stage::PreparePreview { first } => {
+                if self.prepare_preview(device).is_none() || self.preview_visible() {
+                    self.refinement.stage = Stage::Converged;
+                    return self.next_unit(device);
+                }
+                let count = self.visibility_part(first, true);
+                self.refinement.stage = if first + count >= self.preview_draw_count() {
+                    Stage::Converged
+                } else {
+                    Stage::PreparePreview {
+                        first: first + count,
+                    }
+                };
+                Some(WorkUnit::PreviewVisibility { first, count })
+            }
             Stage::Preview { row } => {
                 let Some(p) = self.prepare_preview(device) else {
                     self.refinement.stage = self.main_stage();
@@ -1363,6 +1478,7 @@ impl Renderer {
                 let first_pass = self.first_pass_batches();
                 let by_segment = self.by_segment;
                 let width = self.settings.width;
+                let shapes = self.first_pass_shapes();
                 let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
                 let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
@@ -1379,7 +1495,7 @@ impl Renderer {
                         .filter(|_| k == 0 && by_segment)
                         .map(|c| {
                             let total = r.budget.as_secs_f64();
-                            r.segment_band_rows(c, (row, height, width), lights as u32, total)
+                            r.segment_band_rows(c, (row, height, width), &shapes, total)
                         });
                     let rows = by_counts
                         .unwrap_or_else(|| r.bands[k].rows(row, height, budget, guess, prior));
@@ -1490,6 +1606,12 @@ impl Renderer {
             Stage::Converged => {
                 // Dabs that came during a repaint.
                 if self.repaint_pending.is_empty() {
+                    // The first preview's time changed its divisor: its visibility at the new one
+                    // now (S1 on lavapipe: 140 ms of a first edit's 300 ms preview).
+                    if self.prepare_preview(device).is_some() && !self.preview_visible() {
+                        self.refinement.stage = Stage::PreparePreview { first: 0 };
+                        return self.next_unit(device);
+                    }
                     return None;
                 }
                 let pending = std::mem::take(&mut self.repaint_pending);
@@ -1564,7 +1686,11 @@ impl Renderer {
             // Counted, the bands keep to the unit budget (a UI frame waits behind a unit).
             Some(c) => {
                 let size = (row, height, width.ceil() as u32);
-                r.segment_band_rows(c, size, lights as u32, r.budget.as_secs_f64())
+                let shape = BandShape {
+                    lights: lights as u32,
+                    gathers: true,
+                };
+                r.segment_band_rows(c, size, &[shape], r.budget.as_secs_f64())
             }
             None => r.preview_bands.rows(row, height, budget, guess, &[]),
         };
@@ -1743,5 +1869,65 @@ impl Renderer {
             (background, normalise),
             None,
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit of few segments measures the cost per pixel only where the segments' part is small:
+    /// S1's preview rows (42 segments under 40 lights, 45 pixels, 10 ms) once made a pixel 400
+    /// times dearer than it is.
+    #[test]
+    fn few_segments_under_many_lights_do_not_price_the_pixels() {
+        let mut r = Refinement {
+            segment_cost: Some(6e-6),
+            pixel_cost: Some(0.5e-6),
+            ..Default::default()
+        };
+        r.segments_measured(0.010, 40, Some((42, 45)), true);
+        assert_eq!((r.pixel_cost, r.batch_gather_cost), (Some(0.5e-6), None));
+        // No segments: the pixels' cost, and the gather's past it for a unit that gathers.
+        r.segments_measured(0.020, 16, Some((0, 40_000)), false);
+        assert!((r.pixel_cost.unwrap_or(0.0) - 0.5e-6).abs() < 1e-12);
+        r.segments_measured(0.060, 8, Some((0, 40_000)), true);
+        let gather = r.batch_gather_cost.unwrap_or(0.0);
+        assert!((gather - 1.0e-6).abs() < 1e-9, "gather {gather}");
+        // Up at once, down slowly.
+        r.segments_measured(0.030, 8, Some((0, 40_000)), true);
+        let lower = r.batch_gather_cost.unwrap_or(0.0);
+        assert!(lower < gather && lower > 0.8 * gather, "gather {lower}");
+        // Many segments: the cost per segment and light past the pixels (and the gather).
+        r.batch_gather_cost = Some(1e-6);
+        r.segments_measured(0.080 + 0.060, 8, Some((1000, 40_000)), true);
+        // (0.140 - 40 000 x 1.5 us) / (8 x 1000) = 10 us, averaged with the 6 us before.
+        let segment = r.segment_cost.unwrap_or(0.0);
+        assert!((segment - 8e-6).abs() < 1e-12, "segment {segment}");
+    }
+
+    /// A band of the first pass fits the dearest of its light batches: rows without segments under
+    /// the last batch, which gathers, hold fewer rows than the claim alone would.
+    #[test]
+    fn first_pass_bands_fit_the_batch_that_gathers() {
+        let r = Refinement {
+            segment_cost: Some(5e-6),
+            pixel_cost: Some(0.5e-6),
+            batch_gather_cost: Some(1e-6),
+            ..Default::default()
+        };
+        let counts = vec![0u32; 480];
+        let shape = |lights, gathers| BandShape { lights, gathers };
+        let size = (0, 480, 720);
+        let claim = r.segment_band_rows(&counts, size, &[shape(16, false)], 0.035);
+        let batches = [shape(16, false), shape(16, false), shape(8, true)];
+        let gathered = r.segment_band_rows(&counts, size, &batches, 0.035);
+        println!("rows of a band: {claim} claimed, {gathered} with the gather");
+        // 720 pixels at 0.5 us (0.36 ms a row), at 1.5 us with the gather (1.08 ms).
+        assert_eq!((claim, gathered), (96, 32));
+        // With segments, the first batch's 16 lights are the dearer: a row of 100 segments costs
+        // 8.36 ms under them (5.08 ms under the last batch), four fit 35 ms.
+        let dense = vec![100u32; 480];
+        assert_eq!(r.segment_band_rows(&dense, size, &batches, 0.035), 4);
     }
 }
