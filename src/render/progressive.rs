@@ -63,7 +63,8 @@ const GUESS_SEGMENT_LIGHT_S: f64 = 10e-6;
 /// A pixel of a shading unit's rows (the claim, gather and resolve; lavapipe, two cores: ~0.7 us
 /// on S1).
 const GUESS_PIXEL_S: f64 = 0.5e-6;
-/// A pixel of a repaint's gather and resolve (lavapipe, two cores: 0.65-0.95 us on S1).
+/// A pixel of a repaint's gather and resolve, and what the last light batch's gather adds to a
+/// pixel of its band (lavapipe, two cores: 0.65-0.95 us on S1, and 0.3-0.9 us).
 const GUESS_GATHER_PIXEL_S: f64 = 1e-6;
 /// A shading unit listing fewer segments does not update the cost per segment.
 const MIN_MEASURED_SEGMENTS: u64 = 64;
@@ -360,6 +361,8 @@ pub struct Refinement {
     /// batch's and the preview's) costs over the others (S1's top band, no segments: 25 ms under a
     /// light batch, 63 ms under the last).
     batch_gather_cost: Option<f64>,
+    /// Measured seconds per segment and light of a repaint's units.
+    repaint_cost: Option<f64>,
     /// Items of the last grid unit.
     grid_last: u32,
     /// Workgroups the device runs side by side when that is a handful (a software rasteriser's
@@ -412,6 +415,7 @@ impl Default for Refinement {
             grid_cost: None,
             gather_cost: None,
             batch_gather_cost: None,
+            repaint_cost: None,
             parallel_workgroups: 1,
             samples_cost: None,
             volume_cost: None,
@@ -610,9 +614,13 @@ impl Refinement {
                 let per = seconds / count.max(1) as f64;
                 self.resolve_cost = ema(self.resolve_cost, per);
             }
-            WorkUnit::Repaint { .. } => {
+            WorkUnit::Repaint { segments, .. } => {
                 let lights = batch.map_or(1, |b| b.1);
                 self.segments_measured(seconds, lights, listed, false);
+                if segments as u64 >= MIN_MEASURED_SEGMENTS {
+                    let per = seconds / (lights.max(1) * segments) as f64;
+                    self.repaint_cost = ema(self.repaint_cost, per);
+                }
             }
             // The gather and resolve of its rows: the cost per pixel.
             WorkUnit::RepaintGather { .. } => {
@@ -1135,13 +1143,16 @@ impl Renderer {
             r.stage,
             Stage::PreviewVisibility { .. } | Stage::Preview { .. }
         );
-        let in_flight = r.in_flight.as_ref().is_some_and(|f| {
-            f.restart == r.restarts
-                && matches!(
-                    f.unit,
-                    WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
-                )
-        });
+        // (A preview's visibility drawn after convergence for the next change is not a preview
+        // under way: no change is owed a preview then.)
+        let in_flight = r.preview_owed
+            && r.in_flight.as_ref().is_some_and(|f| {
+                f.restart == r.restarts
+                    && matches!(
+                        f.unit,
+                        WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
+                    )
+            });
         in_flight || (planned && r.preview_started)
     }
 
@@ -1163,7 +1174,6 @@ impl Renderer {
         self.refinement.sharp_rows
     }
 
-    /// Frame batch `batch`'s K-buffer slot and light count.
     /// Whether a batch gathers its rows' segments into pixels (by segment, the last light batch).
     fn batch_gathers(&self, b: &ShadeBatch) -> bool {
         self.by_segment && b.flags & FLAG_SEGMENTS != 0 && last_light_batch(b)
@@ -1194,6 +1204,7 @@ impl Renderer {
             .collect()
     }
 
+    /// Frame batch `batch`'s K-buffer slot and light count.
     fn batch_shape(&self, batch: u32) -> Option<(u32, u32)> {
         self.shading_pass
             .frame_batches()
@@ -1549,7 +1560,13 @@ impl Renderer {
                 let total = self.repaint.len() as u32;
                 let lights = self.batch_shape(batch).map_or(1, |b| b.1).max(1) as f64;
                 let r = &mut self.refinement;
-                let per = r.segment_cost.map(|c| c * lights);
+                // A dab's scattered segments cost more each than a band's (S1: 5.7-6.3 us a
+                // segment and light against the bands' 5.3): their own measure, or a quarter over
+                // the bands' before one is made.
+                let per = r
+                    .repaint_cost
+                    .or(r.segment_cost.map(|c| 1.25 * c))
+                    .map(|c| c * lights);
                 let remaining = total.saturating_sub(first);
                 let count = r
                     .items(per, GUESS_SEGMENT_LIGHT_S * lights, u32::MAX / 2, remaining)
@@ -1607,7 +1624,13 @@ impl Renderer {
                 // Dabs that came during a repaint.
                 if self.repaint_pending.is_empty() {
                     // The first preview's time changed its divisor: its visibility at the new one
-                    // now (S1 on lavapipe: 140 ms of a first edit's 300 ms preview).
+                    // now (S1 on lavapipe: 140 ms of a first edit's 300 ms preview). A divisor
+                    // that waited for the next camera move (the redraw would have cost the next
+                    // preview more than it saves) applies now, the redraw costing no preview.
+                    let r = &mut self.refinement;
+                    if let Some(f) = r.preview_deferred_factor.take() {
+                        r.preview_auto_factor = Some(f);
+                    }
                     if self.prepare_preview(device).is_some() && !self.preview_visible() {
                         self.refinement.stage = Stage::PreparePreview { first: 0 };
                         return self.next_unit(device);
@@ -1889,8 +1912,9 @@ mod tests {
         r.segments_measured(0.010, 40, Some((42, 45)), true);
         assert_eq!((r.pixel_cost, r.batch_gather_cost), (Some(0.5e-6), None));
         // No segments: the pixels' cost, and the gather's past it for a unit that gathers.
-        r.segments_measured(0.020, 16, Some((0, 40_000)), false);
-        assert!((r.pixel_cost.unwrap_or(0.0) - 0.5e-6).abs() < 1e-12);
+        r.segments_measured(0.012, 16, Some((0, 40_000)), false);
+        assert!((r.pixel_cost.unwrap_or(0.0) - 0.4e-6).abs() < 1e-12);
+        r.pixel_cost = Some(0.5e-6);
         r.segments_measured(0.060, 8, Some((0, 40_000)), true);
         let gather = r.batch_gather_cost.unwrap_or(0.0);
         assert!((gather - 1.0e-6).abs() < 1e-9, "gather {gather}");

@@ -83,8 +83,10 @@ impl CellItem {
         // The lines' distance is |w0 . (d x e)| / |d x e|, and |d x e|^2 = c - b^2: most segments
         // a ray meets in a cell pass far from it, and leave here without a division (with a margin,
         // so the test below decides every near case as it would alone).
+        // (Only where denom is well above its rounding: a ray nearly along the fiber is left to
+        // the test below, as before.)
         let w = w0.dot(d.cross(e));
-        if w * w > 1.25 * self.radius2 * denom {
+        if denom > 1e-3 * c && w * w > 1.25 * self.radius2 * denom {
             return None;
         }
         let (dd, ee) = (d.dot(w0), e.dot(w0));
@@ -156,7 +158,8 @@ impl FiberGrid {
         // cells its capsule reaches.
         let each = |k: usize, f: &mut dyn FnMut(usize)| {
             let ((q0, q1), s) = (ranges[k], &segments[k]);
-            let grow = Vec3::splat(s.radius + 1e-3 * cell);
+            // (A margin of 1 % of a cell against the walk's accumulated boundaries.)
+            let grow = Vec3::splat(s.radius + 1e-2 * cell);
             for z in q0[2]..=q1[2] {
                 for y in q0[1]..=q1[1] {
                     for x in q0[0]..=q1[0] {
