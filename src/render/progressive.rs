@@ -1489,7 +1489,11 @@ impl Renderer {
                 let first_pass = self.first_pass_batches();
                 let by_segment = self.by_segment;
                 let width = self.settings.width;
-                let shapes = self.first_pass_shapes();
+                // Only a new band of the first batch by segment sizes by them.
+                let shapes = match band == 0 && by_segment {
+                    true => self.first_pass_shapes(),
+                    false => Vec::new(),
+                };
                 let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
                 let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
