@@ -45,16 +45,68 @@ pub fn integrate<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64, tol: f64) -> f64 {
 
 /// Integral over [a, b] of a function that may have integrable 1/sqrt singularities at a and b.
 pub fn integrate_endpoint_singular<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64, tol: f64) -> f64 {
-    let g = |u: f64| {
-        // x - a ~ u^2 near the ends: a 1/sqrt singularity becomes bounded. Where two caustics merge
-        // (eta' -> 2) the singularity is |x - a|^(-2/3); that case converges more slowly (worst
-        // relative error seen ~1e-5) but a stronger substitution pushes nodes into rounding noise.
+    EndpointSingular::start(f, a, b).refine(tol)
+}
+
+/// [`integrate_endpoint_singular`] in two steps: the first level of the adaptive rule (the whole piece
+/// and its halves, in the substitution's u), then the refinement to a tolerance. Pieces integrated
+/// twice (a coarse pass that sets the tolerance, then the refined one) share the first level.
+struct EndpointSingular<'f, F> {
+    f: &'f F,
+    a: f64,
+    b: f64,
+    whole: f64,
+    halves: [f64; 2],
+}
+
+impl<'f, F: Fn(f64) -> f64> EndpointSingular<'f, F> {
+    fn start(f: &'f F, a: f64, b: f64) -> Self {
+        let mut piece = Self {
+            f,
+            a,
+            b,
+            whole: 0.0,
+            halves: [0.0; 2],
+        };
+        if a != b {
+            let g = |u: f64| piece.g(u);
+            let (whole, halves) = (
+                panel(&g, 0.0, 1.0),
+                [panel(&g, 0.0, 0.5), panel(&g, 0.5, 1.0)],
+            );
+            (piece.whole, piece.halves) = (whole, halves);
+        }
+        piece
+    }
+
+    /// The integrand in u: x - a ~ u^2 near the ends, so a 1/sqrt singularity becomes bounded. Where
+    /// two caustics merge (eta' -> 2) the singularity is |x - a|^(-2/3); that case converges more
+    /// slowly (worst relative error seen ~1e-5) but a stronger substitution pushes nodes into
+    /// rounding noise.
+    fn g(&self, u: f64) -> f64 {
+        let (a, b) = (self.a, self.b);
         let x = a + (b - a) * 0.5 * (1.0 - (PI * u).cos());
         let dx = (b - a) * 0.5 * PI * (PI * u).sin();
-        let v = f(x) * dx;
+        let v = (self.f)(x) * dx;
         if v.is_finite() { v } else { 0.0 }
-    };
-    integrate(&g, 0.0, 1.0, tol)
+    }
+
+    /// The first level's estimate (the adaptive rule's answer at an infinite tolerance).
+    fn rough(&self) -> f64 {
+        self.halves[0] + self.halves[1]
+    }
+
+    /// The integral to about `tol` absolute error: [`integrate`]'s adaptive rule on the substituted
+    /// integrand, its first level already done.
+    fn refine(&self, tol: f64) -> f64 {
+        let [l, r] = self.halves;
+        if self.a == self.b || (l + r - self.whole).abs() <= tol {
+            return l + r;
+        }
+        let g = |u: f64| self.g(u);
+        adaptive(&g, 0.0, 0.5, l, 0.5 * tol, MAX_DEPTH - 1)
+            + adaptive(&g, 0.5, 1.0, r, 0.5 * tol, MAX_DEPTH - 1)
+    }
 }
 
 /// Integral over [breaks[0], breaks[last]] to relative accuracy `rel`, split at every break (where
@@ -71,17 +123,15 @@ pub fn integrate_piecewise<F: Fn(f64) -> f64>(
     rel: f64,
     abs_min: f64,
 ) -> f64 {
-    let pieces = breaks.windows(2).filter(|w| w[1] > w[0]);
-    let rough: f64 = pieces
-        .clone()
-        .map(|w| integrate_endpoint_singular(f, w[0], w[1], f64::INFINITY))
-        .sum::<f64>()
-        .abs();
+    let pieces: Vec<_> = breaks
+        .windows(2)
+        .filter(|w| w[1] > w[0])
+        .map(|w| EndpointSingular::start(f, w[0], w[1]))
+        .collect();
+    let rough: f64 = pieces.iter().map(|p| p.rough()).sum::<f64>().abs();
     let n = breaks.len().saturating_sub(1).max(1) as f64;
     let tol = (rough * rel / n).max(abs_min / n);
-    pieces
-        .map(|w| integrate_endpoint_singular(f, w[0], w[1], tol))
-        .sum()
+    pieces.iter().map(|p| p.refine(tol)).sum()
 }
 
 /// Break points for integrating a lobe over [-pi/2, pi/2]: the two ends and `centre + k width` for every k
