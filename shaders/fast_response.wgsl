@@ -229,7 +229,10 @@ fn longitudinal_weight(theta_j: f32, lambda_j: f32, mu_m: f32, lambda_m: f32) ->
         }
     }
     var w = LongitudinalWeight(kappa_j, sin(theta_j), cos(theta_j), mu_m, lambda_m, t, 0.0, 0.0);
-    if (curvature <= 0.25 * k_m) {
+    // A peak that is not finite takes the same fallback (the twin's is_finite; a compiler allowed
+    // finite maths may drop a NaN test, so this guards infinities for sure; the lights file's
+    // lambda bound, SRBF_LAMBDA_MIN, is what keeps the peak finite).
+    if (curvature <= 0.25 * k_m || !(abs(t) < 1e30)) {
         w.peak = mu_m;
         w.lambda = lambda_m;
         w.ln_w_peak = 0.0;

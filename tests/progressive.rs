@@ -1080,6 +1080,16 @@ fn a_converged_plan_draws_the_next_previews_visibility() {
         "the image is unchanged"
     );
     assert!(refine_all(&mut prepared, &ctx).is_empty(), "then converged");
+    // The stats tell the image's convergence from the plan's end.
+    let stats = prepared.refine(&ctx).expect("refine").stats;
+    let (first_pass, image) = (
+        stats.first_pass.expect("a first pass"),
+        stats
+            .image_converged
+            .expect("the image's convergence is timed"),
+    );
+    println!("first pass {first_pass:?}, image converged {image:?}");
+    assert!(image >= first_pass);
 
     // A change: the prepared renderer's preview only shades; the other draws its visibility first.
     let mut params = scene.look.params;

@@ -123,7 +123,11 @@ struct ProgressiveReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     preview_ms: Option<f64>,
     first_pass_ms: f64,
-    /// From the change to the converged image (wall clock, including the CPU between units).
+    /// From the change to the converged image (wall clock, as the polling after each unit saw it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    image_converged_ms: Option<f64>,
+    /// From the change to the end of the plan (wall clock, including the CPU between units): the
+    /// converged image and, after it, the next preview's visibility where its divisor changed.
     converged_ms: f64,
     /// Parameter changes after convergence, as the editor makes them (beta_R halved, then restored:
     /// the second with the preview's divisor adapted by the first).
@@ -146,6 +150,8 @@ struct EditReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     preview_ms: Option<f64>,
     first_pass_ms: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    image_converged_ms: Option<f64>,
     converged_ms: f64,
     longest_unit_ms: f64,
 }
@@ -155,6 +161,9 @@ struct RefineRun {
     stats: strandlight::render::progressive::RefineStats,
     preview_ms: Option<f64>,
     first_pass_ms: Option<f64>,
+    /// When a call first saw the image converged since the last restart (the plan may go on with
+    /// the next preview's visibility).
+    image_converged_ms: Option<f64>,
     converged_ms: f64,
     /// The longest unit over the whole run (a refining restart resets the stats).
     longest_ms: f64,
@@ -172,6 +181,7 @@ fn refine_run(
         stats: Default::default(),
         preview_ms: None,
         first_pass_ms: None,
+        image_converged_ms: None,
         converged_ms: 0.0,
         longest_ms: 0.0,
     };
@@ -188,6 +198,11 @@ fn refine_run(
             }
             None => {}
         }
+        // The stats start again at a restart: so does the image's convergence.
+        run.image_converged_ms = p
+            .stats
+            .image_converged
+            .and(run.image_converged_ms.or(Some(ms)));
         if p.converged {
             run.stats = p.stats;
             run.converged_ms = ms;
@@ -262,14 +277,17 @@ fn edit_run(
         }
     })?;
     let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
+    let mut image_converged_ms = run.image_converged_ms;
     if let Some(s) = spawn.take() {
         worker = Some(s());
     }
     if worker.is_some() {
         // Converged before the tables came: they refine it once more.
         hand_over(renderer, &mut worker);
+        let before = t.elapsed().as_secs_f64() * 1e3;
         let again = refine_run(ctx, renderer, |_, _| {})?;
         converged_ms = t.elapsed().as_secs_f64() * 1e3;
+        image_converged_ms = again.image_converged_ms.map(|ms| before + ms);
         longest_ms = longest_ms.max(again.longest_ms);
     }
     Ok(EditReport {
@@ -278,6 +296,7 @@ fn edit_run(
         tables_ms,
         preview_ms: run.preview_ms,
         first_pass_ms: run.first_pass_ms.unwrap_or(run.converged_ms),
+        image_converged_ms,
         converged_ms,
         longest_unit_ms: longest_ms,
     })
@@ -412,12 +431,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             let stats = run.stats;
             let first_pass_ms = run.first_pass_ms.unwrap_or(run.converged_ms);
             eprintln!(
-                "{} progressive: {} units, longest {:.1} ms, preview {}, first pass {first_pass_ms:.0} ms, converged in {:.0} ms",
+                "{} progressive: {} units, longest {:.1} ms, preview {}, first pass {first_pass_ms:.0} ms, image converged in {}, plan finished in {:.0} ms",
                 scene.name,
                 stats.units,
                 stats.longest.as_secs_f64() * 1e3,
                 run.preview_ms
                     .map_or_else(|| "none".into(), |t| format!("{t:.0} ms")),
+                run.image_converged_ms
+                    .map_or_else(|| "?".into(), |t| format!("{t:.0} ms")),
                 run.converged_ms
             );
             let mut narrow = look.params;
@@ -480,6 +501,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     .collect(),
                 preview_ms: run.preview_ms,
                 first_pass_ms,
+                image_converged_ms: run.image_converged_ms,
                 converged_ms: run.converged_ms,
                 edits,
                 brush,

@@ -80,6 +80,11 @@ pub struct FitStats {
 
 pub const SRBF_FILE_VERSION: u32 = 1;
 
+/// Narrowest bandwidth a lights file may hold. The fit never goes below 0.01 ([`super::fit::lambda_min`]),
+/// and far narrower lights break the renderer's f32 arithmetic: kappa_j = 2 / lambda_j^2 overflows
+/// below lambda_j ~ 1e-19 and its Newton search for the longitudinal weight's peak gives NaN.
+pub const SRBF_LAMBDA_MIN: f64 = 1e-3;
+
 /// A set of lights approximating an environment (the `.srbf.json` file).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -190,8 +195,11 @@ impl SrbfSet {
             if !(d.is_finite() && (d.length() - 1.0).abs() < 1e-3) {
                 return Err(format!("light {k}: direction is not a unit vector"));
             }
-            if !(l.lambda.is_finite() && l.lambda > 0.0 && l.lambda <= 100.0) {
-                return Err(format!("light {k}: lambda {} out of (0, 100]", l.lambda));
+            if !(l.lambda.is_finite() && (SRBF_LAMBDA_MIN..=100.0).contains(&l.lambda)) {
+                return Err(format!(
+                    "light {k}: lambda {} out of [{SRBF_LAMBDA_MIN}, 100]",
+                    l.lambda
+                ));
             }
             if l.rgb.iter().any(|a| !a.is_finite() || *a < 0.0) {
                 return Err(format!("light {k}: amplitudes must be finite and >= 0"));
@@ -225,5 +233,32 @@ impl SrbfSet {
             path: path.into(),
             source,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lights_bandwidth_outside_its_range_is_an_error() {
+        let set = |lambda: f64| SrbfSet {
+            version: SRBF_FILE_VERSION,
+            source: None,
+            source_hash: None,
+            source_size: None,
+            yaw: 0.0,
+            lights: vec![SrbfLight {
+                direction: [0.0, 1.0, 0.0],
+                lambda,
+                rgb: [1.0; 3],
+            }],
+            fit: None,
+        };
+        assert!(set(0.01).validate().is_ok());
+        for bad in [0.0, 1e-20, 5e-4, 101.0, f64::NAN] {
+            let e = set(bad).validate().unwrap_err();
+            assert!(e.contains("lambda"), "{bad}: {e}");
+        }
     }
 }

@@ -225,6 +225,9 @@ pub struct RefineStats {
     /// From the restart to the completion of the preview, and the first pass of the full image.
     pub preview: Option<Duration>,
     pub first_pass: Option<Duration>,
+    /// From the restart to the converged image: before [`Progress::converged`] where the plan then
+    /// draws the next preview's visibility at a divisor adapted since.
+    pub image_converged: Option<Duration>,
 }
 
 /// The passes the units belong to, in [`RefineStats::pass_time`] order.
@@ -1006,10 +1009,17 @@ impl Renderer {
             _ => None,
         };
         let r = &mut self.refinement;
+        // One time for what this unit completed (the first pass and the convergence may be one).
+        let since = r.started.elapsed();
+        if restart == r.restarts
+            && r.stage.image_converged()
+            && !matches!(unit, WorkUnit::PreviewVisibility { .. })
+        {
+            r.stats.image_converged.get_or_insert(since);
+        }
         if ready.is_some() && restart == r.restarts {
             // The image shows the latest change.
             r.preview_owed = false;
-            let since = r.started.elapsed();
             match ready {
                 Some(ImageReady::Preview) => {
                     r.stats.preview.get_or_insert(since);

@@ -61,11 +61,17 @@ impl LutTexture {
             (fy as usize).min(self.height - 2),
         );
         let (wx, wy) = (fx - x0 as f32, fy - y0 as f32);
-        let at =
-            |x: usize, y: usize, c: usize| self.texels[(y * self.width + x) * self.channels + c];
-        for (c, o) in out.iter_mut().enumerate().take(self.channels) {
-            let a = at(x0, y0, c) + wx * (at(x0 + 1, y0, c) - at(x0, y0, c));
-            let b = at(x0, y0 + 1, c) + wx * (at(x0 + 1, y0 + 1, c) - at(x0, y0 + 1, c));
+        // The two texels of each row side by side: (x0, x0 + 1) at y0 and at y0 + 1.
+        let ch = self.channels;
+        let pair = |y: usize| {
+            let i = (y * self.width + x0) * ch;
+            self.texels[i..i + 2 * ch].split_at(ch)
+        };
+        let ((a0, a1), (b0, b1)) = (pair(y0), pair(y0 + 1));
+        let texels = a0.iter().zip(a1).zip(b0.iter().zip(b1));
+        for (o, ((a0, a1), (b0, b1))) in out.iter_mut().zip(texels) {
+            let a = a0 + wx * (a1 - a0);
+            let b = b0 + wx * (b1 - b0);
             *o = a + wy * (b - a);
         }
     }
