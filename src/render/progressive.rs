@@ -47,8 +47,9 @@ const GUESS_GRID_ENTRY_S: f64 = 10e-3;
 /// 2-core Zen 3 VM; when the guess was 50 ns S1's 343k samples went in one 110-140 ms unit).
 const GUESS_GRID_SAMPLE_S: f64 = 500e-9;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
-/// A voxel resolved (lavapipe, two cores: 100-180 ns, 400-480 ns on a 2-core Zen 3 VM).
-const GUESS_VOXEL_S: f64 = 400e-9;
+/// A voxel resolved (lavapipe, two cores: 100-180 ns, 400-580 ns on a 2-core Zen 3 VM, where the
+/// guess of 400 ns made S1's first resolve unit of 87.5k voxels take 51 ms at 35 ms units).
+const GUESS_VOXEL_S: f64 = 600e-9;
 /// The fewest voxels a resolve unit and rows a backdrop unit hold (a unit's fixed cost, which a tiny
 /// budget cannot hold, would otherwise shrink them to one of each).
 const MIN_RESOLVE_VOXELS: u32 = 16_384;
