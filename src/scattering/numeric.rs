@@ -23,10 +23,24 @@ fn panel<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64) -> f64 {
 
 fn adaptive<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
     let m = 0.5 * (a + b);
-    let (l, r) = (panel(f, a, m), panel(f, m, b));
+    let halves = [panel(f, a, m), panel(f, m, b)];
+    adaptive_halves(f, a, b, whole, halves, tol, depth)
+}
+
+/// [`adaptive`] with the halves' panels of [a, b] already computed.
+fn adaptive_halves<F: Fn(f64) -> f64>(
+    f: &F,
+    a: f64,
+    b: f64,
+    whole: f64,
+    [l, r]: [f64; 2],
+    tol: f64,
+    depth: u32,
+) -> f64 {
     if (l + r - whole).abs() <= tol || depth == 0 {
         return l + r;
     }
+    let m = 0.5 * (a + b);
     adaptive(f, a, m, l, 0.5 * tol, depth - 1) + adaptive(f, m, b, r, 0.5 * tol, depth - 1)
 }
 
@@ -99,13 +113,11 @@ impl<'f, F: Fn(f64) -> f64> EndpointSingular<'f, F> {
     /// The integral to about `tol` absolute error: [`integrate`]'s adaptive rule on the substituted
     /// integrand, its first level already done.
     fn refine(&self, tol: f64) -> f64 {
-        let [l, r] = self.halves;
-        if self.a == self.b || (l + r - self.whole).abs() <= tol {
-            return l + r;
+        if self.a == self.b {
+            return 0.0;
         }
         let g = |u: f64| self.g(u);
-        adaptive(&g, 0.0, 0.5, l, 0.5 * tol, MAX_DEPTH - 1)
-            + adaptive(&g, 0.5, 1.0, r, 0.5 * tol, MAX_DEPTH - 1)
+        adaptive_halves(&g, 0.0, 1.0, self.whole, self.halves, tol, MAX_DEPTH)
     }
 }
 
