@@ -20,6 +20,7 @@ pub mod segment_shading;
 pub mod shade;
 pub mod shading;
 pub mod shadow_grid;
+pub mod table_cache;
 pub mod targets;
 pub mod tiled;
 pub mod timing;

@@ -253,16 +253,18 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
         let fibers = settings
             .shadows
             .then(|| FiberGrid::build(scene.hair, scene.sigma_a));
-        // The tables as the renderer builds them (each point reads them at its own absorption).
-        let (forward, dual) = rayon::join(
-            || ForwardTable::build(params, REFERENCE_VARIANT),
-            || DualTables::build(params, REFERENCE_VARIANT),
-        );
-        let azimuthal = AzimuthalTable::for_params(&scene.look.fast);
+        // The tables the renderer reads (each point reads them at its own absorption): the same
+        // build, taken from the process's cache when the renderer made them.
+        let tables = super::renderer::build_tables(params, None);
+        let azimuthal = if tables.azimuthal.matches(&scene.look.fast) {
+            tables.azimuthal.clone()
+        } else {
+            std::sync::Arc::new(AzimuthalTable::for_params(&scene.look.fast))
+        };
         let d = DualReference {
             fibers: fibers.as_ref(),
-            forward: &forward,
-            dual: &dual,
+            forward: &tables.forward,
+            dual: &tables.dual,
             fast: scene.look.fast,
             azimuthal: &azimuthal,
         };

@@ -17,6 +17,7 @@ use super::shading::{
     ShadingPass,
 };
 use super::shadow_grid::{GpuShadowGrid, ShadowGridInputs, ShadowGridPass};
+use super::table_cache::with_cache;
 use super::targets::{COMPONENTS, FrameTargets, MAX_SEGMENTS};
 use super::timing::PassTimer;
 use super::visibility::VisibilityPass;
@@ -118,6 +119,7 @@ impl HairLook {
 /// absorption, which is their second axis: read per point's) and the azimuthal table of the exact
 /// window integrals (eta and eccentricity; read per point's absorption).
 /// The editor builds them on a worker thread ([`Renderer::set_params_deferred`], [`Renderer::set_tables`]).
+#[derive(Clone)]
 pub struct ParamTables {
     pub forward: ForwardTable,
     pub dual: DualTables,
@@ -133,8 +135,17 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
     } == *b
 }
 
-/// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same.
+/// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same;
+/// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
+/// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
+    if let Some(tables) = with_cache(|c| c.get(params)) {
+        return tables;
+    }
+    let reuse = reuse
+        .filter(|t| t.fits_hair(params))
+        .cloned()
+        .or_else(|| with_cache(|c| c.azimuthal(params)));
     let ((forward, dual), azimuthal) = rayon::join(
         || {
             rayon::join(
@@ -142,16 +153,15 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
                 || DualTables::build(params, REFERENCE_VARIANT),
             )
         },
-        || match reuse {
-            Some(t) if t.fits_hair(params) => t.clone(),
-            _ => Arc::new(AzimuthalTable::for_hair(params)),
-        },
+        || reuse.unwrap_or_else(|| Arc::new(AzimuthalTable::for_hair(params))),
     );
-    ParamTables {
+    let tables = ParamTables {
         forward,
         dual,
         azimuthal,
-    }
+    };
+    with_cache(|c| c.keep(params, &tables));
+    tables
 }
 
 /// The largest angle (radians) a segment may subtend from the eye for the frame to shade it once:
