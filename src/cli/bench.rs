@@ -13,6 +13,7 @@ use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
 use strandlight::render::renderer::build_tables;
 use strandlight::render::scene::{StandardScene, default_environment};
+use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
@@ -239,6 +240,9 @@ fn edit_run(
     edited: &HairLook,
 ) -> anyhow::Result<EditReport> {
     let params = edited.params;
+    // The tables built anew, as for parameters not seen before (the process keeps recent sets:
+    // the restored edit would otherwise take them from the cache).
+    table_cache::clear();
     let preview_factor = renderer.preview_factor();
     let t = Instant::now();
     let needs_tables = renderer.set_params_deferred(ctx, edited);
@@ -315,6 +319,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let scene = StandardScene::by_name(name)
             .with_context(|| format!("unknown scene '{name}' (S0, S1, S2 or S3)"))?;
         let mut cpu = BTreeMap::new();
+        // Each scene's renderer builds its tables (renderer_creation includes them).
+        table_cache::clear();
         let t = Instant::now();
         let hair = scene.hair();
         cpu.insert("hair_generation", t.elapsed().as_secs_f64());

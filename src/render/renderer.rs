@@ -139,7 +139,11 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
 /// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
-    if let Some(tables) = with_cache(|c| c.get(params)) {
+    if let Some(mut tables) = with_cache(|c| c.get(params)) {
+        // The caller's table where it serves: callers tell a new azimuthal table by identity.
+        if let Some(r) = reuse.filter(|r| r.fits_hair(params)) {
+            tables.azimuthal = r.clone();
+        }
         return tables;
     }
     let reuse = reuse

@@ -17,7 +17,6 @@ use crate::scattering::params::HairParams;
 pub const CACHED_PARAMETER_SETS: usize = 4;
 
 /// Tables by parameter set, most recently used last.
-#[derive(Default)]
 pub struct TableCache {
     entries: Vec<(HairParams, ParamTables)>,
     capacity: usize,
@@ -64,63 +63,115 @@ impl TableCache {
 /// The process's cache ([`super::renderer::build_tables`] reads and fills it).
 static CACHE: Mutex<TableCache> = Mutex::new(TableCache::new(CACHED_PARAMETER_SETS));
 
-/// Runs `f` on the process's cache. (A poisoned lock only means that another thread panicked while
-/// holding it: every entry is pushed whole, so the cache is still valid.)
-pub fn with_cache<R>(f: impl FnOnce(&mut TableCache) -> R) -> R {
+/// Runs `f` on the process's cache, locked (`f` must not build tables: the lock is not re-entrant).
+/// A poisoned lock only means that another thread panicked while holding it: every entry is
+/// pushed whole, so the cache is still valid.
+pub(crate) fn with_cache<R>(f: impl FnOnce(&mut TableCache) -> R) -> R {
     f(&mut CACHE.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Forgets every kept set (the next build of any parameters builds anew: benchmarks time it).
+pub fn clear() {
+    with_cache(|c| c.entries.clear());
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::render::renderer::build_tables;
+    use crate::scattering::dual_terms::DualTables;
+    use crate::shadow::forward::ForwardTable;
 
-    /// A kept set serves its parameters at any absorption, not another eta; the least recently used
-    /// set goes first; the process's cache gives a second build the first one's tables.
+    /// Tables that are told apart by their contents (no build: the cache's logic alone).
+    fn tagged(tag: f32, p: &HairParams) -> ParamTables {
+        ParamTables {
+            forward: ForwardTable {
+                a_f: vec![tag],
+                beta_f2: vec![],
+            },
+            dual: DualTables { rows: vec![] },
+            azimuthal: Arc::new(AzimuthalTable {
+                eta: p.eta as f32,
+                eccentricity: p.eccentricity as f32,
+                cells: vec![[tag; 4]],
+            }),
+        }
+    }
+
+    fn tag(t: &ParamTables) -> f32 {
+        t.forward.a_f[0]
+    }
+
+    /// A kept set serves its parameters at any absorption and no other set; the least recently
+    /// used set goes first (a read counts as a use); a kept azimuthal table serves any set of the
+    /// same eta and eccentricity.
     #[test]
-    fn kept_tables_serve_the_same_parameters() {
+    fn kept_tables_serve_the_same_parameters_only() {
+        let p = HairParams::default();
+        let mut cache = TableCache::new(2);
+        cache.keep(&p, &tagged(1.0, &p));
+        let dyed = HairParams {
+            sigma_a: [2.0, 1.0, 0.5],
+            ..p
+        };
+        assert_eq!(cache.get(&dyed).as_ref().map(tag), Some(1.0));
+        let others = [
+            HairParams {
+                beta_r: p.beta_r * 1.5,
+                ..p
+            },
+            HairParams {
+                alpha_r: p.alpha_r * 0.5,
+                ..p
+            },
+            HairParams {
+                eccentricity: 0.9,
+                ..p
+            },
+            HairParams { eta: 1.6, ..p },
+            HairParams {
+                caustic_fade: p.caustic_fade * 2.0,
+                ..p
+            },
+        ];
+        for o in &others {
+            assert!(cache.get(o).is_none(), "{o:?} served by {p:?}'s tables");
+        }
+        let wider = others[0];
+        assert!(
+            cache.azimuthal(&wider).is_some(),
+            "the same eta and eccentricity"
+        );
+        assert!(cache.azimuthal(&others[2]).is_none() && cache.azimuthal(&others[3]).is_none());
+        // [p], then [p, wider]; reading p makes wider the least recently used, which a third set
+        // pushes out.
+        cache.keep(&wider, &tagged(2.0, &wider));
+        assert_eq!(cache.get(&p).as_ref().map(tag), Some(1.0));
+        cache.keep(&others[1], &tagged(3.0, &others[1]));
+        assert!(cache.get(&wider).is_none());
+        assert_eq!(cache.get(&p).as_ref().map(tag), Some(1.0));
+        // Keeping a set again replaces its entry.
+        cache.keep(&dyed, &tagged(4.0, &p));
+        assert_eq!(cache.get(&p).as_ref().map(tag), Some(4.0));
+        assert_eq!(cache.entries.len(), 2);
+    }
+
+    /// build_tables takes a kept set instead of building (a tagged set stands for it), with the
+    /// caller's azimuthal table in place of the kept one where it serves the parameters.
+    #[test]
+    fn build_tables_takes_a_kept_set_and_keeps_the_callers_table() {
         // An eta no other test uses (tests run in parallel and share the process's cache).
         let p = HairParams {
             eta: 1.5123,
             ..HairParams::default()
         };
-        let tables = build_tables(&p, None);
-        let again = build_tables(&p, None);
-        assert!(
-            Arc::ptr_eq(&tables.azimuthal, &again.azimuthal) || with_cache(|c| c.get(&p).is_none())
-        );
-        let mut cache = TableCache::new(2);
-        cache.keep(&p, &tables);
-        let dyed = HairParams {
-            sigma_a: [2.0, 1.0, 0.5],
-            ..p
-        };
-        let hit = cache
-            .get(&dyed)
-            .expect("an absorption change uses the same tables");
-        assert!(Arc::ptr_eq(&hit.azimuthal, &tables.azimuthal));
-        assert_eq!(hit.dual, tables.dual);
-        assert_eq!(
-            (&hit.forward.a_f, &hit.forward.beta_f2),
-            (&tables.forward.a_f, &tables.forward.beta_f2)
-        );
-        let wider = HairParams {
-            beta_r: p.beta_r * 1.5,
-            ..p
-        };
-        assert!(
-            cache.get(&wider).is_none(),
-            "another width needs its own tables"
-        );
-        assert!(
-            cache.azimuthal(&wider).is_some(),
-            "but the same azimuthal table"
-        );
-        let other_eta = HairParams { eta: 1.5124, ..p };
-        assert!(cache.azimuthal(&other_eta).is_none());
-        // Two more sets in a cache of two: p, the least recently used, goes.
-        cache.keep(&wider, &tables);
-        cache.keep(&other_eta, &tables);
-        assert!(cache.get(&p).is_none() && cache.get(&wider).is_some());
+        with_cache(|c| c.keep(&p, &tagged(7.0, &p)));
+        let t = build_tables(&p, None);
+        assert_eq!(tag(&t), 7.0, "built anew");
+        let own = tagged(8.0, &p).azimuthal;
+        let t = build_tables(&p, Some(&own));
+        assert_eq!(tag(&t), 7.0);
+        assert!(Arc::ptr_eq(&t.azimuthal, &own));
+        with_cache(|c| c.entries.retain(|(q, _)| !same_tables(q, &p)));
     }
 }

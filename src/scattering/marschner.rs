@@ -154,6 +154,14 @@ pub fn caustic_offset(p: u32, eta_perp: f64) -> Option<f64> {
     (h2 > 0.0 && h2 < 1.0).then(|| h2.sqrt())
 }
 
+/// The absorption-free factors of A_p(h) ([`AzimuthalLobe::attenuation_geometry`]).
+#[derive(Clone, Copy, Debug)]
+pub struct AttenuationGeometry {
+    pub f_ext: f64,
+    pub f_int: f64,
+    pub chord: f64,
+}
+
 /// Everything about one lobe that depends on theta_d (and phi_h through eccentricity) but not on phi.
 #[derive(Clone, Copy, Debug)]
 pub struct AzimuthalLobe {
@@ -230,6 +238,14 @@ impl AzimuthalLobe {
     /// [`AzimuthalLobe::attenuation_a_p`] at h in [-1, 1] with its angles gamma_i = asin h and
     /// gamma_t = asin(h / eta') already known (an integral over gamma_i has them).
     pub fn attenuation_a_p_at(&self, h: f64, gamma_i: f64, gamma_t: f64) -> Rgb {
+        let g = self.attenuation_geometry(h, gamma_i, gamma_t);
+        self.sigma_a_prime.map(|s| self.attenuation_of(&g, s))
+    }
+
+    /// What A_p(h) owes to the fiber's surface and shape, not its absorption: the Fresnel factors
+    /// and the chord 2 cos(gamma_t) (the same for every sigma_a; the dual-scattering tables share it
+    /// across their absorption axis).
+    pub fn attenuation_geometry(&self, h: f64, gamma_i: f64, gamma_t: f64) -> AttenuationGeometry {
         let (f_ext, f_int) = match self.fresnel {
             FresnelModel::Exact => (
                 fresnel_bravais(self.eta_perp, self.eta_par, gamma_i),
@@ -240,15 +256,19 @@ impl AzimuthalLobe {
                 (f, f)
             }
         };
-        let chord = 2.0 * gamma_t.cos();
+        AttenuationGeometry {
+            f_ext,
+            f_int,
+            chord: 2.0 * gamma_t.cos(),
+        }
+    }
+
+    /// A_p of one channel from its geometry and the channel's sigma_a' (`sigma_a_prime`).
+    pub fn attenuation_of(&self, g: &AttenuationGeometry, sigma_a_prime: f64) -> f64 {
         match self.lobe {
-            Lobe::R => [f_ext; 3],
-            Lobe::TT => self
-                .sigma_a_prime
-                .map(|s| (1.0 - f_ext).powi(2) * (-s * chord).exp()),
-            Lobe::TRT => self
-                .sigma_a_prime
-                .map(|s| (1.0 - f_ext).powi(2) * f_int * (-2.0 * s * chord).exp()),
+            Lobe::R => g.f_ext,
+            Lobe::TT => (1.0 - g.f_ext).powi(2) * (-sigma_a_prime * g.chord).exp(),
+            Lobe::TRT => (1.0 - g.f_ext).powi(2) * g.f_int * (-2.0 * sigma_a_prime * g.chord).exp(),
         }
     }
 

@@ -25,7 +25,7 @@
 
 use super::cone::{DensityPyramid, crossings};
 use super::fiber_density::FiberDensity;
-use crate::scattering::dual_terms::dual_sample;
+use crate::scattering::dual_terms::dual_samples_across;
 use crate::scattering::{HairParams, ModelVariant};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -45,17 +45,22 @@ pub use crate::scattering::dual_terms::{SIGMA_MAX, SIGMA_MIN, SIGMA_SAMPLES, sig
 
 impl ForwardTable {
     pub fn build(params: &HairParams, variant: ModelVariant) -> Self {
-        let cells: Vec<(f32, f32)> = (0..THETA_SAMPLES * SIGMA_SAMPLES)
+        // By theta, every absorption at once (dual_samples_across: the same samples as dual_sample
+        // at each, to the bit), then in the table's order (theta fastest).
+        let sigmas: Vec<f64> = (0..SIGMA_SAMPLES).map(|j| sigma_at(j) as f64).collect();
+        let columns: Vec<Vec<(f32, f32)>> = (0..THETA_SAMPLES)
             .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % THETA_SAMPLES, k / THETA_SAMPLES);
+            .map(|i| {
                 let theta =
                     -FRAC_PI_2 + std::f64::consts::PI * i as f64 / (THETA_SAMPLES - 1) as f64;
-                let mut p = *params;
-                p.sigma_a = [sigma_at(j) as f64; 3];
-                let s = dual_sample(&p, variant, theta);
-                (s.a_f[0], s.beta_f2[0])
+                dual_samples_across(params, variant, theta, &sigmas)
+                    .iter()
+                    .map(|s| (s.a_f[0], s.beta_f2[0]))
+                    .collect()
             })
+            .collect();
+        let cells: Vec<(f32, f32)> = (0..THETA_SAMPLES * SIGMA_SAMPLES)
+            .map(|k| columns[k % THETA_SAMPLES][k / THETA_SAMPLES])
             .collect();
         Self {
             a_f: cells.iter().map(|c| c.0).collect(),
