@@ -170,6 +170,18 @@ pub fn integrate_fixed<const K: usize>(
     panels: usize,
 ) -> [f64; K] {
     let mut acc = [0.0; K];
+    fixed_nodes(breaks, panels, |x, cw| {
+        let v = f(x);
+        for k in 0..K {
+            acc[k] += cw * v[k];
+        }
+    });
+    acc
+}
+
+/// The nodes of [`integrate_fixed`]'s rule in order, each with its weight (the panel's half-width
+/// times the rule's weight).
+fn fixed_nodes(breaks: &[f64], panels: usize, mut node: impl FnMut(f64, f64)) {
     let pairs = rule().as_node_weight_pairs();
     for w in breaks.windows(2) {
         let (a, b) = (w[0], w[1]);
@@ -181,14 +193,10 @@ pub fn integrate_fixed<const K: usize>(
             let (lo, hi) = (a + h * p as f64, a + h * (p + 1) as f64);
             let (c, d) = (0.5 * (hi - lo), 0.5 * (hi + lo));
             for &(x, wt) in pairs {
-                let v = f(c * x + d);
-                for k in 0..K {
-                    acc[k] += c * wt * v[k];
-                }
+                node(c * x + d, c * wt);
             }
         }
     }
-    acc
 }
 
 /// [`integrate_fixed`] of a vector-valued integrand of run-time length `acc.len()` (`f` writes its
@@ -202,24 +210,12 @@ pub fn integrate_fixed_slice(
 ) {
     acc.fill(0.0);
     let mut v = vec![0.0; acc.len()];
-    let pairs = rule().as_node_weight_pairs();
-    for w in breaks.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if b <= a {
-            continue;
+    fixed_nodes(breaks, panels, |x, cw| {
+        f(x, &mut v);
+        for (s, vk) in acc.iter_mut().zip(&v) {
+            *s += cw * vk;
         }
-        let h = (b - a) / panels as f64;
-        for p in 0..panels {
-            let (lo, hi) = (a + h * p as f64, a + h * (p + 1) as f64);
-            let (c, d) = (0.5 * (hi - lo), 0.5 * (hi + lo));
-            for &(x, wt) in pairs {
-                f(c * x + d, &mut v);
-                for (s, vk) in acc.iter_mut().zip(&v) {
-                    *s += c * wt * vk;
-                }
-            }
-        }
-    }
+    });
 }
 
 #[cfg(test)]
