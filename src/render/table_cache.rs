@@ -1,10 +1,12 @@
 //! The hair-parameter tables ([`ParamTables`]) of the last few parameter sets, kept for the process:
 //! a renderer made again for the same look (a second view, a test's next render, the reference
 //! beside the renderer) or an edit undone takes them from here instead of building them again
-//! (about 2.2 s on two cores for the default fiber, most of a renderer's creation).
+//! (about 1.1 s on two cores for the default fiber, nearly all of it the azimuthal table: most of a
+//! renderer's creation).
 //!
 //! The tables are a pure function of the parameters other than the absorption ([`same_tables`]):
-//! a cached entry is exactly what a new build would give.
+//! a cached entry is exactly what a new build would give. (The key is conservative: the caustic
+//! parameters, which no table reads, are part of it.)
 
 use std::sync::{Arc, Mutex};
 

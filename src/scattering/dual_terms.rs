@@ -499,7 +499,7 @@ impl DualTables {
         use rayon::prelude::*;
         // By inclination, every absorption at once (dual_samples_across: the exact model's geometry
         // once per node for all rows), then the rows: the same samples as a build row by row
-        // (DualRow::build at each absorption), about 8x faster.
+        // (DualRow::build at each absorption), about 12x faster.
         let sigmas: Vec<f64> = (0..DUAL_SIGMA_SAMPLES)
             .map(|j| axis_sigma(j, DUAL_SIGMA_SAMPLES) as f64)
             .collect();
