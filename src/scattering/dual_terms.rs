@@ -73,30 +73,12 @@ pub fn azimuthal_split(
     let mut p = *params;
     p.eccentricity = 1.0;
     let az = AzimuthalLobe::new(&p, variant, lobe, theta_d, 0.0);
-    let [f0, f1, f2, e0, e1, e2] = integrate_fixed(
-        |t| {
-            let h = t.sin();
-            let a = az.attenuation_a_p(h);
-            let w = t.cos() * 0.5;
-            let frac = wrap_angle(phi_p(lobe.p(), h, az.eta_perp)).abs() / PI;
-            [
-                w * a[0] * frac,
-                w * a[1] * frac,
-                w * a[2] * frac,
-                w * a[0],
-                w * a[1],
-                w * a[2],
-            ]
-        },
-        &[-FRAC_PI_2, -0.75, 0.0, 0.75, FRAC_PI_2],
-        6,
-    );
-    ([f0, f1, f2], [e0 - f0, e1 - f1, e2 - f2])
+    let s = split_sums(&az, &az.sigma_a_prime);
+    ([s[0].0, s[1].0, s[2].0], [s[0].1, s[1].1, s[2].1])
 }
 
-/// [`azimuthal_split`] of lobe t at theta_d for each absorption of `sigmas` (every channel at it), equal
-/// to it to the bit: each node's geometry (its h, angles, Fresnel factors, chord and phi) is found
-/// once for all absorptions, and only each one's attenuation exp(-2 p sigma_a' cos gamma_t) per node.
+/// [`azimuthal_split`] of lobe t at theta_d for each absorption of `sigmas` (every channel at it):
+/// each node's geometry is found once for all of them ([`split_sums`]).
 pub fn azimuthal_split_rows(
     params: &HairParams,
     variant: ModelVariant,
@@ -115,17 +97,28 @@ pub fn azimuthal_split_rows(
         })
         .collect();
     let az = AzimuthalLobe::new(&p, variant, lobe, theta_d, 0.0);
-    let mut sums = vec![0.0; 2 * sigmas.len()];
+    split_sums(&az, &sigma_primes)
+        .iter()
+        .map(|&(f, b)| ([f; 3], [b; 3]))
+        .collect()
+}
+
+/// (F_f, F_b) of lobe `az` for each sigma_a' of `sigma_primes`, by h = sin t quadrature: each
+/// node's geometry (h, gamma_i, gamma_t, Fresnel factors, chord, phi) once, its attenuation
+/// exp(-2 p sigma_a' cos gamma_t) per sigma_a' (the same arithmetic as
+/// [`AzimuthalLobe::attenuation_a_p`] per channel).
+fn split_sums(az: &AzimuthalLobe, sigma_primes: &[f64]) -> Vec<(f64, f64)> {
+    let p = az.p();
+    let mut sums = vec![0.0; 2 * sigma_primes.len()];
     integrate_fixed_slice(
         |t, v| {
-            // As AzimuthalLobe::attenuation_a_p and azimuthal_split's integrand.
             let h = t.sin();
             let hc = h.clamp(-1.0, 1.0);
             let gamma_i = hc.asin();
             let gamma_t = (hc / az.eta_perp).clamp(-1.0, 1.0).asin();
             let g = az.attenuation_geometry(hc, gamma_i, gamma_t);
             let w = t.cos() * 0.5;
-            let frac = wrap_angle(phi_p(lobe.p(), h, az.eta_perp)).abs() / PI;
+            let frac = wrap_angle(phi_p(p, h, az.eta_perp)).abs() / PI;
             for (j, &s) in sigma_primes.iter().enumerate() {
                 let a = az.attenuation_of(&g, s);
                 v[2 * j] = w * a * frac;
@@ -137,7 +130,7 @@ pub fn azimuthal_split_rows(
         &mut sums,
     );
     sums.chunks_exact(2)
-        .map(|fe| ([fe[0]; 3], [fe[1] - fe[0]; 3]))
+        .map(|fe| (fe[0], fe[1] - fe[0]))
         .collect()
 }
 
@@ -219,7 +212,16 @@ pub struct DualSample {
 pub fn dual_sample(params: &HairParams, variant: ModelVariant, theta: f64) -> DualSample {
     let splits =
         Lobe::ALL.map(|lobe| azimuthal_split(params, variant, lobe, params.alpha(lobe) - theta));
-    dual_sample_of_splits(params, variant, theta, splits)
+    dual_sample_of_splits(
+        params,
+        longitudinal_fractions(params, variant, theta),
+        splits,
+    )
+}
+
+/// Each lobe's [`longitudinal_fraction`] at theta (absorption plays no part).
+fn longitudinal_fractions(params: &HairParams, variant: ModelVariant, theta: f64) -> [f64; 3] {
+    Lobe::ALL.map(|lobe| longitudinal_fraction(params, variant, lobe, theta))
 }
 
 /// [`dual_sample`] at theta for each absorption of `sigmas` (every channel at it; `params`' own
@@ -234,29 +236,29 @@ pub fn dual_samples_across(
     let splits = Lobe::ALL.map(|lobe| {
         azimuthal_split_rows(params, variant, lobe, params.alpha(lobe) - theta, sigmas)
     });
+    let fractions = longitudinal_fractions(params, variant, theta);
     (0..sigmas.len())
         .map(|j| {
             let p = HairParams {
                 sigma_a: [sigmas[j]; 3],
                 ..*params
             };
-            dual_sample_of_splits(&p, variant, theta, splits.each_ref().map(|s| s[j]))
+            dual_sample_of_splits(&p, fractions, splits.each_ref().map(|s| s[j]))
         })
         .collect()
 }
 
-/// dual_sample from each lobe's (F_f, F_b) ([`azimuthal_split`] at theta_d = alpha_t - theta).
+/// dual_sample from each lobe's longitudinal fraction and (F_f, F_b) ([`azimuthal_split`] at
+/// theta_d = alpha_t - theta).
 fn dual_sample_of_splits(
     params: &HairParams,
-    variant: ModelVariant,
-    theta: f64,
+    fractions: [f64; 3],
     splits: [([f64; 3], [f64; 3]); 3],
 ) -> DualSample {
     let mut s = DualSample::default();
     let (mut wf, mut wb) = ([0f64; 3], [0f64; 3]);
     let (mut af, mut ab, mut bf, mut bb) = ([0f64; 3], [0f64; 3], [0f64; 3], [0f64; 3]);
-    for (lobe, (ff, fb)) in Lobe::ALL.into_iter().zip(splits) {
-        let l = longitudinal_fraction(params, variant, lobe, theta);
+    for ((lobe, l), (ff, fb)) in Lobe::ALL.into_iter().zip(fractions).zip(splits) {
         let (alpha, beta2) = (params.alpha(lobe), params.beta(lobe).powi(2));
         for c in 0..3 {
             let (f, b) = (l * ff[c], l * fb[c]);
