@@ -139,17 +139,16 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
 /// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
+    // The caller's table where it serves, kept or built: callers tell a new azimuthal table by
+    // identity.
+    let reuse = reuse.filter(|t| t.fits_hair(params)).cloned();
     if let Some(mut tables) = with_cache(|c| c.get(params)) {
-        // The caller's table where it serves: callers tell a new azimuthal table by identity.
-        if let Some(r) = reuse.filter(|r| r.fits_hair(params)) {
-            tables.azimuthal = r.clone();
+        if let Some(r) = reuse {
+            tables.azimuthal = r;
         }
         return tables;
     }
-    let reuse = reuse
-        .filter(|t| t.fits_hair(params))
-        .cloned()
-        .or_else(|| with_cache(|c| c.azimuthal(params)));
+    let reuse = reuse.or_else(|| with_cache(|c| c.azimuthal(params)));
     let ((forward, dual), azimuthal) = rayon::join(
         || {
             rayon::join(
