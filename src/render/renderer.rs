@@ -757,7 +757,8 @@ impl Renderer {
 
     /// Writes the look's fast parameters, with the azimuthal table's eta and eccentricity while the
     /// table for new ones is being built: a frame never reads a table made for another index (an eta or
-    /// eccentricity change shows when its table arrives, 0.4-1.7 s on two cores).
+    /// eccentricity change shows when its table arrives, 0.75-0.85 s on two cores for a round fiber,
+    /// about 3 s for an elliptical one).
     fn write_params(&self, ctx: &GpuContext) {
         let mut fast = self.look.fast;
         if !self.azimuthal.matches(&fast) {

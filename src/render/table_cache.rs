@@ -1,8 +1,8 @@
 //! The hair-parameter tables ([`ParamTables`]) of the last few parameter sets, kept for the process:
 //! a renderer made again for the same look (a second view, a test's next render, the reference
 //! beside the renderer) or an edit undone takes them from here instead of building them again
-//! (about 1.1 s on two cores for the default fiber, nearly all of it the azimuthal table: most of a
-//! renderer's creation).
+//! (about 0.85 s on two cores for the default fiber, nearly all of it the azimuthal table: about
+//! half of a renderer's creation).
 //!
 //! The tables are a pure function of the parameters other than the absorption ([`same_tables`]):
 //! a cached entry is exactly what a new build would give. (The key is conservative: the caustic
