@@ -451,6 +451,56 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
     );
 }
 
+/// An eta change: the viewport keeps the old index until the new one's azimuthal table is ready (no
+/// frame reads a table made for another index), shows it first with the table's draft (built at once, a
+/// tenth of the build), then converges with the table to what a headless render of the session makes.
+#[test]
+fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
+    let dir = tmp("eta");
+    let mut h = harness(small_session(), &dir, false);
+    converge(&mut h);
+    let before = mean_luminance(&image(&h));
+    let t = Instant::now();
+    slider(&h, "η").set_value_accesskit(1.62);
+    let (mut draft_in, mut table_in) = (None, None);
+    while table_in.is_none() {
+        h.step();
+        let live = h.state().live.as_ref().expect("a scene");
+        let table = live.renderer.azimuthal_table();
+        if table.eta == 1.62 {
+            if table.draft {
+                draft_in.get_or_insert(t.elapsed());
+            } else {
+                table_in = Some(t.elapsed());
+            }
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "no table for the new eta"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let draft_in = draft_in.expect("the new eta showed with a draft first");
+    println!(
+        "eta 1.55 -> 1.62: draft in the renderer after {:.2} s, the table after {:.2} s",
+        draft_in.as_secs_f64(),
+        table_in.map_or(0.0, |d| d.as_secs_f64())
+    );
+    converge(&mut h);
+    let got = image(&h);
+    assert_eq!(h.state().session.look.params.eta, 1.62);
+    let mut session = h.state().session.clone();
+    session.render.width = got.width;
+    session.render.height = got.height;
+    let cli = render_session(&dir, "eta", &session);
+    let d = max_relative_difference(&got, &cli);
+    println!(
+        "editor against render --session: max difference {d:.2e} of the peak; mean luminance {before:.4} -> {:.4}",
+        mean_luminance(&got)
+    );
+    assert!(d < 1e-4, "{d}");
+}
+
 /// Pixels of `f` showing the head (any of their samples).
 fn head_pixels(f: &Frame) -> usize {
     f.sample_ids

@@ -11,7 +11,7 @@ use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
-use strandlight::render::renderer::build_tables;
+use strandlight::render::renderer::{build_preview_tables, build_tables};
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
@@ -148,6 +148,14 @@ struct EditReport {
     cpu_ms: f64,
     /// CPU milliseconds of the tables on the worker.
     tables_ms: f64,
+    /// A new eta or eccentricity: CPU milliseconds of the draft tables on the worker
+    /// (`build_preview_tables`), built at once and handed over when done, as the editor does.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    draft_tables_ms: Option<f64>,
+    /// A new eta or eccentricity: from the change to the first image (a preview) that reads its
+    /// index (the earlier images keep the old one: no frame reads a table made for another index).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    index_shown_ms: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     preview_ms: Option<f64>,
     first_pass_ms: f64,
@@ -168,6 +176,9 @@ struct RefineRun {
     converged_ms: f64,
     /// The longest unit over the whole run (a refining restart resets the stats).
     longest_ms: f64,
+    /// Whether the plan as the last call left it has shown an image (a preview or the full image
+    /// of its latest restart).
+    shown: bool,
 }
 
 /// Refines to convergence, waiting for each unit, calling `between` after each call (the editor's
@@ -185,10 +196,12 @@ fn refine_run(
         image_converged_ms: None,
         converged_ms: 0.0,
         longest_ms: 0.0,
+        shown: false,
     };
     loop {
         let p = renderer.refine(ctx)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
+        run.shown = p.stats.preview.is_some() || p.stats.first_pass.is_some();
         run.longest_ms = run.longest_ms.max(p.stats.longest.as_secs_f64() * 1e3);
         match p.ready {
             Some(ImageReady::Preview) => {
@@ -233,7 +246,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Changes the look to `edited` as the editor would (the uniform now, the tables on a worker thread,
-/// handed over once the full image's first pass is shown) and refines to convergence.
+/// handed over once the full image's first pass is shown; for a new eta or eccentricity draft tables
+/// first, at once, and the tables once the draft's preview shows) and refines to convergence.
 fn edit_run(
     ctx: &GpuContext,
     renderer: &mut Renderer,
@@ -248,56 +262,109 @@ fn edit_run(
     let needs_tables = renderer.set_params_deferred(ctx, edited);
     let cpu_ms = t.elapsed().as_secs_f64() * 1e3;
     let azimuthal = renderer.azimuthal_table().clone();
-    let spawn = move || {
+    let new_index = needs_tables && !azimuthal.made_for_hair(&params);
+    let timed = |draft: bool| {
+        let azimuthal = azimuthal.clone();
         std::thread::spawn(move || {
             let t = Instant::now();
-            let tables = build_tables(&params, Some(&azimuthal));
+            let tables = if draft {
+                build_preview_tables(&params, Some(&azimuthal))
+            } else {
+                build_tables(&params, Some(&azimuthal))
+            };
             (tables, t.elapsed().as_secs_f64() * 1e3)
         })
     };
-    // As the editor: the build starts once the preview shows (at once without one).
-    let mut spawn = needs_tables.then_some(spawn);
+    let mut draft = new_index.then(|| timed(true));
+    let (mut draft_tables_ms, mut index_shown_ms) = (None, None);
+    // As the editor: the build starts once the change's preview shows (at once without one; for a
+    // new index once its draft's preview shows).
+    let mut spawn = needs_tables.then_some(());
     let mut worker = None;
-    if renderer.preview_factor() < 2 {
-        worker = spawn.take().map(|s| s());
+    if renderer.preview_factor() < 2 && !new_index {
+        worker = spawn.take().map(|_| timed(false));
     }
     let mut tables_ms = 0.0;
-    let mut hand_over = |r: &mut Renderer, worker: &mut Option<std::thread::JoinHandle<_>>| {
-        if let Some(w) = worker.take()
-            && let Ok((tables, ms)) = w.join()
-        {
-            tables_ms = ms;
-            r.set_tables(ctx, &params, &tables);
-        }
+    // The worker's tables to the renderer; their build's milliseconds.
+    let hand_over = |r: &mut Renderer, worker: &mut Option<std::thread::JoinHandle<_>>| {
+        let (tables, ms) = worker.take()?.join().ok()?;
+        r.set_tables(ctx, &params, &tables);
+        Some(ms)
     };
     let run = refine_run(ctx, renderer, |r, run| {
-        if (run.preview_ms.is_some() || run.first_pass_ms.is_some())
-            && let Some(s) = spawn.take()
-        {
-            worker = Some(s());
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        if new_index {
+            if draft_tables_ms.is_some() && index_shown_ms.is_none() && run.shown {
+                index_shown_ms = Some(ms);
+                worker = spawn.take().map(|_| timed(false));
+            }
+            if draft.as_ref().is_some_and(|d| d.is_finished())
+                && let Some(Ok((tables, ms))) = draft.take().map(|d| d.join())
+            {
+                r.set_tables(ctx, &params, &tables);
+                if tables.azimuthal.draft {
+                    draft_tables_ms = Some(ms);
+                    // Without a preview the table is built at once (the editor's).
+                    if r.preview_factor() < 2 {
+                        worker = spawn.take().map(|_| timed(false));
+                    }
+                } else {
+                    // Tables the process kept: nothing more to build.
+                    tables_ms = ms;
+                    spawn = None;
+                }
+            }
+            // The table goes over as soon as it is built (the editor's: a new azimuthal table).
+            if worker.as_ref().is_some_and(|w| w.is_finished()) {
+                tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
+            }
+            return;
+        }
+        if (run.preview_ms.is_some() || run.first_pass_ms.is_some()) && spawn.is_some() {
+            worker = spawn.take().map(|_| timed(false));
         }
         if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
-            hand_over(r, &mut worker);
+            tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
         }
     })?;
     let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
     let mut image_converged_ms = run.image_converged_ms;
-    if let Some(s) = spawn.take() {
-        worker = Some(s());
+    if let Some(d) = draft.take()
+        && let Ok((tables, ms)) = d.join()
+    {
+        // Converged before the draft came (not on lavapipe).
+        renderer.set_tables(ctx, &params, &tables);
+        if tables.azimuthal.draft {
+            draft_tables_ms = Some(ms);
+        } else {
+            tables_ms = ms;
+            spawn = None;
+        }
+    }
+    if spawn.take().is_some() {
+        worker = Some(timed(false));
     }
     if worker.is_some() {
         // Converged before the tables came: they refine it once more.
-        hand_over(renderer, &mut worker);
+        tables_ms = hand_over(renderer, &mut worker).unwrap_or(tables_ms);
         let before = t.elapsed().as_secs_f64() * 1e3;
         let again = refine_run(ctx, renderer, |_, _| {})?;
         converged_ms = t.elapsed().as_secs_f64() * 1e3;
         image_converged_ms = again.image_converged_ms.map(|ms| before + ms);
         longest_ms = longest_ms.max(again.longest_ms);
+        if new_index && index_shown_ms.is_none() {
+            index_shown_ms = again
+                .preview_ms
+                .or(again.first_pass_ms)
+                .map(|ms| before + ms);
+        }
     }
     Ok(EditReport {
         preview_factor,
         cpu_ms,
         tables_ms,
+        draft_tables_ms,
+        index_shown_ms,
         preview_ms: run.preview_ms,
         first_pass_ms: run.first_pass_ms.unwrap_or(run.converged_ms),
         image_converged_ms,
@@ -449,8 +516,15 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             );
             let mut narrow = look.params;
             narrow.beta_r *= 0.5;
+            let mut denser = look.params;
+            denser.eta = 1.6;
             let mut edits = Vec::new();
-            for (what, params) in [("beta_R halved", narrow), ("beta_R restored", look.params)] {
+            for (what, params) in [
+                ("beta_R halved", narrow),
+                ("beta_R restored", look.params),
+                ("eta 1.6", denser),
+                ("eta restored", look.params),
+            ] {
                 let edit = edit_run(&ctx, &mut renderer, &HairLook::new(params))?;
                 eprintln!(
                     "{} edit ({what}): {:.2} ms CPU, preview {} at 1/{}, first pass {:.0} ms, converged in {:.0} ms",

@@ -17,7 +17,7 @@ use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::occluder::Occluder;
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
-use crate::render::renderer::{ParamTables, build_tables};
+use crate::render::renderer::{ParamTables, build_preview_tables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
@@ -242,6 +242,8 @@ pub struct LiveScene {
     wanted_tables: Option<(HairParams, Arc<AzimuthalTable>)>,
     /// Tables built but not yet handed to the renderer (see `step`).
     held_tables: Option<Tables>,
+    /// The last table build died (a draft in the renderer then stays).
+    tables_failed: bool,
     pub progress: Option<Progress>,
     /// When the current refinement started, and how long it took to converge.
     pub refine_started: Instant,
@@ -355,6 +357,7 @@ impl LiveScene {
             wanted_camera: None,
             wanted_tables: None,
             held_tables: None,
+            tables_failed: false,
             progress: None,
             refine_started: Instant::now(),
             converged_in: None,
@@ -527,8 +530,12 @@ impl LiveScene {
     /// once); its tables are built off the UI thread when the parameters they depend on changed.
     pub(super) fn set_look_deferred(&mut self, look: HairLook) {
         let fits = |p: &HairParams| crate::render::renderer::same_tables(p, &look.params);
-        // Tables built or being built for parameters that differ only in the absorption serve.
-        let held_fits = self.held_tables.as_ref().is_some_and(|(p, _)| fits(p))
+        // Tables built or being built for parameters that differ only in the absorption serve (a
+        // draft's table follows it).
+        let held_fits = self
+            .held_tables
+            .as_ref()
+            .is_some_and(|(p, t)| fits(p) && !t.azimuthal.draft)
             || (self.tables.is_some() && self.tables_building.as_ref().is_some_and(fits));
         if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
             let params = look.params;
@@ -662,7 +669,8 @@ impl LiveScene {
             self.restarted();
         }
         // The tables' build starts once the change shows (at once without a preview, or for a new eta
-        // or eccentricity, which shows only with its azimuthal table).
+        // or eccentricity, which shows only with its azimuthal table: its draft at once, the table
+        // once the draft's preview shows).
         let start = self
             .wanted_tables
             .as_ref()
@@ -671,24 +679,40 @@ impl LiveScene {
                 self.tables.is_none()
                     && (self.first_image_in().is_some()
                         || self.renderer.preview_factor() < 2
-                        || !azimuthal.fits_hair(params))
+                        || !azimuthal.made_for_hair(params))
             });
         if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
             self.tables_building = Some(params);
+            // A new eta or eccentricity shows first with a draft of its azimuthal table (a tenth of
+            // the build), then with the table, built next.
+            let draft = !azimuthal.made_for_hair(&params);
             self.tables = Some(Job::spawn(
                 "hair tables",
                 || {},
-                move |_| (params, build_tables(&params, Some(&azimuthal))),
+                move |_| {
+                    let reuse = Some(&azimuthal);
+                    let tables = if draft {
+                        build_preview_tables(&params, reuse)
+                    } else {
+                        build_tables(&params, reuse)
+                    };
+                    (params, tables)
+                },
             ));
         }
         let finished = self.tables.as_mut().and_then(|job| job.poll());
         match finished {
             Some(Ok(tables)) => {
                 self.tables = None;
+                self.tables_failed = false;
                 self.held_tables = Some(tables);
             }
-            // A table build that died leaves the old tables (the shading still follows the look).
-            Some(Err(_)) => self.tables = None,
+            // A table build that died leaves the old tables (the shading still follows the look), or
+            // the draft: then the image is as final as it gets (`tables_pending`).
+            Some(Err(_)) => {
+                self.tables = None;
+                self.tables_failed = true;
+            }
             None => {}
         }
         // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
@@ -697,8 +721,8 @@ impl LiveScene {
         // that full image is on screen, so the change shows sharp in about one pass's time and its
         // multiple scattering follows. Tables go over at once when the grid is being rebuilt anyway
         // (one rebuild, not two) or when the azimuthal table is new (an eta or eccentricity change
-        // shows only with its table); anything waiting goes over when the refinement has nothing left
-        // to show.
+        // shows only with a table made for it: its draft, then the table); anything waiting goes over
+        // when the refinement has nothing left to show.
         let shown = self.full_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
         let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
             shown
@@ -709,7 +733,16 @@ impl LiveScene {
             && let Some((params, tables)) = self.held_tables.take()
             && self.renderer.set_tables(&self.ctx, &params, &tables)
         {
-            self.restarted_as_refinement();
+            if tables.azimuthal.draft {
+                // A new eta or eccentricity shows from here (its preview); the table is built once
+                // that preview shows, unless a newer change asked for other tables meanwhile.
+                if self.wanted_tables.is_none() {
+                    self.wanted_tables = Some((params, tables.azimuthal.clone()));
+                }
+                self.restarted();
+            } else {
+                self.restarted_as_refinement();
+            }
         }
         // With tables on the way, the volume waits for them: they rebuild the grid too.
         let tables_waiting =
@@ -808,6 +841,7 @@ impl LiveScene {
         self.wanted_tables.is_some()
             || self.tables.is_some()
             || self.held_tables.is_some()
+            || (self.renderer.azimuthal_table().draft && !self.tables_failed)
             || self.renderer.volume_stale()
     }
 }

@@ -135,10 +135,32 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
     } == *b
 }
 
-/// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same;
+/// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same
+/// (and it is no draft);
 /// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
+    assemble_tables(params, reuse, false)
+}
+
+/// Tables of `params` for a preview while [`build_tables`] builds them: those the process keeps when it
+/// has them, else the forward and dual tables with a draft of the azimuthal table where the eta or
+/// eccentricity is new ([`AzimuthalTable::build_draft`]: on two cores 0.08 s for a round fiber and
+/// 0.3 s for an elliptical one, against 0.8 s and 3 s). A draft is never kept, and a renderer holding
+/// one still asks for the tables ([`Renderer::set_params_deferred`]). `reuse` as for [`build_tables`].
+pub fn build_preview_tables(
+    params: &HairParams,
+    reuse: Option<&Arc<AzimuthalTable>>,
+) -> ParamTables {
+    assemble_tables(params, reuse, true)
+}
+
+/// [`build_tables`], or with `draft` [`build_preview_tables`].
+fn assemble_tables(
+    params: &HairParams,
+    reuse: Option<&Arc<AzimuthalTable>>,
+    draft: bool,
+) -> ParamTables {
     // The caller's table where it serves, kept or built: callers tell a new azimuthal table by
     // identity.
     let reuse = reuse.filter(|t| t.fits_hair(params)).cloned();
@@ -149,6 +171,16 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
         return tables;
     }
     let reuse = reuse.or_else(|| with_cache(|c| c.azimuthal(params)));
+    let azimuthal = || {
+        reuse.unwrap_or_else(|| {
+            let (eta, a) = (params.eta as f32, params.eccentricity as f32);
+            Arc::new(if draft {
+                AzimuthalTable::build_draft(eta, a)
+            } else {
+                AzimuthalTable::build(eta, a)
+            })
+        })
+    };
     let ((forward, dual), azimuthal) = rayon::join(
         || {
             rayon::join(
@@ -156,14 +188,16 @@ pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) ->
                 || DualTables::build(params, REFERENCE_VARIANT),
             )
         },
-        || reuse.unwrap_or_else(|| Arc::new(AzimuthalTable::for_hair(params))),
+        azimuthal,
     );
     let tables = ParamTables {
         forward,
         dual,
         azimuthal,
     };
-    with_cache(|c| c.keep(params, &tables));
+    if !tables.azimuthal.draft {
+        with_cache(|c| c.keep(params, &tables));
+    }
     tables
 }
 
@@ -714,7 +748,7 @@ impl Renderer {
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
         self.look = *look;
-        if !same_tables(&look.params, &self.tables_for) {
+        if self.tables_needed(&look.params) {
             let tables = build_tables(&look.params, Some(&self.azimuthal));
             self.set_tables(ctx, &look.params, &tables);
         }
@@ -742,26 +776,34 @@ impl Renderer {
     }
 
     /// Hair parameters changed, without waiting for the tables: the uniform is rewritten now (single
-    /// scattering shows the change in the next frame); returns true when parameters the tables depend
-    /// on changed (any but the absorption, [`same_tables`]), and then the caller builds the tables ([`build_tables`], off the UI thread) and hands them to
-    /// [`Renderer::set_tables`]. Until then multiple scattering and forward transmittance use the old
-    /// tables, and a new eta or eccentricity waits for its azimuthal table (the frame keeps the old
-    /// index: `write_params`).
+    /// scattering shows the change in the next frame); returns true when the renderer needs tables for
+    /// them ([`Renderer::tables_needed`]), and then the caller builds the tables ([`build_tables`], off
+    /// the UI thread) and hands them to [`Renderer::set_tables`]. Until then multiple scattering and
+    /// forward transmittance use the old tables, and a new eta or eccentricity waits for an azimuthal
+    /// table made for it (the frame keeps the old index: `write_params`); the editor hands it a draft
+    /// first ([`build_preview_tables`]).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
-        let tables_needed = !same_tables(&look.params, &self.tables_for);
+        let tables_needed = self.tables_needed(&look.params);
         self.look = *look;
         self.write_params(ctx);
         self.restart_refinement();
         tables_needed
     }
 
+    /// Whether `params` need tables this renderer does not hold: other parameters than the
+    /// absorption, or the azimuthal table is a draft ([`build_preview_tables`]).
+    pub fn tables_needed(&self, params: &HairParams) -> bool {
+        !same_tables(params, &self.tables_for) || self.azimuthal.draft
+    }
+
     /// Writes the look's fast parameters, with the azimuthal table's eta and eccentricity while the
     /// table for new ones is being built: a frame never reads a table made for another index (an eta or
-    /// eccentricity change shows when its table arrives, 0.75-0.85 s on two cores for a round fiber,
-    /// about 3 s for an elliptical one).
+    /// eccentricity change shows when a table made for it arrives: in the editor its draft, 0.08 s of
+    /// build on two cores for a round fiber and 0.3 s for an elliptical one, then the table, 0.8 s and
+    /// 3 s).
     fn write_params(&self, ctx: &GpuContext) {
         let mut fast = self.look.fast;
-        if !self.azimuthal.matches(&fast) {
+        if !self.azimuthal.for_index(&fast) {
             fast.eta = self.azimuthal.eta;
             fast.eccentricity = self.azimuthal.eccentricity;
         }
@@ -795,6 +837,11 @@ impl Renderer {
             bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
         let azimuthal_changed = !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal);
+        // The table after its draft, for the same parameters: the change is on screen and the grid
+        // (whose forward terms read the forward table, not this one) holds; only the shading, which
+        // reads the azimuthal table, refines again.
+        let after_draft =
+            azimuthal_changed && self.azimuthal.draft && same_tables(params, &self.tables_for);
         if azimuthal_changed {
             ctx.queue
                 .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.as_bytes());
@@ -807,7 +854,9 @@ impl Renderer {
         // A new azimuthal table shows a change not on screen yet (an eta or eccentricity change waits
         // for it): a preview is owed; the others refine the change already shown.
         let multiple = self.settings.multiple_scattering;
-        if azimuthal_changed {
+        if after_draft {
+            self.restart_as_refinement(|r| r.restart_refinement());
+        } else if azimuthal_changed {
             if multiple {
                 self.mark_shadow_grid_dirty();
             } else {

@@ -95,6 +95,7 @@ mod tests {
             azimuthal: Arc::new(AzimuthalTable {
                 eta: p.eta as f32,
                 eccentricity: p.eccentricity as f32,
+                draft: false,
                 cells: vec![[tag; 4]],
             }),
         }

@@ -59,7 +59,82 @@ const WINDOW: f32 = 3.5;
 pub struct AzimuthalTable {
     pub eta: f32,
     pub eccentricity: f32,
+    /// A draft ([`AzimuthalTable::build_draft`]): most cells interpolated, for a preview.
+    pub draft: bool,
     pub cells: Vec<[f32; 4]>,
+}
+
+/// A draft's strides along theta_d, lambda' and dphi ([`AzimuthalTable::build_draft`]).
+pub const DRAFT_STRIDE: [usize; 3] = [2, 2, 4];
+
+/// Whether a draft computes sample i of axis `axis` (0 theta_d, 1 lambda', 2 dphi) of n samples: every
+/// [`DRAFT_STRIDE`]-th, the last, and along dphi the cells of TRT's knots, the caustic and the
+/// support's edge at u = 1/3 and 2/3 ([`trt_dphi`]: interpolated, the feature the axis keeps sharp
+/// would be smoothed).
+fn draft_sample(axis: usize, i: usize, n: usize) -> bool {
+    let knot = axis == 2 && n == TABLE_DPHI && (3 * i == n - 1 || 3 * i == 2 * (n - 1));
+    i.is_multiple_of(DRAFT_STRIDE[axis]) || i + 1 == n || knot
+}
+
+/// The computed samples around sample i of an axis and the weight of the upper one.
+fn draft_neighbours(axis: usize, i: usize, n: usize) -> (usize, usize, f32) {
+    let lo = (0..i)
+        .rev()
+        .find(|&k| draft_sample(axis, k, n))
+        .unwrap_or(0);
+    let hi = (i + 1..n)
+        .find(|&k| draft_sample(axis, k, n))
+        .unwrap_or(n - 1);
+    (lo, hi, (i - lo) as f32 / (hi - lo).max(1) as f32)
+}
+
+/// Whether a draft computes cell i (past the header) of a table with `eta_samples` TRT indices.
+fn draft_computes(i: usize, eta_samples: usize) -> bool {
+    let (it, il, ip, lambda_axis) = if i < box_base(eta_samples) {
+        let j = (i - 1) % (TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI);
+        let rest = j % (TABLE_LAMBDA * TABLE_DPHI);
+        (
+            j / (TABLE_LAMBDA * TABLE_DPHI),
+            rest / TABLE_DPHI,
+            rest % TABLE_DPHI,
+            TABLE_LAMBDA,
+        )
+    } else {
+        let j = (i - box_base(eta_samples)) % (TABLE_THETA_D * TABLE_DPHI);
+        (j / TABLE_DPHI, 0, j % TABLE_DPHI, 1)
+    };
+    draft_sample(0, it, TABLE_THETA_D)
+        && draft_sample(1, il, lambda_axis)
+        && draft_sample(2, ip, TABLE_DPHI)
+}
+
+/// Fills a draft's slab of cells [theta_d][lambda'][dphi] (`dims`) from its computed ones: along dphi
+/// in the computed rows, then along lambda', then along theta_d.
+fn fill_draft_slab(cells: &mut [[f32; 4]], dims: [usize; 3]) {
+    let [n0, n1, n2] = dims;
+    let at = |a: usize, b: usize, c: usize| (a * n1 + b) * n2 + c;
+    for a in (0..n0).filter(|&a| draft_sample(0, a, n0)) {
+        for b in (0..n1).filter(|&b| draft_sample(1, b, n1)) {
+            for c in (0..n2).filter(|&c| !draft_sample(2, c, n2)) {
+                let (lo, hi, w) = draft_neighbours(2, c, n2);
+                cells[at(a, b, c)] = lerp4(cells[at(a, b, lo)], cells[at(a, b, hi)], w);
+            }
+        }
+        for b in (0..n1).filter(|&b| !draft_sample(1, b, n1)) {
+            let (lo, hi, w) = draft_neighbours(1, b, n1);
+            for c in 0..n2 {
+                cells[at(a, b, c)] = lerp4(cells[at(a, lo, c)], cells[at(a, hi, c)], w);
+            }
+        }
+    }
+    for a in (0..n0).filter(|&a| !draft_sample(0, a, n0)) {
+        let (lo, hi, w) = draft_neighbours(0, a, n0);
+        for b in 0..n1 {
+            for c in 0..n2 {
+                cells[at(a, b, c)] = lerp4(cells[at(lo, b, c)], cells[at(hi, b, c)], w);
+            }
+        }
+    }
 }
 
 /// Where the TRT windows start (in cells).
@@ -230,6 +305,19 @@ impl AzimuthalTable {
     /// indices; 1.1-1.2 s and 4.1-4.5 s before the inversions of the window's ends started from the
     /// secant and stopped at a bracket of a few ulps).
     pub fn build(eta: f32, eccentricity: f32) -> Self {
+        Self::build_cells(eta, eccentricity, false)
+    }
+
+    /// A draft of [`Self::build`]'s table for a preview while the table is built: the cells at every
+    /// [`DRAFT_STRIDE`]-th sample of theta_d, lambda' and dphi (and each axis's last) computed (and the
+    /// cells of TRT's knots), 1/14 of them, the others interpolated between those as the lookups interpolate
+    /// (`tests/azimuthal_table.rs` measures what that costs). Never kept, never reused as the table
+    /// ([`Self::fits_hair`], [`Self::matches`]); [`Self::for_index`] tells that it reads the right index.
+    pub fn build_draft(eta: f32, eccentricity: f32) -> Self {
+        Self::build_cells(eta, eccentricity, true)
+    }
+
+    fn build_cells(eta: f32, eccentricity: f32, draft: bool) -> Self {
         let (eta_lo, eta_hi) = eta_star_range(eta, eccentricity);
         let eta_samples = if eta_lo == eta_hi {
             1
@@ -287,10 +375,29 @@ impl AzimuthalTable {
             )
             .map(|v| v / PI)
         };
-        let cells = (0..total).into_par_iter().map(cell).collect();
+        let computed = |i: usize| !draft || i == 0 || draft_computes(i, eta_samples);
+        let mut cells: Vec<[f32; 4]> = (0..total)
+            .into_par_iter()
+            .map(|i| if computed(i) { cell(i) } else { [0.0; 4] })
+            .collect();
+        if draft {
+            let gaussian = [TABLE_THETA_D, TABLE_LAMBDA, TABLE_DPHI];
+            let slabs = (0..1 + eta_samples).map(|k| (1 + k * per_lobe, gaussian));
+            let boxes = (0..3).map(|lobe| {
+                (
+                    box_base(eta_samples) + lobe * TABLE_THETA_D * TABLE_DPHI,
+                    [TABLE_THETA_D, 1, TABLE_DPHI],
+                )
+            });
+            for (base, dims) in slabs.chain(boxes) {
+                let n = dims.iter().product::<usize>();
+                fill_draft_slab(&mut cells[base..base + n], dims);
+            }
+        }
         Self {
             eta,
             eccentricity,
+            draft,
             cells,
         }
     }
@@ -300,8 +407,13 @@ impl AzimuthalTable {
         Self::build(p.eta, p.eccentricity)
     }
 
-    /// Whether this table was built for `p` (and needs no rebuild).
+    /// Whether this table was built for `p` (and needs no rebuild: not a draft).
     pub fn matches(&self, p: &FastHairParams) -> bool {
+        !self.draft && self.for_index(p)
+    }
+
+    /// Whether this table, or this draft, was made for `p`'s eta and eccentricity (a frame may read it).
+    pub fn for_index(&self, p: &FastHairParams) -> bool {
         self.eta == p.eta && self.eccentricity == p.eccentricity
     }
 
@@ -312,6 +424,11 @@ impl AzimuthalTable {
 
     /// [`AzimuthalTable::matches`] for exact hair parameters.
     pub fn fits_hair(&self, p: &HairParams) -> bool {
+        !self.draft && self.made_for_hair(p)
+    }
+
+    /// [`AzimuthalTable::for_index`] for exact hair parameters (a draft too).
+    pub fn made_for_hair(&self, p: &HairParams) -> bool {
         self.eta == p.eta as f32 && self.eccentricity == p.eccentricity as f32
     }
 
