@@ -11,7 +11,7 @@ use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
-use strandlight::render::renderer::{build_preview_tables, build_tables};
+use strandlight::render::renderer::{ParamTables, build_tables_or_draft};
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
@@ -152,8 +152,9 @@ struct EditReport {
     /// (`build_preview_tables`), built at once and handed over when done, as the editor does.
     #[serde(skip_serializing_if = "Option::is_none")]
     draft_tables_ms: Option<f64>,
-    /// A new eta or eccentricity: from the change to the first image (a preview) that reads its
-    /// index (the earlier images keep the old one: no frame reads a table made for another index).
+    /// A new eta or eccentricity: from the change to the first image (a preview, or without one the
+    /// first pass) that reads its index (the earlier images keep the old one: no frame reads a table
+    /// made for another index).
     #[serde(skip_serializing_if = "Option::is_none")]
     index_shown_ms: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -267,16 +268,28 @@ fn edit_run(
         let azimuthal = azimuthal.clone();
         std::thread::spawn(move || {
             let t = Instant::now();
-            let tables = if draft {
-                build_preview_tables(&params, Some(&azimuthal))
-            } else {
-                build_tables(&params, Some(&azimuthal))
-            };
+            let tables = build_tables_or_draft(&params, Some(&azimuthal), draft);
             (tables, t.elapsed().as_secs_f64() * 1e3)
         })
     };
     let mut draft = new_index.then(|| timed(true));
     let (mut draft_tables_ms, mut index_shown_ms) = (None, None);
+    // Whether the draft (or tables the process kept) went over: the new index shows from there.
+    let mut index_handed = false;
+    // The draft's tables to the renderer; whether the table still follows (not when the process
+    // kept the tables).
+    let draft_over = |r: &mut Renderer,
+                      (tables, ms): (ParamTables, f64),
+                      draft_ms: &mut Option<f64>,
+                      tables_ms: &mut f64| {
+        r.set_tables(ctx, &params, &tables);
+        if tables.azimuthal.draft {
+            *draft_ms = Some(ms);
+        } else {
+            *tables_ms = ms;
+        }
+        tables.azimuthal.draft
+    };
     // As the editor: the build starts once the change's preview shows (at once without one; for a
     // new index once its draft's preview shows).
     let mut spawn = needs_tables.then_some(());
@@ -294,24 +307,21 @@ fn edit_run(
     let run = refine_run(ctx, renderer, |r, run| {
         let ms = t.elapsed().as_secs_f64() * 1e3;
         if new_index {
-            if draft_tables_ms.is_some() && index_shown_ms.is_none() && run.shown {
+            if index_handed && index_shown_ms.is_none() && run.shown {
                 index_shown_ms = Some(ms);
-                worker = spawn.take().map(|_| timed(false));
+                if spawn.take().is_some() {
+                    worker = Some(timed(false));
+                }
             }
             if draft.as_ref().is_some_and(|d| d.is_finished())
-                && let Some(Ok((tables, ms))) = draft.take().map(|d| d.join())
+                && let Some(Ok(built)) = draft.take().map(|d| d.join())
             {
-                r.set_tables(ctx, &params, &tables);
-                if tables.azimuthal.draft {
-                    draft_tables_ms = Some(ms);
-                    // Without a preview the table is built at once (the editor's).
-                    if r.preview_factor() < 2 {
-                        worker = spawn.take().map(|_| timed(false));
-                    }
-                } else {
-                    // Tables the process kept: nothing more to build.
-                    tables_ms = ms;
+                index_handed = true;
+                if !draft_over(r, built, &mut draft_tables_ms, &mut tables_ms) {
                     spawn = None;
+                } else if r.preview_factor() < 2 && spawn.take().is_some() {
+                    // Without a preview the table is built at once (the editor's).
+                    worker = Some(timed(false));
                 }
             }
             // The table goes over as soon as it is built (the editor's: a new azimuthal table).
@@ -320,8 +330,8 @@ fn edit_run(
             }
             return;
         }
-        if (run.preview_ms.is_some() || run.first_pass_ms.is_some()) && spawn.is_some() {
-            worker = spawn.take().map(|_| timed(false));
+        if (run.preview_ms.is_some() || run.first_pass_ms.is_some()) && spawn.take().is_some() {
+            worker = Some(timed(false));
         }
         if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
             tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
@@ -329,15 +339,17 @@ fn edit_run(
     })?;
     let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
     let mut image_converged_ms = run.image_converged_ms;
+    if index_handed && index_shown_ms.is_none() {
+        // The first image after the draft was the converged one (refine_run returns before its
+        // callback sees it: without a preview, the table's hand-over restarted the first pass).
+        index_shown_ms = Some(converged_ms);
+    }
     if let Some(d) = draft.take()
-        && let Ok((tables, ms)) = d.join()
+        && let Ok(built) = d.join()
     {
         // Converged before the draft came (not on lavapipe).
-        renderer.set_tables(ctx, &params, &tables);
-        if tables.azimuthal.draft {
-            draft_tables_ms = Some(ms);
-        } else {
-            tables_ms = ms;
+        index_handed = true;
+        if !draft_over(renderer, built, &mut draft_tables_ms, &mut tables_ms) {
             spawn = None;
         }
     }
@@ -352,7 +364,7 @@ fn edit_run(
         converged_ms = t.elapsed().as_secs_f64() * 1e3;
         image_converged_ms = again.image_converged_ms.map(|ms| before + ms);
         longest_ms = longest_ms.max(again.longest_ms);
-        if new_index && index_shown_ms.is_none() {
+        if index_handed && index_shown_ms.is_none() {
             index_shown_ms = again
                 .preview_ms
                 .or(again.first_pass_ms)

@@ -17,7 +17,7 @@ use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::occluder::Occluder;
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
-use crate::render::renderer::{ParamTables, build_preview_tables, build_tables};
+use crate::render::renderer::{ParamTables, build_tables, build_tables_or_draft};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
@@ -627,6 +627,12 @@ impl LiveScene {
     /// A change the image does not show yet: times are measured from here.
     pub(super) fn restarted(&mut self) {
         self.refine_started = Instant::now();
+        self.showing_anew();
+    }
+
+    /// The change's first image is still to come (a new eta's draft: the images before it kept the
+    /// old index); its times count from the change.
+    fn showing_anew(&mut self) {
         self.preview_in = None;
         self.full_image_in = None;
         self.restarted_as_refinement();
@@ -675,13 +681,17 @@ impl LiveScene {
             .wanted_tables
             .as_ref()
             .is_some_and(|(params, azimuthal)| {
-                // One build at a time (a slider drag would pile them up on the GPU's cores).
-                self.tables.is_none()
+                // One build at a time (a slider drag would pile them up on the GPU's cores), but
+                // tables the process keeps (an undo after a new eta's draft) need none.
+                (self.tables.is_none() || crate::render::table_cache::holds(params))
                     && (self.first_image_in().is_some()
                         || self.renderer.preview_factor() < 2
                         || !azimuthal.made_for_hair(params))
             });
         if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
+            // A build under way (only when the process keeps these tables) is for parameters left
+            // behind: its result is dropped.
+            self.tables = None;
             self.tables_building = Some(params);
             // A new eta or eccentricity shows first with a draft of its azimuthal table (a tenth of
             // the build), then with the table, built next.
@@ -690,13 +700,10 @@ impl LiveScene {
                 "hair tables",
                 || {},
                 move |_| {
-                    let reuse = Some(&azimuthal);
-                    let tables = if draft {
-                        build_preview_tables(&params, reuse)
-                    } else {
-                        build_tables(&params, reuse)
-                    };
-                    (params, tables)
+                    (
+                        params,
+                        build_tables_or_draft(&params, Some(&azimuthal), draft),
+                    )
                 },
             ));
         }
@@ -739,7 +746,7 @@ impl LiveScene {
                 if self.wanted_tables.is_none() {
                     self.wanted_tables = Some((params, tables.azimuthal.clone()));
                 }
-                self.restarted();
+                self.showing_anew();
             } else {
                 self.restarted_as_refinement();
             }

@@ -140,7 +140,7 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
 /// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
-    assemble_tables(params, reuse, false)
+    build_tables_or_draft(params, reuse, false)
 }
 
 /// Tables of `params` for a preview while [`build_tables`] builds them: those the process keeps when it
@@ -152,11 +152,11 @@ pub fn build_preview_tables(
     params: &HairParams,
     reuse: Option<&Arc<AzimuthalTable>>,
 ) -> ParamTables {
-    assemble_tables(params, reuse, true)
+    build_tables_or_draft(params, reuse, true)
 }
 
 /// [`build_tables`], or with `draft` [`build_preview_tables`].
-fn assemble_tables(
+pub fn build_tables_or_draft(
     params: &HairParams,
     reuse: Option<&Arc<AzimuthalTable>>,
     draft: bool,

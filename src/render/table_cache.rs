@@ -52,6 +52,11 @@ impl TableCache {
         self.entries.drain(..excess);
     }
 
+    /// Whether the tables of `params` are kept (no lookup's reordering).
+    pub fn holds(&self, params: &HairParams) -> bool {
+        self.entries.iter().any(|(p, _)| same_tables(p, params))
+    }
+
     /// A kept azimuthal table for `params`' eta and eccentricity (the other parameters may differ).
     pub fn azimuthal(&self, params: &HairParams) -> Option<Arc<AzimuthalTable>> {
         self.entries
@@ -70,6 +75,11 @@ static CACHE: Mutex<TableCache> = Mutex::new(TableCache::new(CACHED_PARAMETER_SE
 /// pushed whole, so the cache is still valid.
 pub(crate) fn with_cache<R>(f: impl FnOnce(&mut TableCache) -> R) -> R {
     f(&mut CACHE.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Whether the process keeps the tables of `params` ([`TableCache::holds`]).
+pub fn holds(params: &HairParams) -> bool {
+    with_cache(|c| c.holds(params))
 }
 
 /// Forgets every kept set (the next build of any parameters builds anew: benchmarks time it).

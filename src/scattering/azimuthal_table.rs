@@ -67,10 +67,14 @@ pub struct AzimuthalTable {
 /// A draft's strides along theta_d, lambda' and dphi ([`AzimuthalTable::build_draft`]).
 pub const DRAFT_STRIDE: [usize; 3] = [2, 2, 4];
 
+// TRT's knots (u = 1/3 and 2/3) fall on dphi cells.
+const _: () = assert!((TABLE_DPHI - 1).is_multiple_of(3));
+
 /// Whether a draft computes sample i of axis `axis` (0 theta_d, 1 lambda', 2 dphi) of n samples: every
 /// [`DRAFT_STRIDE`]-th, the last, and along dphi the cells of TRT's knots, the caustic and the
 /// support's edge at u = 1/3 and 2/3 ([`trt_dphi`]: interpolated, the feature the axis keeps sharp
 /// would be smoothed).
+/// (The knot cells are computed in the TT and box slabs too, where they are ordinary cells.)
 fn draft_sample(axis: usize, i: usize, n: usize) -> bool {
     let knot = axis == 2 && n == TABLE_DPHI && (3 * i == n - 1 || 3 * i == 2 * (n - 1));
     i.is_multiple_of(DRAFT_STRIDE[axis]) || i + 1 == n || knot
