@@ -54,6 +54,36 @@ fn report(name: &str, errs: &mut [f64]) -> (f64, f64, f64) {
     (med, p95, max)
 }
 
+/// Relative errors of lobe p's Gaussian windows read from each table against the exact integrals over
+/// n random samples, one list per table; TRT's eta*-bar anywhere in its range (the renderer averages
+/// it per light and view).
+fn gaussian_window_errors(
+    tables: &[&AzimuthalTable],
+    eta: f32,
+    a: f32,
+    p: u32,
+    n: usize,
+    seed: u64,
+) -> Vec<Vec<f64>> {
+    let (lo, hi) = strandlight::scattering::azimuthal_table::eta_star_range(eta, a);
+    let mut errs = vec![Vec::new(); tables.len()];
+    for (i, s) in samples(n, seed).iter().enumerate() {
+        let eta_star = if p == 2 {
+            lo + (hi - lo) * (i % 17) as f32 / 16.0
+        } else {
+            eta
+        };
+        let exact = inner_integral_exact(p, eta_star, s.sigma_a, s.theta_d, s.lambda_prime, s.dphi);
+        // Floor: 1e-3 of the window's integral (N_p is of order 0.1 where it matters).
+        let floor = 1e-3 * window_energy(s.lambda_prime);
+        for (e, t) in errs.iter_mut().zip(tables) {
+            let got = t.window_gaussian(p, eta_star, s.sigma_a, s.theta_d, s.lambda_prime, s.dphi);
+            e.extend(errors(got, exact, floor));
+        }
+    }
+    errs
+}
+
 #[test]
 fn gaussian_windows_match_the_exact_integral() {
     for (eta, a) in [(1.55f32, 1.0f32), (1.45, 0.9)] {
@@ -64,30 +94,10 @@ fn gaussian_windows_match_the_exact_integral() {
             table.cells.len(),
             t.elapsed().as_secs_f64()
         );
-        let (lo, hi) = strandlight::scattering::azimuthal_table::eta_star_range(eta, a);
         for p in [1u32, 2] {
-            let mut errs = Vec::new();
-            for (i, s) in samples(3000, 7 + p as u64).iter().enumerate() {
-                // TRT's eta*-bar anywhere in its range (the renderer averages it per light and view).
-                let eta_star = if p == 2 {
-                    lo + (hi - lo) * (i % 17) as f32 / 16.0
-                } else {
-                    eta
-                };
-                let exact =
-                    inner_integral_exact(p, eta_star, s.sigma_a, s.theta_d, s.lambda_prime, s.dphi);
-                let got = table.window_gaussian(
-                    p,
-                    eta_star,
-                    s.sigma_a,
-                    s.theta_d,
-                    s.lambda_prime,
-                    s.dphi,
-                );
-                // Floor: 1e-3 of the window's integral (N_p is of order 0.1 where it matters).
-                let floor = 1e-3 * window_energy(s.lambda_prime);
-                errs.extend(errors(got, exact, floor));
-            }
+            let mut errs = gaussian_window_errors(&[&table], eta, a, p, 3000, 7 + p as u64)
+                .pop()
+                .unwrap_or_default();
             let (med, p95, _) = report(&format!("eta {eta} a {a} lobe {p}"), &mut errs);
             // Measured: median 2e-4, p95 0.5-0.9 % (round), 1.9 % (elliptical TRT: eta*-bar interpolated).
             assert!(med < 0.005, "median {med}");
@@ -135,24 +145,13 @@ fn draft_tables_preview_within_their_bound() {
         // The computed cells are the table's own.
         assert_eq!(draft.cells[0], table.cells[0]);
         assert_eq!(draft.cells[1], table.cells[1]);
-        let (lo, hi) = strandlight::scattering::azimuthal_table::eta_star_range(eta, a);
         for p in [1u32, 2] {
-            let (mut draft_errs, mut table_errs) = (Vec::new(), Vec::new());
-            for (i, s) in samples(2000, 101 + p as u64).iter().enumerate() {
-                let eta_star = if p == 2 {
-                    lo + (hi - lo) * (i % 17) as f32 / 16.0
-                } else {
-                    eta
-                };
-                let exact =
-                    inner_integral_exact(p, eta_star, s.sigma_a, s.theta_d, s.lambda_prime, s.dphi);
-                let floor = 1e-3 * window_energy(s.lambda_prime);
-                let read = |t: &AzimuthalTable| {
-                    t.window_gaussian(p, eta_star, s.sigma_a, s.theta_d, s.lambda_prime, s.dphi)
-                };
-                draft_errs.extend(errors(read(&draft), exact, floor));
-                table_errs.extend(errors(read(&table), exact, floor));
-            }
+            let mut errs =
+                gaussian_window_errors(&[&draft, &table], eta, a, p, 2000, 101 + p as u64);
+            let (mut table_errs, mut draft_errs) = (
+                errs.pop().unwrap_or_default(),
+                errs.pop().unwrap_or_default(),
+            );
             report(&format!("table: eta {eta} a {a} lobe {p}"), &mut table_errs);
             let (med, p95, _) =
                 report(&format!("draft: eta {eta} a {a} lobe {p}"), &mut draft_errs);
