@@ -185,7 +185,11 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     eta_params.eta = 1.62;
     let eta_look = strandlight::render::HairLook::new(eta_params);
     assert!(progressive.set_params_deferred(&ctx, &eta_look));
-    refine_all(&mut progressive, &ctx);
+    let units = refine_all(&mut progressive, &ctx);
+    assert!(
+        units.is_empty(),
+        "an index alone changes nothing a frame reads: no unit until its table ({units:?})"
+    );
     let c = progressive.read_frame(&ctx).expect("read");
     assert_eq!(difference(&b, &c), 0.0, "eta waits for its azimuthal table");
     // Its draft (the editor's, at once; a tenth of the table's build): the new eta shows. The

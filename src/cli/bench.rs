@@ -304,23 +304,35 @@ fn edit_run(
         r.set_tables(ctx, &params, &tables);
         Some(ms)
     };
+    if let Some(d) = draft.take() {
+        // As the editor: it refines while the draft is built (an index alone leaves the frame as it
+        // is, so there is nothing to do), then hands it over.
+        while !d.is_finished() {
+            let p = renderer.refine(ctx)?;
+            if p.submitted.is_some() || p.busy {
+                ctx.device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+            } else {
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+        }
+        if let Ok(built) = d.join() {
+            index_handed = true;
+            if !draft_over(renderer, built, &mut draft_tables_ms, &mut tables_ms) {
+                spawn = None;
+            } else if renderer.preview_factor() < 2 && spawn.take().is_some() {
+                // Without a preview the table is built at once (the editor's).
+                worker = Some(timed(false));
+            }
+        }
+    }
     let run = refine_run(ctx, renderer, |r, run| {
         let ms = t.elapsed().as_secs_f64() * 1e3;
         if new_index {
             if index_handed && index_shown_ms.is_none() && run.shown {
                 index_shown_ms = Some(ms);
                 if spawn.take().is_some() {
-                    worker = Some(timed(false));
-                }
-            }
-            if draft.as_ref().is_some_and(|d| d.is_finished())
-                && let Some(Ok(built)) = draft.take().map(|d| d.join())
-            {
-                index_handed = true;
-                if !draft_over(r, built, &mut draft_tables_ms, &mut tables_ms) {
-                    spawn = None;
-                } else if r.preview_factor() < 2 && spawn.take().is_some() {
-                    // Without a preview the table is built at once (the editor's).
                     worker = Some(timed(false));
                 }
             }
@@ -343,15 +355,6 @@ fn edit_run(
         // The first image after the draft was the converged one (refine_run returns before its
         // callback sees it: without a preview, the table's hand-over restarted the first pass).
         index_shown_ms = Some(converged_ms);
-    }
-    if let Some(d) = draft.take()
-        && let Ok(built) = d.join()
-    {
-        // Converged before the draft came (not on lavapipe).
-        index_handed = true;
-        if !draft_over(renderer, built, &mut draft_tables_ms, &mut tables_ms) {
-            spawn = None;
-        }
     }
     if spawn.take().is_some() {
         worker = Some(timed(false));

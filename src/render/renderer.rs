@@ -784,9 +784,15 @@ impl Renderer {
     /// first ([`build_preview_tables`]).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
         let tables_needed = self.tables_needed(&look.params);
+        let (before, changed) = (self.frame_params(), self.look != *look);
         self.look = *look;
         self.write_params(ctx);
-        self.restart_refinement();
+        // A new eta or eccentricity alone changes nothing a frame reads until a table made for it
+        // arrives: the image stays, and the cores stay free for that table's build. (The same look
+        // again restarts: callers follow a deferred absorption change with it.)
+        if !changed || self.frame_params() != before {
+            self.restart_refinement();
+        }
         tables_needed
     }
 
@@ -802,13 +808,20 @@ impl Renderer {
     /// build on two cores for a round fiber and 0.3 s for an elliptical one, then the table, 0.8 s and
     /// 3 s).
     fn write_params(&self, ctx: &GpuContext) {
+        let fast = self.frame_params();
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&fast));
+    }
+
+    /// The fast parameters a frame reads: the look's, with the azimuthal table's eta and
+    /// eccentricity while the table for new ones is being built.
+    fn frame_params(&self) -> FastHairParams {
         let mut fast = self.look.fast;
         if !self.azimuthal.for_index(&fast) {
             fast.eta = self.azimuthal.eta;
             fast.eccentricity = self.azimuthal.eccentricity;
         }
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&fast));
+        fast
     }
 
     /// The azimuthal table in use (kept by a rebuild for the same eta and eccentricity).
