@@ -674,9 +674,10 @@ impl LiveScene {
             self.renderer.restart();
             self.restarted();
         }
-        // The tables' build starts once the change shows (at once without a preview, or for a new eta
-        // or eccentricity, which shows only with its azimuthal table: its draft at once, the table
-        // once the draft's preview shows).
+        // The tables' build starts once the change shows (or the image is converged: a change the
+        // frame does not read before its tables), at once without a preview, or for a new eta or
+        // eccentricity, which shows only with an azimuthal table made for it: its draft at once, the
+        // table once the draft's preview shows.
         let start = self
             .wanted_tables
             .as_ref()
@@ -685,6 +686,7 @@ impl LiveScene {
                 // tables the process keeps (an undo after a new eta's draft) need none.
                 (self.tables.is_none() || crate::render::table_cache::holds(params))
                     && (self.first_image_in().is_some()
+                        || self.progress.is_some_and(|p| p.converged)
                         || self.renderer.preview_factor() < 2
                         || !azimuthal.made_for_hair(params))
             });

@@ -88,6 +88,16 @@ pub struct HairLook {
 }
 
 impl HairLook {
+    /// Whether `other` differs from this look in its eta or eccentricity and in nothing else.
+    pub fn index_only_change(&self, other: &HairLook) -> bool {
+        let mut same = *other;
+        same.params.eta = self.params.eta;
+        same.params.eccentricity = self.params.eccentricity;
+        same.fast.eta = self.fast.eta;
+        same.fast.eccentricity = self.fast.eccentricity;
+        same == *self && other != self
+    }
+
     /// Xu's m = 4 segments and Zinke's d_f = d_b = 0.7.
     pub fn new(params: HairParams) -> Self {
         Self {
@@ -784,13 +794,13 @@ impl Renderer {
     /// first ([`build_preview_tables`]).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
         let tables_needed = self.tables_needed(&look.params);
-        let (before, changed) = (self.frame_params(), self.look != *look);
+        let (before, index_only) = (self.frame_params(), self.look.index_only_change(look));
         self.look = *look;
         self.write_params(ctx);
         // A new eta or eccentricity alone changes nothing a frame reads until a table made for it
-        // arrives: the image stays, and the cores stay free for that table's build. (The same look
-        // again restarts: callers follow a deferred absorption change with it.)
-        if !changed || self.frame_params() != before {
+        // arrives: the image stays, and the cores stay free for that table's build. Any other
+        // change restarts, even one the frame's parameters do not show (the tables will).
+        if !index_only || self.frame_params() != before {
             self.restart_refinement();
         }
         tables_needed
@@ -921,6 +931,8 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         self.upload_absorption(ctx, sigma_a)?;
         self.absorption_deferred();
+        // Shown at once (not left to a parameter change that may not restart).
+        self.restart_refinement();
         Ok(())
     }
 
@@ -1749,5 +1761,28 @@ impl FrameReadBack {
             self.extras,
             &bytes,
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only an eta or eccentricity change alone leaves the refinement as it is
+    /// ([`Renderer::set_params_deferred`]); a change the fast form does not carry restarts it.
+    #[test]
+    fn an_index_only_change_is_told_apart() {
+        let a = HairLook::new(HairParams::default());
+        let mut p = a.params;
+        p.eta = 1.6;
+        p.eccentricity = 0.9;
+        assert!(a.index_only_change(&HairLook::new(p)));
+        assert!(!a.index_only_change(&a), "the same look is no change");
+        let mut q = p;
+        q.beta_r *= 0.5;
+        assert!(!a.index_only_change(&HairLook::new(q)));
+        let mut r = a.params;
+        r.glint_scale *= 2.0;
+        assert!(!a.index_only_change(&HairLook::new(r)));
     }
 }
