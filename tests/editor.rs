@@ -195,11 +195,7 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
     middle_drag(&mut h, centre, egui::vec2(30.0, 0.0), egui::Modifiers::NONE);
     converge(&mut h);
     let viewport = image(&h);
-    let mut session = h.state().session.clone();
-    session.render.width = viewport.width;
-    session.render.height = viewport.height;
-    let cli = render_session(&dir, "equal", &session);
-    let d = max_relative_difference(&viewport, &cli);
+    let d = against_render_session(&h, &dir, "equal", &viewport);
     println!(
         "viewport {}x{} against render --session: max difference {d:.2e} of the peak",
         viewport.width, viewport.height
@@ -209,6 +205,20 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
 
 /// `strandlight render --session` of `session` (saved as `dir/name.slsession`) at its render size:
 /// the EXR's beauty.
+/// The largest difference (of the peak) between the viewport's image `got` and `render --session` of
+/// the editor's session at that image's size.
+fn against_render_session(
+    h: &Harness<'static, EditorApp>,
+    dir: &Path,
+    name: &str,
+    got: &Frame,
+) -> f32 {
+    let mut session = h.state().session.clone();
+    session.render.width = got.width;
+    session.render.height = got.height;
+    max_relative_difference(got, &render_session(dir, name, &session))
+}
+
 fn render_session(dir: &Path, name: &str, session: &Session) -> Frame {
     let path = dir.join(format!("{name}.slsession"));
     session.write(&path).expect("saved");
@@ -433,11 +443,7 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
     assert!(thick < thin, "thicker fibres shadow more");
     // The same session rendered headless (the scene assembly scales the hair itself; the editor
     // rewrote the renderer's points).
-    let mut session = h.state().session.clone();
-    session.render.width = got.width;
-    session.render.height = got.height;
-    let cli = render_session(&dir, "thick", &session);
-    let d = max_relative_difference(&got, &cli);
+    let d = against_render_session(&h, &dir, "thick", &got);
     println!("editor against render --session: max difference {d:.2e} of the peak");
     assert!(d < 1e-4, "{d}");
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
@@ -489,11 +495,7 @@ fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
     converge(&mut h);
     let got = image(&h);
     assert_eq!(h.state().session.look.params.eta, 1.62);
-    let mut session = h.state().session.clone();
-    session.render.width = got.width;
-    session.render.height = got.height;
-    let cli = render_session(&dir, "eta", &session);
-    let d = max_relative_difference(&got, &cli);
+    let d = against_render_session(&h, &dir, "eta", &got);
     println!(
         "editor against render --session: max difference {d:.2e} of the peak; mean luminance {before:.4} -> {:.4}",
         mean_luminance(&got)
