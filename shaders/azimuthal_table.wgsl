@@ -2,7 +2,10 @@
 // calN_TRT under every light (Xu Eq. 12) and calN_t^G of the forward-scattered light (Eq. 28). Each cell
 // holds a two-node Gauss rule in the chord x = cos gamma_t of the window's measure, (w_1, w_1 x_1, w_2,
 // w_2 x_2); the value for absorption s = 2 p sigma_a' is w_1 e^(-s x_1) + w_2 e^(-s x_2).
-// The includer binds `azimuthal_table`: array<vec4<f32>>, cell 0 the header (eta_lo, eta_hi, eta samples, eta).
+// The includer binds `azimuthal_table`: array<vec2<u32>> (AzimuthalTable::gpu): entries 0 and 1 the
+// header's f32 bits (eta_lo, eta_hi, eta samples, eta), then cell k >= 1 at entry k + 1 as two half
+// pairs (w_1, w_1 x_1), (w_2, w_2 x_2), scaled by TABLE_HALF_SCALE (an exact power of two: the
+// lookups interpolate the scaled cells and unscale their value, as exact as scaling each cell).
 // Prepended: circular_gaussian (bessel_i0_scaled), fast_azimuthal (sigma_a_prime, bravais_eta_prime).
 
 const TABLE_THETA_D: u32 = 32u;
@@ -12,6 +15,8 @@ const TABLE_LAMBDA_MIN: f32 = 0.005;
 // LAMBDA_PRIME_MAX: every lambda' the shading meets.
 const TABLE_LAMBDA_MAX: f32 = 10.0;
 const TABLE_DPHI: u32 = 256u;
+// HALF_SCALE in azimuthal_table.rs.
+const TABLE_HALF_SCALE: f32 = 1024.0;
 
 fn table_trt_base() -> u32 {
     return 1u + TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
@@ -88,12 +93,24 @@ fn absorption_exponent(p: u32, eta: f32, sigma_a: vec3<f32>, theta_d: f32) -> ve
     return 2.0 * f32(p) * sigma_a_prime(sigma_a, eta, theta_d);
 }
 
+fn table_header() -> vec4<f32> {
+    return vec4<f32>(bitcast<vec2<f32>>(azimuthal_table[0]), bitcast<vec2<f32>>(azimuthal_table[1]));
+}
+
+// Cell k (k >= 1) times TABLE_HALF_SCALE.
+fn table_cell(k: u32) -> vec4<f32> {
+    let e = azimuthal_table[k + 1u];
+    return vec4<f32>(unpack2x16float(e.x), unpack2x16float(e.y));
+}
+
+// Cells k and k + 1 (along dphi) at weight w of the second.
+fn table_pair(k: u32, w: f32) -> vec4<f32> {
+    return mix(table_cell(k), table_cell(k + 1u), w);
+}
+
 fn table_gaussian_cell(base: u32, it: u32, l: AxisPosition, f: AxisPosition) -> vec4<f32> {
     let row0 = base + (it * TABLE_LAMBDA + l.i) * TABLE_DPHI + f.i;
-    let row1 = row0 + TABLE_DPHI;
-    let lo = mix(azimuthal_table[row0], azimuthal_table[row0 + 1u], f.w);
-    let hi = mix(azimuthal_table[row1], azimuthal_table[row1 + 1u], f.w);
-    return mix(lo, hi, l.w);
+    return mix(table_pair(row0, f.w), table_pair(row0 + TABLE_DPHI, f.w), l.w);
 }
 
 fn table_gaussian_slab(base: u32, t: AxisPosition, l: AxisPosition, f: AxisPosition) -> vec4<f32> {
@@ -102,7 +119,7 @@ fn table_gaussian_slab(base: u32, t: AxisPosition, l: AxisPosition, f: AxisPosit
 
 // AzimuthalTable::window_gaussian: calN_TT (p = 1) or calN_TRT (p = 2, eta_star = eta*-bar).
 fn azimuthal_table_gaussian(p: u32, eta_star: f32, sigma_a: vec3<f32>, theta_d: f32, lambda_prime: f32, dphi: f32) -> vec3<f32> {
-    let header = azimuthal_table[0];
+    let header = table_header();
     let eta_samples = u32(header.z);
     let t = axis_position(abs(theta_d) / THETA_D_MAX * f32(TABLE_THETA_D - 1u), TABLE_THETA_D);
     let lp = clamp(lambda_prime, TABLE_LAMBDA_MIN, TABLE_LAMBDA_MAX);
@@ -128,18 +145,17 @@ fn azimuthal_table_gaussian(p: u32, eta_star: f32, sigma_a: vec3<f32>, theta_d: 
     if (e.w > 0.0) {
         c = mix(c, table_gaussian_slab(base + (e.i + 1u) * per_lobe, t, l, f), e.w);
     }
-    return window_energy(lambda_prime) * rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d));
+    return window_energy(lambda_prime) / TABLE_HALF_SCALE * rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d));
 }
 
 // AzimuthalTable::window_box: calN_t^G (box window of half-width pi/2, over pi), lobe p = 0, 1, 2.
 fn azimuthal_table_box(p: u32, sigma_a: vec3<f32>, theta_d: f32, dphi: f32) -> vec3<f32> {
-    let header = azimuthal_table[0];
+    let header = table_header();
     let base = table_box_base(u32(header.z)) + p * TABLE_THETA_D * TABLE_DPHI;
     let t = axis_position(abs(theta_d) / THETA_D_MAX * f32(TABLE_THETA_D - 1u), TABLE_THETA_D);
     let f = axis_position(folded_dphi(dphi) / PI * f32(TABLE_DPHI - 1u), TABLE_DPHI);
     let r0 = base + t.i * TABLE_DPHI + f.i;
     let r1 = r0 + TABLE_DPHI;
-    let lo = mix(azimuthal_table[r0], azimuthal_table[r0 + 1u], f.w);
-    let hi = mix(azimuthal_table[r1], azimuthal_table[r1 + 1u], f.w);
-    return rule_value(mix(lo, hi, t.w), absorption_exponent(p, header.w, sigma_a, theta_d));
+    let c = mix(table_pair(r0, f.w), table_pair(r1, f.w), t.w);
+    return rule_value(c, absorption_exponent(p, header.w, sigma_a, theta_d)) / TABLE_HALF_SCALE;
 }

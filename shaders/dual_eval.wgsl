@@ -14,7 +14,7 @@ struct DualQuery {
 }
 
 @group(0) @binding(0) var<storage, read> dual_tables: array<vec4<f32>>;
-@group(0) @binding(1) var<storage, read> azimuthal_table: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> azimuthal_table: array<vec2<u32>>;
 @group(0) @binding(2) var<storage, read> dual_queries: array<DualQuery>;
 @group(0) @binding(3) var<storage, read_write> dual_results: array<vec4<f32>>;
 // Declared for the fast-model library's table reads, which these entry points never reach (the

@@ -1,14 +1,14 @@
 // Multiple scattering per SRBF light by dual scattering (Xu 2011 Sec. 4.3, Zinke 2008): twin of
 // src/scattering/dual_response.rs and of DualTables::backscatter_in_cell / mean_delta_sigma in dual_terms.rs.
 // Prepended: circular_gaussian, lut, fast_azimuthal, azimuthal_table, fast_response. The includer
-// binds `dual_tables`: one row per sample of the absorption axis (DUAL_ROW vec4 each), a row holding
-// DUAL_SAMPLES x 4 vec4 (A_b, Delta_b, sigma_b, a_f per sample; one absorption: component 0, and
-// for A_b and a_f their logarithms, DualRow::ln_big_a_b and ln_a_f, in component 1) followed
-// by (DUAL_SAMPLES + 1) x 2 vec4 (prefix sums of Delta_b and sigma_b). Each channel reads the rows at
-// its own sigma_a (DualTables::backscatter_in_cell, mean_delta_sigma_in_cell).
+// binds `dual_tables` (dual_tables_texels in src/gpu/dual_eval.rs): one row j per sample of the absorption
+// axis (DUAL_ROW vec4 each), holding DUAL_SAMPLES vec4 (ln A_b, ln a_f of row j, the same of row j + 1;
+// DualRow::ln_big_a_b and ln_a_f) followed by DUAL_SAMPLES + 1 vec4 (the prefix sums of Delta_b and
+// sigma_b of row j, the same of row j + 1). Each channel reads the two rows around its own sigma_a
+// (DualTables::backscatter_in_cell, mean_delta_sigma_in_cell) with one load per sample.
 
 const DUAL_SAMPLES: u32 = 128u;
-const DUAL_ROW: u32 = 4u * DUAL_SAMPLES + 2u * (DUAL_SAMPLES + 1u);
+const DUAL_ROW: u32 = 2u * DUAL_SAMPLES + 1u;
 const DUAL_GLOBAL: u32 = 0u;
 const DUAL_LOCAL: u32 = 1u;
 // The absorption axis (dual_terms.rs axis_sigma / axis_pos with DUAL_SIGMA_SAMPLES rows).
@@ -36,45 +36,43 @@ fn dual_sigma_cell(s: f32) -> DualCell {
     return DualCell(j, y - f32(j));
 }
 
-// DualRow::ln_backscatter_at of one row: ln A_b (k = 0) or ln a_f (k = 3) at theta, linear between
-// the samples (the texels' .y).
-fn dual_row_ln(row: u32, k: u32, theta: f32) -> f32 {
+// DualRow::ln_backscatter_at of the cell's two rows: (ln A_b, ln a_f) of row c.row, the same of row
+// c.row + 1, at theta, linear between the samples.
+fn dual_rows_ln(c: DualCell, theta: f32) -> vec4<f32> {
     let x = dual_position(theta);
     let i = min(u32(x), DUAL_SAMPLES - 2u);
-    let w = x - f32(i);
-    let base = row * DUAL_ROW;
-    return mix(dual_tables[base + 4u * i + k].y, dual_tables[base + 4u * (i + 1u) + k].y, w);
+    let base = c.row * DUAL_ROW;
+    return mix(dual_tables[base + i], dual_tables[base + i + 1u], x - f32(i));
 }
-// DualTables::backscatter_in_cell: A_b (k = 0) or a_f (k = 3) at theta and one channel's absorption
-// cell, log-linear in theta and along the axis.
-fn dual_backscatter(k: u32, theta: f32, c: DualCell) -> f32 {
-    return exp(mix(dual_row_ln(c.row, k, theta), dual_row_ln(c.row + 1u, k, theta), c.w));
+// DualTables::backscatter_in_cell: (A_b, a_f) at theta and one channel's absorption cell, log-linear
+// in theta and along the axis.
+fn dual_backscatter(theta: f32, c: DualCell) -> vec2<f32> {
+    let v = dual_rows_ln(c, theta);
+    return exp(mix(v.xy, v.zw, c.w));
 }
 // The axis cells of a point's three channels (found once per point: local_response reads them).
 fn dual_cells(sigma_a: vec3<f32>) -> array<DualCell, 3> {
     return array<DualCell, 3>(dual_sigma_cell(sigma_a.x), dual_sigma_cell(sigma_a.y), dual_sigma_cell(sigma_a.z));
 }
-fn dual_sat(row: u32, k: u32, x: f32) -> f32 {
+// The prefix sums of Delta_b and sigma_b of the cell's two rows at entry position x (linear between
+// the entries).
+fn dual_sat(c: DualCell, x: f32) -> vec4<f32> {
     let i = min(u32(x), DUAL_SAMPLES - 1u);
-    let w = x - f32(i);
-    let base = row * DUAL_ROW + 4u * DUAL_SAMPLES;
-    return mix(dual_tables[base + 2u * i + k].x, dual_tables[base + 2u * (i + 1u) + k].x, w);
+    let base = c.row * DUAL_ROW + DUAL_SAMPLES;
+    return mix(dual_tables[base + i], dual_tables[base + i + 1u], x - f32(i));
 }
 
-// DualRow::mean_delta_sigma of one row: means of Delta_b and sigma_b over theta in [lo, hi] (Xu Eq. 31).
+// DualTables::mean_delta_sigma for one channel, at the axis cell of its absorption: (Delta_b, sigma_b),
+// the means over theta in [lo, hi] of each row (DualRow::mean_delta_sigma, Xu Eq. 31) between them.
 // The CPU twin reads the sample at the middle of a window under 1e-4 entries; local_response's
 // windows are forward_spread >= 1e-3 rad wide (0.04 entries), at least half of that after a clamp at
 // a pole (their middle lies within [-pi/2, pi/2]), so that branch (which lavapipe would run beside
 // this one) is left out here.
-fn dual_row_mean(row: u32, lo: f32, hi: f32) -> vec2<f32> {
+fn mean_delta_sigma(lo: f32, hi: f32, c: DualCell) -> vec2<f32> {
     let a = dual_position(min(lo, hi)) + 0.5;
     let b = dual_position(max(lo, hi)) + 0.5;
-    return vec2<f32>(dual_sat(row, 0u, b) - dual_sat(row, 0u, a), dual_sat(row, 1u, b) - dual_sat(row, 1u, a)) / max(b - a, 1e-4);
-}
-
-// DualTables::mean_delta_sigma for one channel, at the axis cell of its absorption: (Delta_b, sigma_b).
-fn mean_delta_sigma(lo: f32, hi: f32, c: DualCell) -> vec2<f32> {
-    return mix(dual_row_mean(c.row, lo, hi), dual_row_mean(c.row + 1u, lo, hi), c.w);
+    let rows = (dual_sat(c, b) - dual_sat(c, a)) / max(b - a, 1e-4);
+    return mix(rows.xy, rows.zw, c.w);
 }
 
 // Standard deviation of the forward-scattered light's longitudinal spread.
@@ -115,7 +113,8 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
         // calN_t^G = (1/pi) integral over the front half of the azimuths (Xu Eq. 28).
         return w * azimuthal_table_box(d.lobe, p.sigma_a.xyz, theta_d, d.dphi);
     }
-    let a = dual_backscatter(0u, theta_d, d.cell) * backscatter_depth_fraction(dual_backscatter(3u, theta_d, d.cell), d.depth_behind);
+    let b = dual_backscatter(theta_d, d.cell);
+    let a = b.x * backscatter_depth_fraction(b.y, d.depth_behind);
     return vec3<f32>(w * a);
 }
 

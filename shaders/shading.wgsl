@@ -32,7 +32,7 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(16) var<storage, read_write> aov_ms_global: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> aov_ms_local: array<vec4<f32>>;
 @group(0) @binding(18) var<storage, read> fragments: array<vec2<u32>>;
-@group(0) @binding(19) var<storage, read> azimuthal_table: array<vec4<f32>>;
+@group(0) @binding(19) var<storage, read> azimuthal_table: array<vec2<u32>>;
 // Segment shading (see `claim_segments`).
 @group(0) @binding(20) var<storage, read_write> segment_batches: array<atomic<u32>>;
 @group(0) @binding(21) var<storage, read_write> work_count: array<atomic<u32>>;

@@ -5,7 +5,9 @@
 
 use rand_core::Rng;
 use std::f32::consts::{FRAC_PI_2, PI};
-use strandlight::scattering::azimuthal_table::{AzimuthalTable, LAMBDA_MAX, window_energy};
+use strandlight::scattering::azimuthal_table::{
+    AzimuthalTable, HALF_SCALE, LAMBDA_MAX, half_precision, window_energy,
+};
 use strandlight::scattering::fast_exact_azimuthal::{
     azimuthal_window_integral, inner_integral_exact,
 };
@@ -94,6 +96,24 @@ fn gaussian_windows_match_the_exact_integral() {
             table.cells.len(),
             t.elapsed().as_secs_f64()
         );
+        // The cells are half floats scaled by HALF_SCALE on the GPU: they hold what the GPU reads
+        // (the header in f32), and stay far below where the scaled half floats saturate (64).
+        let max = table.cells[1..]
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, v| m.max(v.abs()));
+        println!(
+            "largest cell value {max:.3} (half floats saturate at {:.0})",
+            65504.0 / HALF_SCALE
+        );
+        assert!(max < 8.0, "largest cell {max}");
+        assert!(
+            table.cells[1..]
+                .iter()
+                .flatten()
+                .all(|v| half_precision(*v) == *v)
+        );
+        assert_eq!(table.gpu.len(), table.cells.len() + 1);
         for p in [1u32, 2] {
             let mut errs = gaussian_window_errors(&[&table], eta, a, p, 3000, 7 + p as u64)
                 .pop()

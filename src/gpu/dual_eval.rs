@@ -8,37 +8,40 @@ use super::shaders;
 use crate::scattering::dual_terms::{DUAL_SAMPLES, DualTables};
 use wgpu::util::DeviceExt;
 
-/// Per row of the absorption axis ([`DUAL_ROW`] vec4): A_b, Delta_b, sigma_b, a_f per sample (4 vec4),
-/// then the prefix sums of Delta_b and sigma_b (2 vec4 per entry), as `dual_response.wgsl` reads them.
-/// A row's channels are equal (one absorption): A_b's and a_f's texels are (value, its logarithm
-/// [`crate::scattering::dual_terms::DualRow::ln_big_a_b`] / `ln_a_f`, 0, 0), and the shader reads the logarithms and the prefix sums'
-/// component 0 (the values and the per-sample Delta_b and sigma_b stay for the CPU's layout; unread
-/// there).
+/// Per row j of the absorption axis ([`DUAL_ROW`] vec4), as `dual_response.wgsl` reads them: per sample
+/// i, (ln A_b, ln a_f) of row j and of row j + 1 ([`crate::scattering::dual_terms::DualRow::ln_big_a_b`],
+/// `ln_a_f`), then per entry of the prefix sums, (sum Delta_b, sum sigma_b) of row j and of row j + 1.
+/// A channel's absorption lies between two rows ([`DualTables::backscatter_in_cell`],
+/// `mean_delta_sigma_in_cell`), so one vec4 holds what it reads of both at a sample: 6 loads per
+/// channel of M^L instead of 24 (the last row repeats itself; no cell starts there). A row's channels
+/// are equal (one absorption): component 0.
 pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
-    let v4 = |x: [f32; 3]| [x[0], x[1], x[2], 0.0];
     let mut out = Vec::with_capacity(t.rows.len() * DUAL_ROW);
-    for row in &t.rows {
-        // A_b and a_f with their logarithms in .y (M^L's log-linear reading).
-        let with_ln = |v: f32, ln: f32| [v, ln, 0.0, 0.0];
-        out.extend(row.samples.iter().enumerate().flat_map(|(i, s)| {
+    for (j, row) in t.rows.iter().enumerate() {
+        let next = &t.rows[(j + 1).min(t.rows.len() - 1)];
+        out.extend((0..DUAL_SAMPLES).map(|i| {
             [
-                with_ln(s.big_a_b[0], row.ln_big_a_b[i]),
-                v4(s.delta_b),
-                v4(s.sigma_b),
-                with_ln(s.a_f[0], row.ln_a_f[i]),
+                row.ln_big_a_b[i],
+                row.ln_a_f[i],
+                next.ln_big_a_b[i],
+                next.ln_a_f[i],
             ]
         }));
-        for (d, s) in row.sat_delta.iter().zip(&row.sat_sigma) {
-            out.push(v4(*d));
-            out.push(v4(*s));
-        }
+        out.extend((0..=DUAL_SAMPLES).map(|i| {
+            [
+                row.sat_delta[i][0],
+                row.sat_sigma[i][0],
+                next.sat_delta[i][0],
+                next.sat_sigma[i][0],
+            ]
+        }));
     }
     debug_assert_eq!(out.len(), t.rows.len() * DUAL_ROW);
     out
 }
 
 /// vec4 per row of the absorption axis in the dual tables' buffer.
-pub const DUAL_ROW: usize = 4 * DUAL_SAMPLES + 2 * (DUAL_SAMPLES + 1);
+pub const DUAL_ROW: usize = 2 * DUAL_SAMPLES + 1;
 
 pub fn upload_dual_tables(device: &wgpu::Device, t: &DualTables) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

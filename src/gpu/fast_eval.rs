@@ -50,7 +50,7 @@ impl GpuLuts {
 pub fn upload_azimuthal_table(device: &wgpu::Device, table: &AzimuthalTable) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("azimuthal table"),
-        contents: table.as_bytes(),
+        contents: table.gpu_bytes(),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     })
 }

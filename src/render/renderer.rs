@@ -590,7 +590,7 @@ impl Renderer {
             mapped_at_creation: false,
         });
         ctx.queue
-            .write_buffer(&azimuthal_table, 0, azimuthal.as_bytes());
+            .write_buffer(&azimuthal_table, 0, azimuthal.gpu_bytes());
         let storage = |label: &str, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -867,7 +867,7 @@ impl Renderer {
             azimuthal_changed && self.azimuthal.draft && same_tables(params, &self.tables_for);
         if azimuthal_changed {
             ctx.queue
-                .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.as_bytes());
+                .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.gpu_bytes());
             self.azimuthal = tables.azimuthal.clone();
             self.write_params(ctx);
         }

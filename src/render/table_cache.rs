@@ -107,6 +107,7 @@ mod tests {
                 eccentricity: p.eccentricity as f32,
                 draft: false,
                 cells: vec![[tag; 4]],
+                gpu: vec![],
             }),
         }
     }

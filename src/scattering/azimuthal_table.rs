@@ -22,8 +22,15 @@
 //! stored divided by the window's own integral 2 pi e^-kappa I0(kappa) so cells vary slowly in lambda'.
 //! Cells hold (w_1, w_1 x_1, w_2, w_2 x_2): interpolated linearly, a corner with no weight does not pull
 //! the nodes. Built on the CPU in f64 moments of the f32 quadrature of [`for_each_window_node`], with rayon;
-//! rebuilt when eta or the eccentricity change (nothing else reaches it). The WGSL twin
-//! (`shaders/azimuthal_table.wgsl`) reads the same buffer of vec4.
+//! rebuilt when eta or the eccentricity change (nothing else reaches it).
+//!
+//! Cells are kept in half precision ([`half_precision`]: 11 significant bits, scaled by
+//! [`HALF_SCALE`] so that values down to 6e-8 keep them), and the GPU's buffer
+//! ([`AzimuthalTable::gpu`]) holds each cell as two half pairs in a vec2<u32>: a lookup loads half
+//! the words it did in f32, and on lavapipe, whose loads cost per word, the shading pass took
+//! about a fifth less time. The CPU's cells are the same rounded values, so the WGSL twin
+//! (`shaders/azimuthal_table.wgsl`) and the lookups here read the same numbers;
+//! `tests/azimuthal_table.rs` measures the rounding with the rest.
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
 use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_prime};
@@ -52,6 +59,40 @@ pub const TABLE_ETA_ECCENTRIC: usize = 6;
 /// Half-width of the Gaussian window in units of lambda' (as the exact integral).
 const WINDOW: f32 = 3.5;
 
+/// The cells' scale in half precision: a power of two (exact either way). Half floats reach 65504,
+/// so values from 6e-8 (where they turn subnormal) to 64 keep 11 significant bits; larger ones
+/// saturate. The cells stay under 2.1: measured 0.83 (eta 1.55, round), 1.55-2.07 for eta 1.3-2 and
+/// eccentricities 0.5-2 (2026-12-02); `tests/azimuthal_table.rs` bounds them by 8.
+pub const HALF_SCALE: f32 = 1024.0;
+
+/// The half-precision bits of v as the GPU holds it (scaled by [`HALF_SCALE`], saturated at the
+/// largest half float).
+fn half_bits(v: f32) -> u16 {
+    half::f16::from_f32((v * HALF_SCALE).clamp(-65504.0, 65504.0)).to_bits()
+}
+
+/// The value of [`half_bits`] (what the GPU's cells hold).
+fn from_half_bits(b: u16) -> f32 {
+    half::f16::from_bits(b).to_f32() / HALF_SCALE
+}
+
+/// v rounded to the nearest value the GPU's half-precision cells hold.
+pub fn half_precision(v: f32) -> f32 {
+    from_half_bits(half_bits(v))
+}
+
+/// Rounds a cell to what the GPU holds and returns that as the GPU's entry: (w_1, w_1 x_1) and
+/// (w_2, w_2 x_2) as half pairs, the first of each in the low half (WGSL's unpack2x16float).
+fn to_gpu_cell(c: &mut [f32; 4]) -> [u32; 2] {
+    let b = c.map(half_bits);
+    *c = b.map(from_half_bits);
+    let pair = |lo: u16, hi: u16| lo as u32 | ((hi as u32) << 16);
+    [pair(b[0], b[1]), pair(b[2], b[3])]
+}
+
+/// The GPU buffer's entries before the cells: the header's four f32 bits.
+pub const GPU_HEADER_ENTRIES: usize = 2;
+
 /// One table for one (eta, eccentricity). Layout of `cells` (vec4 each): [0] header (eta_lo, eta_hi,
 /// eta samples, eta); then TT windows [theta_d][lambda][dphi]; TRT windows [eta][theta_d][lambda][dphi];
 /// box windows of R, TT, TRT [lobe][theta_d][dphi].
@@ -62,6 +103,9 @@ pub struct AzimuthalTable {
     /// A draft ([`AzimuthalTable::build_draft`]): most cells interpolated, for a preview.
     pub draft: bool,
     pub cells: Vec<[f32; 4]>,
+    /// The GPU's buffer (`azimuthal_table.wgsl`): the header's f32 bits in [`GPU_HEADER_ENTRIES`]
+    /// entries, then cell k >= 1 at entry k + 1 (`to_gpu_cell`), made with the table on its thread.
+    pub gpu: Vec<[u32; 2]>,
 }
 
 /// A draft's strides along theta_d, lambda' and dphi ([`AzimuthalTable::build_draft`]).
@@ -302,7 +346,7 @@ impl AzimuthalTable {
     pub const MAX_CELLS: usize = 1
         + (1 + TABLE_ETA_ECCENTRIC) * TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI
         + 3 * TABLE_THETA_D * TABLE_DPHI;
-    pub const MAX_BYTES: u64 = (Self::MAX_CELLS * 16) as u64;
+    pub const MAX_BYTES: u64 = ((Self::MAX_CELLS + GPU_HEADER_ENTRIES - 1) * 8) as u64;
 
     /// Builds the table for the fiber's eta and eccentricity (on two cores of the CI-sized machine,
     /// 2026-12-01: 0.75-0.85 s for a round fiber, 2.9-3.3 s for an elliptical one with its six TRT
@@ -398,11 +442,16 @@ impl AzimuthalTable {
                 fill_draft_slab(&mut cells[base..base + n], dims);
             }
         }
+        // What the GPU holds (the header stays in f32).
+        let header = cells[0].map(f32::to_bits);
+        let mut gpu = vec![[header[0], header[1]], [header[2], header[3]]];
+        gpu.par_extend(cells[1..].par_iter_mut().map(to_gpu_cell));
         Self {
             eta,
             eccentricity,
             draft,
             cells,
+            gpu,
         }
     }
 
@@ -436,9 +485,9 @@ impl AzimuthalTable {
         self.eta == p.eta as f32 && self.eccentricity == p.eccentricity as f32
     }
 
-    /// The cells as bytes for the GPU (vec4<f32> each).
-    pub fn as_bytes(&self) -> &[u8] {
-        bytemuck::cast_slice(&self.cells)
+    /// The GPU's buffer as bytes ([`Self::gpu`]).
+    pub fn gpu_bytes(&self) -> &[u8] {
+        bytemuck::cast_slice(&self.gpu)
     }
 }
 
