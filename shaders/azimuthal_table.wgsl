@@ -4,7 +4,7 @@
 // w_2 x_2); the value for absorption s = 2 p sigma_a' is w_1 e^(-s x_1) + w_2 e^(-s x_2).
 // The includer binds `azimuthal_table`: array<vec2<u32>> (AzimuthalTable::gpu): entries 0 and 1 the
 // header's f32 bits (eta_lo, eta_hi, eta samples, eta), then cell k >= 1 at entry k + 1 as two half
-// pairs (w_1, w_1 x_1), (w_2, w_2 x_2), scaled by TABLE_HALF_SCALE (an exact power of two: the
+// pairs (w_1, w_1 x_1), (w_2, w_2 x_2), scaled by HALF_SCALE (an exact power of two: the
 // lookups interpolate the scaled cells and unscale their value, as exact as scaling each cell).
 // Prepended: circular_gaussian (bessel_i0_scaled), fast_azimuthal (sigma_a_prime, bravais_eta_prime).
 
@@ -15,8 +15,8 @@ const TABLE_LAMBDA_MIN: f32 = 0.005;
 // LAMBDA_PRIME_MAX: every lambda' the shading meets.
 const TABLE_LAMBDA_MAX: f32 = 10.0;
 const TABLE_DPHI: u32 = 256u;
-// HALF_SCALE in azimuthal_table.rs.
-const TABLE_HALF_SCALE: f32 = 1024.0;
+// The cells' scale (src/scattering/half_cells.rs).
+const HALF_SCALE: f32 = 1024.0;
 
 fn table_trt_base() -> u32 {
     return 1u + TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
@@ -97,7 +97,7 @@ fn table_header() -> vec4<f32> {
     return vec4<f32>(bitcast<vec2<f32>>(azimuthal_table[0]), bitcast<vec2<f32>>(azimuthal_table[1]));
 }
 
-// Cell k (k >= 1) times TABLE_HALF_SCALE.
+// Cell k (k >= 1) times HALF_SCALE.
 fn table_cell(k: u32) -> vec4<f32> {
     let e = azimuthal_table[k + 1u];
     return vec4<f32>(unpack2x16float(e.x), unpack2x16float(e.y));
@@ -145,7 +145,7 @@ fn azimuthal_table_gaussian(p: u32, eta_star: f32, sigma_a: vec3<f32>, theta_d: 
     if (e.w > 0.0) {
         c = mix(c, table_gaussian_slab(base + (e.i + 1u) * per_lobe, t, l, f), e.w);
     }
-    return window_energy(lambda_prime) / TABLE_HALF_SCALE * rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d));
+    return window_energy(lambda_prime) / HALF_SCALE * rule_value(c, absorption_exponent(p, eta, sigma_a, theta_d));
 }
 
 // AzimuthalTable::window_box: calN_t^G (box window of half-width pi/2, over pi), lobe p = 0, 1, 2.
@@ -157,5 +157,5 @@ fn azimuthal_table_box(p: u32, sigma_a: vec3<f32>, theta_d: f32, dphi: f32) -> v
     let r0 = base + t.i * TABLE_DPHI + f.i;
     let r1 = r0 + TABLE_DPHI;
     let c = mix(table_pair(r0, f.w), table_pair(r1, f.w), t.w);
-    return rule_value(c, absorption_exponent(p, header.w, sigma_a, theta_d)) / TABLE_HALF_SCALE;
+    return rule_value(c, absorption_exponent(p, header.w, sigma_a, theta_d)) / HALF_SCALE;
 }

@@ -5,12 +5,11 @@
 
 use rand_core::Rng;
 use std::f32::consts::{FRAC_PI_2, PI};
-use strandlight::scattering::azimuthal_table::{
-    AzimuthalTable, HALF_SCALE, LAMBDA_MAX, half_precision, window_energy,
-};
+use strandlight::scattering::azimuthal_table::{AzimuthalTable, LAMBDA_MAX, window_energy};
 use strandlight::scattering::fast_exact_azimuthal::{
     azimuthal_window_integral, inner_integral_exact,
 };
+use strandlight::scattering::half_cells::{HALF_MAX, half_precision};
 
 fn percentile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -102,10 +101,7 @@ fn gaussian_windows_match_the_exact_integral() {
             .iter()
             .flatten()
             .fold(0.0f32, |m, v| m.max(v.abs()));
-        println!(
-            "largest cell value {max:.3} (half floats saturate at {:.0})",
-            65504.0 / HALF_SCALE
-        );
+        println!("largest cell value {max:.3} (the GPU's half floats saturate at {HALF_MAX:.0})");
         assert!(max < 8.0, "largest cell {max}");
         assert!(
             table.cells[1..]

@@ -46,7 +46,7 @@ impl GpuLuts {
     }
 }
 
-/// The azimuthal table as a storage buffer (vec4 cells; the renderer binds the same layout).
+/// The azimuthal table as a storage buffer ([`AzimuthalTable::gpu`]; the renderer binds the same).
 pub fn upload_azimuthal_table(device: &wgpu::Device, table: &AzimuthalTable) -> wgpu::Buffer {
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("azimuthal table"),

@@ -24,19 +24,22 @@
 //! the nodes. Built on the CPU in f64 moments of the f32 quadrature of [`for_each_window_node`], with rayon;
 //! rebuilt when eta or the eccentricity change (nothing else reaches it).
 //!
-//! Cells are kept in half precision ([`half_precision`]: 11 significant bits, scaled by
-//! [`HALF_SCALE`] so that values down to 6e-8 keep them), and the GPU's buffer
+//! Cells are kept in half precision ([`super::half_cells`]: 11 significant bits from 6e-8 to 64;
+//! the cells stay under 2.1: 0.83 for eta 1.55 round, 1.55-2.07 for eta 1.3-2 and eccentricities
+//! 0.5-2, measured 2026-12-02, and `tests/azimuthal_table.rs` bounds them by 8). The GPU's buffer
 //! ([`AzimuthalTable::gpu`]) holds each cell as two half pairs in a vec2<u32>: a lookup loads half
-//! the words it did in f32, and on lavapipe, whose loads cost per word, the shading pass took
-//! about a fifth less time. The CPU's cells are the same rounded values, so the WGSL twin
-//! (`shaders/azimuthal_table.wgsl`) and the lookups here read the same numbers;
-//! `tests/azimuthal_table.rs` measures the rounding with the rest.
+//! the words it did in f32; on lavapipe, whose loads cost per word, the shading pass took 16-21 %
+//! less time on S1 (single scattering alone on S0: 31 %). The CPU's cells are the same rounded
+//! values, so the WGSL twin (`shaders/azimuthal_table.wgsl`) and the lookups here read the same
+//! numbers; `tests/azimuthal_table.rs` measures the rounding with the rest (TT's median error
+//! against the exact integrals 2.6e-4 before, 3.0e-4 after; p95 6.5e-3 and 6.6e-3).
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
 use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_prime};
 use super::fast_exact_azimuthal::for_each_window_node;
 use super::fast_params::FastHairParams;
 use super::fast_response::LAMBDA_PRIME_MAX;
+use super::half_cells::{from_half_bits, half_bits, half_pair};
 use super::params::HairParams;
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
@@ -59,35 +62,12 @@ pub const TABLE_ETA_ECCENTRIC: usize = 6;
 /// Half-width of the Gaussian window in units of lambda' (as the exact integral).
 const WINDOW: f32 = 3.5;
 
-/// The cells' scale in half precision: a power of two (exact either way). Half floats reach 65504,
-/// so values from 6e-8 (where they turn subnormal) to 64 keep 11 significant bits; larger ones
-/// saturate. The cells stay under 2.1: measured 0.83 (eta 1.55, round), 1.55-2.07 for eta 1.3-2 and
-/// eccentricities 0.5-2 (2026-12-02); `tests/azimuthal_table.rs` bounds them by 8.
-pub const HALF_SCALE: f32 = 1024.0;
-
-/// The half-precision bits of v as the GPU holds it (scaled by [`HALF_SCALE`], saturated at the
-/// largest half float).
-fn half_bits(v: f32) -> u16 {
-    half::f16::from_f32((v * HALF_SCALE).clamp(-65504.0, 65504.0)).to_bits()
-}
-
-/// The value of [`half_bits`] (what the GPU's cells hold).
-fn from_half_bits(b: u16) -> f32 {
-    half::f16::from_bits(b).to_f32() / HALF_SCALE
-}
-
-/// v rounded to the nearest value the GPU's half-precision cells hold.
-pub fn half_precision(v: f32) -> f32 {
-    from_half_bits(half_bits(v))
-}
-
 /// Rounds a cell to what the GPU holds and returns that as the GPU's entry: (w_1, w_1 x_1) and
 /// (w_2, w_2 x_2) as half pairs, the first of each in the low half (WGSL's unpack2x16float).
 fn to_gpu_cell(c: &mut [f32; 4]) -> [u32; 2] {
     let b = c.map(half_bits);
     *c = b.map(from_half_bits);
-    let pair = |lo: u16, hi: u16| lo as u32 | ((hi as u32) << 16);
-    [pair(b[0], b[1]), pair(b[2], b[3])]
+    [half_pair(b[0], b[1]), half_pair(b[2], b[3])]
 }
 
 /// The GPU buffer's entries before the cells: the header's four f32 bits.

@@ -10,6 +10,7 @@ pub mod fast_params;
 pub mod fast_response;
 pub mod frame;
 pub mod fresnel;
+pub mod half_cells;
 pub mod lut;
 pub mod marschner;
 pub mod numeric;

@@ -1,0 +1,54 @@
+//! Table cells in half precision, as the GPU holds them: the shading pass's lookups load half the
+//! words (on lavapipe a load costs per word), and the CPU's tables hold the same rounded values, so
+//! a WGSL lookup and its Rust twin read the same numbers. Values are scaled by [`HALF_SCALE`] (a
+//! power of two: exact either way) so that those from 6e-8 (where half floats turn subnormal) to 64
+//! keep 11 significant bits; larger ones saturate. WGSL: `HALF_SCALE` in
+//! `shaders/azimuthal_table.wgsl`, and `unpack2x16float` reads a pair.
+//!
+//! Only for tables whose values enter a lookup without cancellation. The azimuthal table's cells
+//! do (a rule's weights times positive exponentials). The C_k table does not: N_R sums C_k's
+//! against Fresnel's binomial terms of alternating sign, and in half floats the fast form's R
+//! against brute force went from median 0.11 % / p95 2.9 % to 0.19 % / 4.5 % (tests/fast_model.rs,
+//! 2026-12-02), so it stays in f32.
+
+/// The cells' scale in half precision.
+pub const HALF_SCALE: f32 = 1024.0;
+
+/// The largest value a scaled half float holds.
+pub const HALF_MAX: f32 = 65504.0 / HALF_SCALE;
+
+/// The half-precision bits of v (scaled by [`HALF_SCALE`], saturated at the largest half float).
+pub fn half_bits(v: f32) -> u16 {
+    half::f16::from_f32((v * HALF_SCALE).clamp(-65504.0, 65504.0)).to_bits()
+}
+
+/// The value of [`half_bits`].
+pub fn from_half_bits(b: u16) -> f32 {
+    half::f16::from_bits(b).to_f32() / HALF_SCALE
+}
+
+/// v rounded to the nearest value a half-precision cell holds.
+pub fn half_precision(v: f32) -> f32 {
+    from_half_bits(half_bits(v))
+}
+
+/// Two half floats in one word, `lo` in the low half (WGSL's unpack2x16float: `.x`).
+pub fn half_pair(lo: u16, hi: u16) -> u32 {
+    lo as u32 | ((hi as u32) << 16)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_cells_round_once_and_keep_small_values() {
+        for v in [0.0f32, 1.0, 0.1, 1e-3, 3e-7, 2.07, -0.5, 63.9] {
+            let h = half_precision(v);
+            assert_eq!(half_precision(h), h, "{v}");
+            assert!((h - v).abs() <= v.abs() * 4.9e-4 + 3e-11, "{v} -> {h}");
+        }
+        assert_eq!(half_precision(1e6), HALF_MAX);
+        assert_eq!(half_pair(1, 2), 0x0002_0001);
+    }
+}
