@@ -9,7 +9,7 @@ use strandlight::scattering::azimuthal_table::{AzimuthalTable, LAMBDA_MAX, windo
 use strandlight::scattering::fast_exact_azimuthal::{
     azimuthal_window_integral, inner_integral_exact,
 };
-use strandlight::scattering::half_cells::{HALF_MAX, half_precision};
+use strandlight::scattering::half_cells::{HALF_MAX, from_half_bits, half_precision};
 
 fn percentile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -109,7 +109,17 @@ fn gaussian_windows_match_the_exact_integral() {
                 .flatten()
                 .all(|v| half_precision(*v) == *v)
         );
+        // The GPU's entries: the header's f32 bits, then each cell's two half pairs (low half first).
         assert_eq!(table.gpu.len(), table.cells.len() + 1);
+        let header = table.cells[0].map(f32::to_bits);
+        assert_eq!(
+            table.gpu[..2],
+            [[header[0], header[1]], [header[2], header[3]]]
+        );
+        let halves = |e: [u32; 2]| {
+            [e[0], e[0] >> 16, e[1], e[1] >> 16].map(|b| from_half_bits((b & 0xffff) as u16))
+        };
+        assert!((1..table.cells.len()).all(|k| halves(table.gpu[k + 1]) == table.cells[k]));
         for p in [1u32, 2] {
             let mut errs = gaussian_window_errors(&[&table], eta, a, p, 3000, 7 + p as u64)
                 .pop()

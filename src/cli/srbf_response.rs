@@ -106,7 +106,7 @@ impl Tables {
         // Built outside the lock (the build runs on rayon's threads); a duplicate build is harmless.
         let t = std::sync::Arc::new(AzimuthalTable::for_params(fp));
         let mut tables = self.lock();
-        // 14.5-50 MB each: a sweep over many fibers keeps the last few.
+        // 22-75 MB each (f32 cells and the GPU's copy): a sweep over many fibers keeps the last few.
         if tables.len() >= 4 {
             tables.remove(0);
         }

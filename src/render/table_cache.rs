@@ -14,8 +14,8 @@ use super::renderer::{ParamTables, same_tables};
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::params::HairParams;
 
-/// Parameter sets kept (a round fiber's tables take ~15 MB, an eccentric fiber's ~50 MB: most of it
-/// the azimuthal table).
+/// Parameter sets kept (a round fiber's tables take ~22 MB, an eccentric fiber's ~75 MB: most of it
+/// the azimuthal table, its f32 cells and the GPU's half-precision copy).
 pub const CACHED_PARAMETER_SETS: usize = 4;
 
 /// Tables by parameter set, most recently used last.

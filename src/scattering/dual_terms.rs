@@ -298,7 +298,8 @@ pub struct DualRow {
     pub sat_delta: Vec<[f32; 3]>,
     pub sat_sigma: Vec<[f32; 3]>,
     /// ln A_b and ln a_f per sample ([`ln_floored`], component 0): M^L's integrand interpolates
-    /// them log-linearly ([`DualTables::backscatter_in_cell`]; the GPU's texels hold them in .y).
+    /// them log-linearly ([`DualTables::backscatter_in_cell`]; the GPU's texels hold a row's in .x
+    /// and .y, the next row's in .z and .w: `dual_tables_texels`).
     pub ln_big_a_b: Vec<f32>,
     pub ln_a_f: Vec<f32>,
 }
@@ -362,7 +363,7 @@ impl DualRow {
         (i, x - i as f32)
     }
 
-    /// ln A_b and ln a_f at theta, linear between the samples (WGSL twin: `dual_row_ln`).
+    /// ln A_b and ln a_f at theta, linear between the samples (WGSL twin: `dual_rows_ln`, this row's and the next).
     pub fn ln_backscatter_at(&self, theta: f32) -> (f32, f32) {
         let (i, w) = Self::position(theta);
         let lerp = |v: &[f32]| v[i] + w * (v[i + 1] - v[i]);

@@ -1,8 +1,8 @@
 //! Table cells in half precision, as the GPU holds them: the shading pass's lookups load half the
 //! words (on lavapipe a load costs per word), and the CPU's tables hold the same rounded values, so
 //! a WGSL lookup and its Rust twin read the same numbers. Values are scaled by [`HALF_SCALE`] (a
-//! power of two: exact either way) so that those from 6e-8 (where half floats turn subnormal) to 64
-//! keep 11 significant bits; larger ones saturate. WGSL: `HALF_SCALE` in
+//! power of two: exact either way) so that those from 6e-8 (the smallest normal half float) to 64
+//! keep 11 significant bits; larger ones saturate, smaller ones are 0. WGSL: `HALF_SCALE` in
 //! `shaders/azimuthal_table.wgsl`, and `unpack2x16float` reads a pair.
 //!
 //! Only for tables whose values enter a lookup without cancellation. The azimuthal table's cells
@@ -17,9 +17,19 @@ pub const HALF_SCALE: f32 = 1024.0;
 /// The largest value a scaled half float holds.
 pub const HALF_MAX: f32 = 65504.0 / HALF_SCALE;
 
-/// The half-precision bits of v (scaled by [`HALF_SCALE`], saturated at the largest half float).
+/// The smallest normal half float: scaled values below it are stored as 0, so that no GPU's
+/// handling of subnormal halves (some flush them) can tell it from the CPU's twin (values under
+/// 6e-8 before the scale: at most that much absolute).
+const HALF_MIN_NORMAL: f32 = 6.103_515_6e-5;
+
+/// The half-precision bits of v (scaled by [`HALF_SCALE`], saturated at the largest half float,
+/// flushed to zero below the smallest normal one).
 pub fn half_bits(v: f32) -> u16 {
-    half::f16::from_f32((v * HALF_SCALE).clamp(-65504.0, 65504.0)).to_bits()
+    let s = v * HALF_SCALE;
+    if s.abs() < HALF_MIN_NORMAL {
+        return 0;
+    }
+    half::f16::from_f32(s.clamp(-65504.0, 65504.0)).to_bits()
 }
 
 /// The value of [`half_bits`].
@@ -43,12 +53,14 @@ mod tests {
 
     #[test]
     fn half_cells_round_once_and_keep_small_values() {
-        for v in [0.0f32, 1.0, 0.1, 1e-3, 3e-7, 2.07, -0.5, 63.9] {
+        for v in [0.0f32, 1.0, 0.1, 1e-3, 3e-7, 6e-8, 2.07, -0.5, 63.9] {
             let h = half_precision(v);
             assert_eq!(half_precision(h), h, "{v}");
-            assert!((h - v).abs() <= v.abs() * 4.9e-4 + 3e-11, "{v} -> {h}");
+            assert!((h - v).abs() <= v.abs() * 4.9e-4, "{v} -> {h}");
         }
         assert_eq!(half_precision(1e6), HALF_MAX);
+        assert_eq!(half_precision(5e-8), 0.0);
+        assert!(half_precision(6e-8) > 0.0);
         assert_eq!(half_pair(1, 2), 0x0002_0001);
     }
 }
