@@ -13,8 +13,8 @@ use wgpu::util::DeviceExt;
 /// `ln_a_f`), then per entry of the prefix sums, (sum Delta_b, sum sigma_b) of row j and of row j + 1.
 /// A channel's absorption lies between two rows ([`DualTables::backscatter_in_cell`],
 /// `mean_delta_sigma_in_cell`), so one vec4 holds what it reads of both at a sample: 6 loads per
-/// channel of M^L with its one inner node instead of 24 (the last row repeats itself; no cell starts there). A row's channels
-/// are equal (one absorption): component 0.
+/// channel of M^L with its one inner node instead of 24 (the last row repeats itself; no cell
+/// starts there). A row's channels are equal (one absorption): component 0.
 pub fn dual_tables_texels(t: &DualTables) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(t.rows.len() * DUAL_ROW);
     for (j, row) in t.rows.iter().enumerate() {

@@ -118,24 +118,71 @@ fn draft_neighbours(axis: usize, i: usize, n: usize) -> (usize, usize, f32) {
     (lo, hi, (i - lo) as f32 / (hi - lo).max(1) as f32)
 }
 
-/// Whether a draft computes cell i (past the header) of a table with `eta_samples` TRT indices.
+/// What cell i of a table with `eta_samples` TRT indices holds (the layout of
+/// [`AzimuthalTable::cells`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum CellAt {
+    Header,
+    /// A Gaussian window of lobe p (1 TT, 2 TRT), TRT's eta*-bar sample `ie`, at theta_d sample `it`,
+    /// lambda' sample `il` and dphi sample `ip`.
+    Gaussian {
+        p: u32,
+        ie: usize,
+        it: usize,
+        il: usize,
+        ip: usize,
+    },
+    /// The box window of lobe `lobe` at theta_d sample `it` and dphi sample `ip`.
+    Box {
+        lobe: usize,
+        it: usize,
+        ip: usize,
+    },
+}
+
+fn cell_at(i: usize, eta_samples: usize) -> CellAt {
+    if i == 0 {
+        return CellAt::Header;
+    }
+    if i < box_base(eta_samples) {
+        let (p, j) = if i < trt_base() {
+            (1, i - 1)
+        } else {
+            (2, i - trt_base())
+        };
+        let per_lobe = TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI;
+        let (ie, k) = (j / per_lobe, j % per_lobe);
+        let rest = k % (TABLE_LAMBDA * TABLE_DPHI);
+        return CellAt::Gaussian {
+            p,
+            ie,
+            it: k / (TABLE_LAMBDA * TABLE_DPHI),
+            il: rest / TABLE_DPHI,
+            ip: rest % TABLE_DPHI,
+        };
+    }
+    let j = i - box_base(eta_samples);
+    let rest = j % (TABLE_THETA_D * TABLE_DPHI);
+    CellAt::Box {
+        lobe: j / (TABLE_THETA_D * TABLE_DPHI),
+        it: rest / TABLE_DPHI,
+        ip: rest % TABLE_DPHI,
+    }
+}
+
+/// Whether a draft computes cell i of a table with `eta_samples` TRT indices.
 fn draft_computes(i: usize, eta_samples: usize) -> bool {
-    let (it, il, ip, lambda_axis) = if i < box_base(eta_samples) {
-        let j = (i - 1) % (TABLE_THETA_D * TABLE_LAMBDA * TABLE_DPHI);
-        let rest = j % (TABLE_LAMBDA * TABLE_DPHI);
-        (
-            j / (TABLE_LAMBDA * TABLE_DPHI),
-            rest / TABLE_DPHI,
-            rest % TABLE_DPHI,
-            TABLE_LAMBDA,
-        )
-    } else {
-        let j = (i - box_base(eta_samples)) % (TABLE_THETA_D * TABLE_DPHI);
-        (j / TABLE_DPHI, 0, j % TABLE_DPHI, 1)
-    };
-    draft_sample(0, it, TABLE_THETA_D)
-        && draft_sample(1, il, lambda_axis)
-        && draft_sample(2, ip, TABLE_DPHI)
+    match cell_at(i, eta_samples) {
+        CellAt::Header => true,
+        CellAt::Gaussian { it, il, ip, .. } => {
+            draft_sample(0, it, TABLE_THETA_D)
+                && draft_sample(1, il, TABLE_LAMBDA)
+                && draft_sample(2, ip, TABLE_DPHI)
+        }
+        CellAt::Box { it, ip, .. } => {
+            draft_sample(0, it, TABLE_THETA_D) && draft_sample(2, ip, TABLE_DPHI)
+        }
+    }
 }
 
 /// Fills a draft's slab of cells [theta_d][lambda'][dphi] (`dims`) from its computed ones: along dphi
@@ -359,53 +406,39 @@ impl AzimuthalTable {
         let total = box_base(eta_samples) + box_cells;
         // Cell index -> its rule; the header is cell 0.
         let cell = |i: usize| -> [f32; 4] {
-            if i == 0 {
-                return [eta_lo, eta_hi, eta_samples as f32, eta];
+            match cell_at(i, eta_samples) {
+                CellAt::Header => [eta_lo, eta_hi, eta_samples as f32, eta],
+                CellAt::Gaussian { p, ie, it, il, ip } => {
+                    let eta = if p == 2 {
+                        axis_eta(eta_lo, eta_hi, eta_samples, ie)
+                    } else {
+                        eta
+                    };
+                    let lp = axis_lambda(il);
+                    let kappa = 2.0 / (lp * lp);
+                    let theta_d = axis_theta_d(it);
+                    let dphi = if p == 2 {
+                        let u = ip as f32 / (TABLE_DPHI - 1) as f32;
+                        trt_dphi(u, trt_knots(bravais_eta_prime(eta, theta_d)))
+                    } else {
+                        axis_dphi(ip)
+                    };
+                    let rule = window_rule(p, eta, theta_d, dphi, kappa, (WINDOW * lp).min(PI));
+                    let e = window_energy(lp);
+                    rule.map(|v| v / e)
+                }
+                CellAt::Box { lobe, it, ip } => window_rule(
+                    lobe as u32,
+                    eta,
+                    axis_theta_d(it),
+                    axis_dphi(ip),
+                    0.0,
+                    FRAC_PI_2,
+                )
+                .map(|v| v / PI),
             }
-            let gaussian = |p: u32, eta: f32, j: usize| {
-                let (it, rest) = (
-                    j / (TABLE_LAMBDA * TABLE_DPHI),
-                    j % (TABLE_LAMBDA * TABLE_DPHI),
-                );
-                let (il, ip) = (rest / TABLE_DPHI, rest % TABLE_DPHI);
-                let lp = axis_lambda(il);
-                let kappa = 2.0 / (lp * lp);
-                let theta_d = axis_theta_d(it);
-                let dphi = if p == 2 {
-                    let u = ip as f32 / (TABLE_DPHI - 1) as f32;
-                    trt_dphi(u, trt_knots(bravais_eta_prime(eta, theta_d)))
-                } else {
-                    axis_dphi(ip)
-                };
-                let rule = window_rule(p, eta, theta_d, dphi, kappa, (WINDOW * lp).min(PI));
-                let e = window_energy(lp);
-                rule.map(|v| v / e)
-            };
-            if i < trt_base() {
-                return gaussian(1, eta, i - 1);
-            }
-            if i < box_base(eta_samples) {
-                let j = i - trt_base();
-                let ie = j / per_lobe;
-                return gaussian(2, axis_eta(eta_lo, eta_hi, eta_samples, ie), j % per_lobe);
-            }
-            let j = i - box_base(eta_samples);
-            let (lobe, rest) = (
-                j / (TABLE_THETA_D * TABLE_DPHI),
-                j % (TABLE_THETA_D * TABLE_DPHI),
-            );
-            let (it, ip) = (rest / TABLE_DPHI, rest % TABLE_DPHI);
-            window_rule(
-                lobe as u32,
-                eta,
-                axis_theta_d(it),
-                axis_dphi(ip),
-                0.0,
-                FRAC_PI_2,
-            )
-            .map(|v| v / PI)
         };
-        let computed = |i: usize| !draft || i == 0 || draft_computes(i, eta_samples);
+        let computed = |i: usize| !draft || draft_computes(i, eta_samples);
         let mut cells: Vec<[f32; 4]> = (0..total)
             .into_par_iter()
             .map(|i| if computed(i) { cell(i) } else { [0.0; 4] })
