@@ -11,7 +11,7 @@ use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
-use strandlight::render::renderer::{ParamTables, build_tables_or_draft};
+use strandlight::render::renderer::build_tables_or_draft;
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
@@ -272,24 +272,10 @@ fn edit_run(
             (tables, t.elapsed().as_secs_f64() * 1e3)
         })
     };
-    let mut draft = new_index.then(|| timed(true));
+    let draft = new_index.then(|| timed(true));
     let (mut draft_tables_ms, mut index_shown_ms) = (None, None);
     // Whether the draft (or tables the process kept) went over: the new index shows from there.
     let mut index_handed = false;
-    // The draft's tables to the renderer; whether the table still follows (not when the process
-    // kept the tables).
-    let draft_over = |r: &mut Renderer,
-                      (tables, ms): (ParamTables, f64),
-                      draft_ms: &mut Option<f64>,
-                      tables_ms: &mut f64| {
-        r.set_tables(ctx, &params, &tables);
-        if tables.azimuthal.draft {
-            *draft_ms = Some(ms);
-        } else {
-            *tables_ms = ms;
-        }
-        tables.azimuthal.draft
-    };
     // As the editor: the build starts once the change's preview shows (at once without one; for a
     // new index once its draft's preview shows).
     let mut spawn = needs_tables.then_some(());
@@ -304,7 +290,7 @@ fn edit_run(
         r.set_tables(ctx, &params, &tables);
         Some(ms)
     };
-    if let Some(d) = draft.take() {
+    if let Some(d) = draft {
         // As the editor: it refines while the draft is built (an index alone leaves the frame as it
         // is, so there is nothing to do), then hands it over.
         while !d.is_finished() {
@@ -317,13 +303,19 @@ fn edit_run(
                 std::thread::sleep(std::time::Duration::from_millis(1));
             }
         }
-        if let Ok(built) = d.join() {
+        if let Ok((tables, ms)) = d.join() {
             index_handed = true;
-            if !draft_over(renderer, built, &mut draft_tables_ms, &mut tables_ms) {
-                spawn = None;
-            } else if renderer.preview_factor() < 2 && spawn.take().is_some() {
+            renderer.set_tables(ctx, &params, &tables);
+            if tables.azimuthal.draft {
+                draft_tables_ms = Some(ms);
                 // Without a preview the table is built at once (the editor's).
-                worker = Some(timed(false));
+                if renderer.preview_factor() < 2 && spawn.take().is_some() {
+                    worker = Some(timed(false));
+                }
+            } else {
+                // Tables the process kept: nothing more to build.
+                tables_ms = ms;
+                spawn = None;
             }
         }
     }
