@@ -10,7 +10,7 @@ use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, WorkUnit};
-use strandlight::render::renderer::{build_preview_tables, build_tables};
+use strandlight::render::renderer::{build_draft_table, build_tables};
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::Preset;
@@ -192,13 +192,26 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     );
     let c = progressive.read_frame(&ctx).expect("read");
     assert_eq!(difference(&b, &c), 0.0, "eta waits for its azimuthal table");
-    // Its draft (the editor's, at once; a tenth of the table's build): the new eta shows. The
-    // renderer still asks for the tables, and the table after its draft refines the shading alone:
-    // the grid (whose forward terms read the forward table, already the new eta's) is kept.
-    let draft = build_preview_tables(&eta_params, Some(progressive.azimuthal_table()));
-    assert!(draft.azimuthal.draft);
-    assert!(progressive.set_tables(&ctx, &eta_params, &draft));
-    refine_all(&mut progressive, &ctx);
+    // Its draft (the editor's, at once; a twentieth of the table's build): the new eta shows. The
+    // forward and dual tables stay until the tables come (the grid, whose forward terms read the
+    // forward table, is kept), and the renderer still asks for them; the tables then rebuild the
+    // grid as a refinement (no preview: the draft showed the change).
+    // (With a preview, as the editor's: the draft owes one, the tables after it none.)
+    progressive.set_preview(PreviewMode::Fixed(3));
+    let draft = build_draft_table(&eta_params);
+    assert!(draft.draft);
+    assert!(progressive.set_azimuthal_table(&ctx, &eta_params, &draft));
+    let units = refine_all(&mut progressive, &ctx);
+    assert!(
+        !units
+            .iter()
+            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. } | WorkUnit::Volume { .. })),
+        "a draft rebuilds no grid"
+    );
+    assert!(
+        units.iter().any(|u| matches!(u, WorkUnit::Preview { .. })),
+        "a draft shows the new index with a preview"
+    );
     let with_draft = progressive.read_frame(&ctx).expect("read");
     assert!(
         progressive.tables_needed(&eta_params),
@@ -209,20 +222,27 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     assert!(progressive.set_tables(&ctx, &eta_params, &tables));
     let units = refine_all(&mut progressive, &ctx);
     assert!(
-        !units
+        units
             .iter()
-            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. } | WorkUnit::Volume { .. })),
-        "the table after its draft rebuilds no grid"
+            .any(|u| matches!(u, WorkUnit::ShadowGrid { .. })),
+        "the tables after the draft rebuild the grid (its forward terms)"
     );
+    assert!(
+        !units.iter().any(|u| matches!(u, WorkUnit::Preview { .. })),
+        "the tables after the draft refine without a preview"
+    );
+    progressive.set_preview(PreviewMode::Off);
     let c = progressive.read_frame(&ctx).expect("read");
     let draft_error = difference(&with_draft, &c);
     println!(
         "eta 1.55 -> 1.62: the draft's image against the table's: {draft_error:.1e}; against the old eta's: {:.1e}",
         difference(&with_draft, &b)
     );
-    // Measured 1.6e-4 against 9.4e-3.
+    // Measured 1.1e-3 against 9.6e-3: most of it the forward and dual tables, the old eta's until
+    // the tables come (a draft that carried the new eta's, built in twice the time, measured
+    // 1.6e-4 against 9.4e-3).
     assert!(
-        draft_error > 0.0 && draft_error < 0.1 * difference(&b, &c),
+        draft_error > 0.0 && draft_error < 0.2 * difference(&b, &c),
         "the draft's image ({draft_error}) is far closer to the table's than the old eta's"
     );
     whole.set_params(&ctx, &eta_look);

@@ -11,7 +11,7 @@ use strandlight::envmap::{FitOptions, fit_srbf};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
-use strandlight::render::renderer::build_tables_or_draft;
+use strandlight::render::renderer::TableBuild;
 use strandlight::render::scene::{StandardScene, default_environment};
 use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
@@ -148,8 +148,8 @@ struct EditReport {
     cpu_ms: f64,
     /// CPU milliseconds of the tables on the worker.
     tables_ms: f64,
-    /// A new eta or eccentricity: CPU milliseconds of the draft tables on the worker
-    /// (`build_preview_tables`), built at once and handed over when done, as the editor does.
+    /// A new eta or eccentricity: CPU milliseconds of the draft of its azimuthal table on the worker
+    /// (`TableBuild::Azimuthal`), built at once and handed over when done, as the editor does.
     #[serde(skip_serializing_if = "Option::is_none")]
     draft_tables_ms: Option<f64>,
     /// A new eta or eccentricity: from the change to the first image (a preview, or without one the
@@ -247,8 +247,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Changes the look to `edited` as the editor would (the uniform now, the tables on a worker thread,
-/// handed over once the full image's first pass is shown; for a new eta or eccentricity draft tables
-/// first, at once, and the tables once the draft's preview shows) and refines to convergence.
+/// handed over once the full image's first pass is shown; for a new eta or eccentricity the draft of
+/// its azimuthal table first, at once, and the tables once the draft's preview shows) and refines to
+/// convergence.
 fn edit_run(
     ctx: &GpuContext,
     renderer: &mut Renderer,
@@ -268,7 +269,7 @@ fn edit_run(
         let azimuthal = azimuthal.clone();
         std::thread::spawn(move || {
             let t = Instant::now();
-            let tables = build_tables_or_draft(&params, Some(&azimuthal), draft);
+            let tables = TableBuild::build(&params, Some(&azimuthal), draft);
             (tables, t.elapsed().as_secs_f64() * 1e3)
         })
     };
@@ -287,7 +288,7 @@ fn edit_run(
     // The worker's tables to the renderer; their build's milliseconds.
     let hand_over = |r: &mut Renderer, worker: &mut Option<std::thread::JoinHandle<_>>| {
         let (tables, ms) = worker.take()?.join().ok()?;
-        r.set_tables(ctx, &params, &tables);
+        r.take_tables(ctx, &params, &tables);
         Some(ms)
     };
     if let Some(d) = draft {
@@ -305,8 +306,8 @@ fn edit_run(
         }
         if let Ok((tables, ms)) = d.join() {
             index_handed = true;
-            renderer.set_tables(ctx, &params, &tables);
-            if tables.azimuthal.draft {
+            renderer.take_tables(ctx, &params, &tables);
+            if tables.azimuthal_only() {
                 draft_tables_ms = Some(ms);
                 // Without a preview the table is built at once (the editor's).
                 if renderer.preview_factor() < 2 && spawn.take().is_some() {
@@ -319,27 +320,34 @@ fn edit_run(
             }
         }
     }
+    // As the editor: units after the preview take a share of the budget while tables are wanted or
+    // built (on a software GPU the build takes its cores).
+    let share = |building: bool| strandlight::editor::live::budget_share(ctx, building);
+    renderer.set_budget_share(share(spawn.is_some() || worker.is_some()));
     let run = refine_run(ctx, renderer, |r, run| {
-        let ms = t.elapsed().as_secs_f64() * 1e3;
-        if new_index {
-            if index_handed && index_shown_ms.is_none() && run.shown {
-                index_shown_ms = Some(ms);
-                if spawn.take().is_some() {
-                    worker = Some(timed(false));
+        'between: {
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            if new_index {
+                if index_handed && index_shown_ms.is_none() && run.shown {
+                    index_shown_ms = Some(ms);
+                    if spawn.take().is_some() {
+                        worker = Some(timed(false));
+                    }
                 }
+                // The table goes over as soon as it is built (the editor's: a new azimuthal table).
+                if worker.as_ref().is_some_and(|w| w.is_finished()) {
+                    tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
+                }
+                break 'between;
             }
-            // The table goes over as soon as it is built (the editor's: a new azimuthal table).
-            if worker.as_ref().is_some_and(|w| w.is_finished()) {
+            if (run.preview_ms.is_some() || run.first_pass_ms.is_some()) && spawn.take().is_some() {
+                worker = Some(timed(false));
+            }
+            if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
                 tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
             }
-            return;
         }
-        if (run.preview_ms.is_some() || run.first_pass_ms.is_some()) && spawn.take().is_some() {
-            worker = Some(timed(false));
-        }
-        if run.first_pass_ms.is_some() && worker.as_ref().is_some_and(|w| w.is_finished()) {
-            tables_ms = hand_over(r, &mut worker).unwrap_or(tables_ms);
-        }
+        r.set_budget_share(share(spawn.is_some() || worker.is_some()));
     })?;
     let (mut converged_ms, mut longest_ms) = (run.converged_ms, run.longest_ms);
     let mut image_converged_ms = run.image_converged_ms;
@@ -355,6 +363,7 @@ fn edit_run(
         // Converged before the tables came: they refine it once more.
         tables_ms = hand_over(renderer, &mut worker).unwrap_or(tables_ms);
         let before = t.elapsed().as_secs_f64() * 1e3;
+        renderer.set_budget_share(share(false));
         let again = refine_run(ctx, renderer, |_, _| {})?;
         converged_ms = t.elapsed().as_secs_f64() * 1e3;
         image_converged_ms = again.image_converged_ms.map(|ms| before + ms);
@@ -366,6 +375,7 @@ fn edit_run(
                 .map(|ms| before + ms);
         }
     }
+    renderer.set_budget_share(share(false));
     Ok(EditReport {
         preview_factor,
         cpu_ms,

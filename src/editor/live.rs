@@ -17,7 +17,7 @@ use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
 use crate::render::occluder::Occluder;
 use crate::render::preview::PreviewMode;
 use crate::render::progressive::{ImageReady, Progress};
-use crate::render::renderer::{ParamTables, build_tables, build_tables_or_draft};
+use crate::render::renderer::{ParamTables, TableBuild, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::HairParams;
@@ -67,7 +67,7 @@ pub enum LiveError {
     Assemble(#[from] AssembleError),
 }
 
-type Tables = (HairParams, ParamTables);
+type Tables = (HairParams, TableBuild);
 
 /// What a scene needs computed from the session and the hair before the renderer is built: the
 /// per-point absorption, the look in the renderer's form and its tables (all CPU work, done on the
@@ -96,6 +96,21 @@ pub fn unit_budget(ctx: &GpuContext) -> std::time::Duration {
 }
 
 pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_millis(35);
+
+/// The share of the unit budget the refinement's units after the preview get while tables are
+/// wanted or built on a worker (`building`): on a software GPU the build takes its cores, and units
+/// sized to the whole budget from costs measured without it ran 1.5 times as long (S1's eta edits,
+/// whose azimuthal table takes 1.3-1.6 s: units of up to 56-63 ms at 35 ms, lavapipe, 2-core Zen 3
+/// VM). A hardware GPU keeps the whole budget ([`Renderer::set_budget_share`]).
+pub fn budget_share(ctx: &GpuContext, building: bool) -> f64 {
+    if building && ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+        SOFTWARE_SHARE_WHILE_BUILDING
+    } else {
+        1.0
+    }
+}
+
+pub const SOFTWARE_SHARE_WHILE_BUILDING: f64 = 2.0 / 3.0;
 
 /// Computes [`Prepared`] (off the UI thread).
 pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
@@ -535,7 +550,7 @@ impl LiveScene {
         let held_fits = self
             .held_tables
             .as_ref()
-            .is_some_and(|(p, t)| fits(p) && !t.azimuthal.draft)
+            .is_some_and(|(p, t)| fits(p) && !t.azimuthal_only())
             || (self.tables.is_some() && self.tables_building.as_ref().is_some_and(fits));
         if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
             let params = look.params;
@@ -544,7 +559,7 @@ impl LiveScene {
             let azimuthal = self
                 .held_tables
                 .as_ref()
-                .map(|(_, t)| t.azimuthal.clone())
+                .map(|(_, t)| t.azimuthal().clone())
                 .filter(|t| t.fits_hair(&params))
                 .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
             // A newer build replaces an older one; set_tables ignores stale tables anyway. It
@@ -695,18 +710,13 @@ impl LiveScene {
             // behind: its result is dropped.
             self.tables = None;
             self.tables_building = Some(params);
-            // A new eta or eccentricity shows first with a draft of its azimuthal table (a tenth of
-            // the build), then with the table, built next.
+            // A new eta or eccentricity shows first with a draft of its azimuthal table alone (a
+            // twelfth of the build), then with the tables, built next.
             let draft = !azimuthal.made_for_hair(&params);
             self.tables = Some(Job::spawn(
                 "hair tables",
                 || {},
-                move |_| {
-                    (
-                        params,
-                        build_tables_or_draft(&params, Some(&azimuthal), draft),
-                    )
-                },
+                move |_| (params, TableBuild::build(&params, Some(&azimuthal), draft)),
             ));
         }
         let finished = self.tables.as_mut().and_then(|job| job.poll());
@@ -736,17 +746,17 @@ impl LiveScene {
         let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
             shown
                 || self.renderer.shadow_grid_stale()
-                || !Arc::ptr_eq(&t.azimuthal, self.renderer.azimuthal_table())
+                || !Arc::ptr_eq(t.azimuthal(), self.renderer.azimuthal_table())
         });
         if hand_over
             && let Some((params, tables)) = self.held_tables.take()
-            && self.renderer.set_tables(&self.ctx, &params, &tables)
+            && self.renderer.take_tables(&self.ctx, &params, &tables)
         {
-            if tables.azimuthal.draft {
-                // A new eta or eccentricity shows from here (its preview); the table is built once
+            if tables.azimuthal_only() {
+                // A new eta or eccentricity shows from here (its preview); the tables are built once
                 // that preview shows, unless a newer change asked for other tables meanwhile.
                 if self.wanted_tables.is_none() {
-                    self.wanted_tables = Some((params, tables.azimuthal.clone()));
+                    self.wanted_tables = Some((params, tables.azimuthal().clone()));
                 }
                 self.showing_anew();
             } else {
@@ -759,6 +769,9 @@ impl LiveScene {
         if shown && !tables_waiting && !self.painting && self.renderer.rebuild_stale_volume() {
             self.restarted_as_refinement();
         }
+        let building = self.wanted_tables.is_some() || self.tables.is_some();
+        self.renderer
+            .set_budget_share(budget_share(&self.ctx, building));
         let progress = self.renderer.refine(&self.ctx)?;
         // A unit that finished between the two polls.
         self.note_ready(progress.ready);

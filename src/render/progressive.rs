@@ -333,6 +333,8 @@ pub struct Refinement {
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
+    /// The part of the budget the units after the preview are sized to ([`Renderer::set_budget_share`]).
+    budget_share: f64,
     /// Seconds per shadow-grid entry, per sample of its sweeps and per deposited segment (None: not
     /// measured yet).
     grid_cost: Option<f64>,
@@ -416,6 +418,7 @@ impl Default for Refinement {
             grid_partial: Vec::new(),
             shade_done: 0.0,
             budget: DEFAULT_UNIT_BUDGET,
+            budget_share: 1.0,
             grid_cost: None,
             gather_cost: None,
             batch_gather_cost: None,
@@ -469,13 +472,18 @@ impl Refinement {
         self.preview_owed = false;
     }
 
+    /// Seconds a unit after the preview is sized to: the budget's share.
+    fn unit_seconds(&self) -> f64 {
+        self.budget.as_secs_f64() * self.budget_share
+    }
+
     /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
     /// the previous unit of the kind (`last`: costs are uneven, empty rows and empty sweep slots cost
     /// almost nothing, so one cheap unit must not size a huge next one); at least one, at most what
     /// remains.
     fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
         let per_item = per_item.unwrap_or(guess).max(1e-12);
-        let n = (self.budget.as_secs_f64() / per_item)
+        let n = (self.unit_seconds() / per_item)
             .floor()
             .min(2.0 * last.max(1) as f64);
         (n.min(remaining as f64) as u32)
@@ -771,6 +779,13 @@ impl Renderer {
     /// The longest time one unit should take (default [`DEFAULT_UNIT_BUDGET`]).
     pub fn set_unit_budget(&mut self, budget: Duration) {
         self.refinement.budget = budget.max(Duration::from_micros(100));
+    }
+
+    /// Sizes the units after the preview to `share` (0.1 to 1) of the budget, the preview's to all
+    /// of it: for a software GPU while a CPU job (the tables' build) takes part of its cores, which
+    /// stretches units past their measured costs ([`crate::editor::live::budget_share`]).
+    pub fn set_budget_share(&mut self, share: f64) {
+        self.refinement.budget_share = share.clamp(0.1, 1.0);
     }
 
     /// Whether frames read the shadow grid at all.
@@ -1508,7 +1523,7 @@ impl Renderer {
                 let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
                 let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
-                let budget = r.budget.as_secs_f64() / lights;
+                let budget = r.unit_seconds() / lights;
                 let rows = if band > 0 {
                     band.min(height - row)
                 } else {
@@ -1520,7 +1535,7 @@ impl Renderer {
                         .as_deref()
                         .filter(|_| k == 0 && by_segment)
                         .map(|c| {
-                            let total = r.budget.as_secs_f64();
+                            let total = r.unit_seconds();
                             r.segment_band_rows(c, (row, height, width), &shapes, total)
                         });
                     let rows = by_counts

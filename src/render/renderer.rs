@@ -150,27 +150,6 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
 /// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
-    build_tables_or_draft(params, reuse, false)
-}
-
-/// Tables of `params` for a preview while [`build_tables`] builds them: those the process keeps when it
-/// has them, else the forward and dual tables with a draft of the azimuthal table where the eta or
-/// eccentricity is new ([`AzimuthalTable::build_draft`]: on two cores 0.08 s for a round fiber and
-/// 0.3 s for an elliptical one, against 0.8 s and 3 s). A draft is never kept, and a renderer holding
-/// one still asks for the tables ([`Renderer::set_params_deferred`]). `reuse` as for [`build_tables`].
-pub fn build_preview_tables(
-    params: &HairParams,
-    reuse: Option<&Arc<AzimuthalTable>>,
-) -> ParamTables {
-    build_tables_or_draft(params, reuse, true)
-}
-
-/// [`build_tables`], or with `draft` [`build_preview_tables`].
-pub fn build_tables_or_draft(
-    params: &HairParams,
-    reuse: Option<&Arc<AzimuthalTable>>,
-    draft: bool,
-) -> ParamTables {
     // The caller's table where it serves, kept or built: callers tell a new azimuthal table by
     // identity.
     let reuse = reuse.filter(|t| t.fits_hair(params)).cloned();
@@ -183,12 +162,10 @@ pub fn build_tables_or_draft(
     let reuse = reuse.or_else(|| with_cache(|c| c.azimuthal(params)));
     let azimuthal = || {
         reuse.unwrap_or_else(|| {
-            let (eta, a) = (params.eta as f32, params.eccentricity as f32);
-            Arc::new(if draft {
-                AzimuthalTable::build_draft(eta, a)
-            } else {
-                AzimuthalTable::build(eta, a)
-            })
+            Arc::new(AzimuthalTable::build(
+                params.eta as f32,
+                params.eccentricity as f32,
+            ))
         })
     };
     let ((forward, dual), azimuthal) = rayon::join(
@@ -205,10 +182,57 @@ pub fn build_tables_or_draft(
         dual,
         azimuthal,
     };
-    if !tables.azimuthal.draft {
-        with_cache(|c| c.keep(params, &tables));
-    }
+    with_cache(|c| c.keep(params, &tables));
     tables
+}
+
+/// The azimuthal table a new eta or eccentricity previews with while [`build_tables`] builds the
+/// tables: the process's kept table for that index when it has one, else a draft
+/// ([`AzimuthalTable::build_draft`]: on two cores 0.06-0.07 s for a round fiber and 0.22-0.25 s for
+/// an elliptical one, against 0.8 s and 3 s). Only the azimuthal table: the forward and dual tables
+/// (another 0.1 s) change little with the index and follow with the tables, as for any other
+/// parameter ([`Renderer::set_azimuthal_table`]). A draft is never kept.
+pub fn build_draft_table(params: &HairParams) -> Arc<AzimuthalTable> {
+    with_cache(|c| c.azimuthal(params)).unwrap_or_else(|| {
+        Arc::new(AzimuthalTable::build_draft(
+            params.eta as f32,
+            params.eccentricity as f32,
+        ))
+    })
+}
+
+/// What a worker builds for new hair parameters ([`TableBuild::build`]).
+#[derive(Clone)]
+pub enum TableBuild {
+    /// For a new eta or eccentricity, first: its azimuthal table alone, a draft unless the process
+    /// keeps one ([`build_draft_table`], [`Renderer::set_azimuthal_table`]).
+    Azimuthal(Arc<AzimuthalTable>),
+    Tables(ParamTables),
+}
+
+impl TableBuild {
+    /// With `draft` (a new eta or eccentricity, shown at once) the draft table, unless the process
+    /// keeps the tables of `params` (an undo): then, and without `draft`, the tables. `reuse` as
+    /// for [`build_tables`].
+    pub fn build(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>, draft: bool) -> Self {
+        if draft && !super::table_cache::holds(params) {
+            Self::Azimuthal(build_draft_table(params))
+        } else {
+            Self::Tables(build_tables(params, reuse))
+        }
+    }
+
+    pub fn azimuthal(&self) -> &Arc<AzimuthalTable> {
+        match self {
+            Self::Azimuthal(t) => t,
+            Self::Tables(t) => &t.azimuthal,
+        }
+    }
+
+    /// The azimuthal table alone: the forward and dual tables are still to be built.
+    pub fn azimuthal_only(&self) -> bool {
+        matches!(self, Self::Azimuthal(_))
+    }
 }
 
 /// The largest angle (radians) a segment may subtend from the eye for the frame to shade it once:
@@ -791,7 +815,7 @@ impl Renderer {
     /// the UI thread) and hands them to [`Renderer::set_tables`]. Until then multiple scattering and
     /// forward transmittance use the old tables, and a new eta or eccentricity waits for an azimuthal
     /// table made for it (the frame keeps the old index: `write_params`); the editor hands it a draft
-    /// first ([`build_preview_tables`]).
+    /// first ([`TableBuild::build`], [`Renderer::set_azimuthal_table`]).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
         let tables_needed = self.tables_needed(&look.params);
         let (before, index_only) = (self.frame_params(), self.look.index_only_change(look));
@@ -807,16 +831,16 @@ impl Renderer {
     }
 
     /// Whether `params` need tables this renderer does not hold: other parameters than the
-    /// absorption, or the azimuthal table is a draft ([`build_preview_tables`]).
+    /// absorption, or the azimuthal table is a draft ([`build_draft_table`]).
     pub fn tables_needed(&self, params: &HairParams) -> bool {
         !same_tables(params, &self.tables_for) || self.azimuthal.draft
     }
 
     /// Writes the look's fast parameters, with the azimuthal table's eta and eccentricity while the
     /// table for new ones is being built: a frame never reads a table made for another index (an eta or
-    /// eccentricity change shows when a table made for it arrives: in the editor its draft, 0.08 s of
-    /// build on two cores for a round fiber and 0.3 s for an elliptical one, then the table, 0.8 s and
-    /// 3 s).
+    /// eccentricity change shows when a table made for it arrives: in the editor its draft, 0.06-0.07 s
+    /// of build on two cores for a round fiber and 0.22-0.25 s for an elliptical one, then the table,
+    /// 0.8 s and 3 s).
     fn write_params(&self, ctx: &GpuContext) {
         let fast = self.frame_params();
         ctx.queue
@@ -837,6 +861,45 @@ impl Renderer {
     /// The azimuthal table in use (kept by a rebuild for the same eta and eccentricity).
     pub fn azimuthal_table(&self) -> &Arc<AzimuthalTable> {
         &self.azimuthal
+    }
+
+    /// Takes what a worker built for `params` ([`TableBuild`]); false when ignored (the look has
+    /// moved on since).
+    pub fn take_tables(
+        &mut self,
+        ctx: &GpuContext,
+        params: &HairParams,
+        built: &TableBuild,
+    ) -> bool {
+        match built {
+            TableBuild::Azimuthal(table) => self.set_azimuthal_table(ctx, params, table),
+            TableBuild::Tables(tables) => self.set_tables(ctx, params, tables),
+        }
+    }
+
+    /// A new eta or eccentricity's azimuthal table ahead of its other tables (its draft,
+    /// [`build_draft_table`]): the index shows from the next frame, its single scattering a preview
+    /// away. The forward and dual tables, which change little with the index, stay until the tables
+    /// arrive ([`Renderer::set_tables`]), as after any other parameter change: the shadow grid is
+    /// kept, and the renderer still asks for the tables ([`Renderer::tables_needed`]). Ignored
+    /// (false) when the look has moved on or the table is not for its index.
+    pub fn set_azimuthal_table(
+        &mut self,
+        ctx: &GpuContext,
+        params: &HairParams,
+        table: &Arc<AzimuthalTable>,
+    ) -> bool {
+        if !same_tables(params, &self.look.params) || !table.made_for_hair(params) {
+            return false;
+        }
+        if !Arc::ptr_eq(&self.azimuthal, table) {
+            ctx.queue
+                .write_buffer(&self.azimuthal_table, 0, table.gpu_bytes());
+            self.azimuthal = table.clone();
+            self.write_params(ctx);
+            self.restart_refinement();
+        }
+        true
     }
 
     /// Uploads tables built for `params`; ignored (false) when the look has moved on since.
@@ -860,11 +923,12 @@ impl Renderer {
             bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
         let azimuthal_changed = !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal);
-        // The table after its draft, for the same parameters: the change is on screen and the grid
-        // (whose forward terms read the forward table, not this one) holds; only the shading, which
-        // reads the azimuthal table, refines again.
-        let after_draft =
-            azimuthal_changed && self.azimuthal.draft && same_tables(params, &self.tables_for);
+        // The table after its draft: the change is on screen (the draft's), and the refinement
+        // goes on as a refinement.
+        let after_draft = azimuthal_changed && self.azimuthal.draft;
+        // Whether the forward and dual tables are new (the grid's forward terms read the forward
+        // table): not for tables of the parameters these were built for.
+        let others_changed = !same_tables(params, &self.tables_for);
         if azimuthal_changed {
             ctx.queue
                 .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.gpu_bytes());
@@ -875,17 +939,22 @@ impl Renderer {
         // The forward and dual tables are read only with multiple scattering (the grid's forward
         // terms, the shading's dual terms); without it only a new azimuthal table changes the image.
         // A new azimuthal table shows a change not on screen yet (an eta or eccentricity change waits
-        // for it): a preview is owed; the others refine the change already shown.
-        let multiple = self.settings.multiple_scattering;
+        // for it): a preview is owed, unless its draft showed it; the others refine the change
+        // already shown.
+        let regrid = self.settings.multiple_scattering && others_changed;
         if after_draft {
-            self.restart_as_refinement(|r| r.restart_refinement());
+            if regrid {
+                self.restart_as_refinement(|r| r.mark_shadow_grid_dirty());
+            } else {
+                self.restart_as_refinement(|r| r.restart_refinement());
+            }
         } else if azimuthal_changed {
-            if multiple {
+            if regrid {
                 self.mark_shadow_grid_dirty();
             } else {
                 self.restart_refinement();
             }
-        } else if multiple {
+        } else if regrid {
             // The grid's transmittance and the single scattering read no table: a converged image
             // keeps its single scattering, and only multiple scattering is shaded again.
             self.refine_multiple_only(|r| r.mark_shadow_grid_dirty());

@@ -41,7 +41,7 @@ use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_p
 use super::fast_exact_azimuthal::for_each_window_node;
 use super::fast_params::FastHairParams;
 use super::fast_response::LAMBDA_PRIME_MAX;
-use super::half_cells::{from_half_bits, half_bits, half_pair};
+use super::half_cells::{half_pair, round_to_half_bits};
 use super::params::HairParams;
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
@@ -64,12 +64,13 @@ pub const TABLE_ETA_ECCENTRIC: usize = 6;
 /// Half-width of the Gaussian window in units of lambda' (as the exact integral).
 const WINDOW: f32 = 3.5;
 
-/// Rounds a cell to what the GPU holds and returns that as the GPU's entry: (w_1, w_1 x_1) and
+/// Rounds cells to what the GPU holds and returns that as the GPU's entries: (w_1, w_1 x_1) and
 /// (w_2, w_2 x_2) as half pairs, the first of each in the low half (WGSL's unpack2x16float).
-fn to_gpu_cell(c: &mut [f32; 4]) -> [u32; 2] {
-    let b = c.map(half_bits);
-    *c = b.map(from_half_bits);
-    [half_pair(b[0], b[1]), half_pair(b[2], b[3])]
+fn to_gpu_cells(cells: &mut [[f32; 4]]) -> Vec<[u32; 2]> {
+    let bits = round_to_half_bits(cells.as_flattened_mut());
+    bits.chunks_exact(4)
+        .map(|b| [half_pair(b[0], b[1]), half_pair(b[2], b[3])])
+        .collect()
 }
 
 /// The GPU buffer's entries before the cells: the header's four f32 bits.
@@ -460,7 +461,11 @@ impl AzimuthalTable {
         // What the GPU holds (the header stays in f32).
         let header = cells[0].map(f32::to_bits);
         let mut gpu = vec![[header[0], header[1]], [header[2], header[3]]];
-        gpu.par_extend(cells[1..].par_iter_mut().map(to_gpu_cell));
+        gpu.par_extend(
+            cells[1..]
+                .par_chunks_mut(1 << 14)
+                .flat_map_iter(to_gpu_cells),
+        );
         debug_assert_eq!(gpu.len(), cells.len() + GPU_HEADER_ENTRIES - 1);
         Self {
             eta,

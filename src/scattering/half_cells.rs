@@ -32,6 +32,28 @@ pub fn half_bits(v: f32) -> u16 {
     half::f16::from_f32(s.clamp(-65504.0, 65504.0)).to_bits()
 }
 
+/// [`half_bits`] of every value, and the values replaced by what the bits hold: the same bits as
+/// value by value, converted eight at a time where the CPU can (F16C), for the tables' builds
+/// (a round azimuthal table's 3.6 million values took 35 ms value by value on one core).
+pub fn round_to_half_bits(values: &mut [f32]) -> Vec<u16> {
+    use half::slice::HalfFloatSliceExt;
+    for v in values.iter_mut() {
+        let s = *v * HALF_SCALE;
+        *v = if s.abs() < HALF_MIN_NORMAL {
+            0.0
+        } else {
+            s.clamp(-65504.0, 65504.0)
+        };
+    }
+    let mut halves = vec![half::f16::ZERO; values.len()];
+    halves.convert_from_f32_slice(values);
+    halves.convert_to_f32_slice(values);
+    for v in values.iter_mut() {
+        *v /= HALF_SCALE;
+    }
+    halves.reinterpret_cast().to_vec()
+}
+
 /// The value of [`half_bits`].
 pub fn from_half_bits(b: u16) -> f32 {
     half::f16::from_bits(b).to_f32() / HALF_SCALE
@@ -62,5 +84,15 @@ mod tests {
         assert_eq!(half_precision(5e-8), 0.0);
         assert!(half_precision(6e-8) > 0.0);
         assert_eq!(half_pair(1, 2), 0x0002_0001);
+        let values: Vec<f32> = (0..1000)
+            .map(|i| (i as f32 * 0.731).sin() * 10f32.powi(i % 12 - 9))
+            .chain([0.0, -0.0, 1e6, -1e6, 5e-8, 6e-8, 2.07])
+            .collect();
+        let mut rounded = values.clone();
+        let bits = round_to_half_bits(&mut rounded);
+        for ((v, r), b) in values.iter().zip(&rounded).zip(&bits) {
+            assert_eq!(*b, half_bits(*v), "{v}");
+            assert_eq!(r.to_bits(), half_precision(*v).to_bits(), "{v}");
+        }
     }
 }
