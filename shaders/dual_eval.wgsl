@@ -19,7 +19,7 @@ struct DualQuery {
 @group(0) @binding(3) var<storage, read_write> dual_results: array<vec4<f32>>;
 // Declared for the fast-model library's table reads, which these entry points never reach (the
 // derived layout leaves them out).
-@group(0) @binding(4) var<storage, read> lut_c: array<f32>;
+@group(0) @binding(4) var<storage, read> lut_c: array<u32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

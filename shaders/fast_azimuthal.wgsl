@@ -15,31 +15,12 @@ fn sigma_a_prime(sigma_a: vec3<f32>, eta: f32, theta_d: f32) -> vec3<f32> {
     return sigma_a / sqrt(max(1.0 - s * s, 1e-12));
 }
 
-// Coefficients of N_R = sum_k C_k |cos(phi/2)|^k (Xu Eq. 13).
-fn n_r_coefficients(eta: f32, theta_d: f32) -> array<f32, 7> {
-    let f0 = ((1.0 - eta) / (1.0 + eta)) * ((1.0 - eta) / (1.0 + eta));
-    let x = -cos(theta_d);
-    let binom5 = array<f32, 6>(1.0, 5.0, 10.0, 10.0, 5.0, 1.0);
-    var c: array<f32, 7>;
-    c[0] = 0.0;
-    c[1] = 0.25;
-    var xn = 1.0;
-    for (var n = 1u; n < 6u; n++) {
-        xn = xn * x;
-        c[n + 1u] = 0.25 * (1.0 - f0) * binom5[n] * xn;
-    }
-    return c;
-}
-
-// calN_R = sum_k C_k calC_k(lambda', dphi) (Xu Eq. 14).
+// calN_R = sum_k C_k calC_k(lambda', dphi) (Xu Eq. 14), with N_R = (1/4) |cos(phi/2)| F (Xu Eq. 13,
+// Schlick's F), read by parts from the R table: (1/4) (F0 calC_1 + (1 - F0) calD) (RTable in lut.rs).
 fn inner_integral_r(eta: f32, theta_d: f32, lambda_prime: f32, dphi: f32) -> f32 {
-    let ck = n_r_coefficients(eta, theta_d);
-    let table = lut_sample_c(lambda_prime, dphi);
-    var sum = 0.0;
-    for (var k = 1u; k < 7u; k++) {
-        sum = sum + ck[k] * table[k];
-    }
-    return sum;
+    let f0 = ((1.0 - eta) / (1.0 + eta)) * ((1.0 - eta) / (1.0 + eta));
+    let v = lut_sample_r(lambda_prime, dphi, cos(theta_d));
+    return 0.25 * (f0 * v.x + (1.0 - f0) * v.y);
 }
 
 // The averaged eccentric index eta*-bar (Xu Eq. 24-26).

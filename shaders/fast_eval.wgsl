@@ -13,7 +13,7 @@ struct FastQuery {
     _pad2: f32,
 }
 
-@group(0) @binding(0) var<storage, read> lut_c: array<f32>;
+@group(0) @binding(0) var<storage, read> lut_c: array<u32>;
 @group(0) @binding(1) var<storage, read> azimuthal_table: array<vec2<u32>>;
 @group(0) @binding(2) var<storage, read> queries: array<FastQuery>;
 @group(0) @binding(3) var<storage, read_write> results: array<vec4<f32>>;

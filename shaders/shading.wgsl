@@ -23,7 +23,7 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(5) var<storage, read> segments: array<u32>;
 @group(0) @binding(6) var<storage, read> absorption: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> lights: array<GpuLight>;
-@group(0) @binding(8) var<storage, read> lut_c: array<f32>;
+@group(0) @binding(8) var<storage, read> lut_c: array<u32>;
 @group(0) @binding(11) var<storage, read> shadow_values: array<vec4<f32>>;
 @group(0) @binding(12) var<storage, read> dual_tables: array<vec4<f32>>;
 @group(0) @binding(13) var<storage, read_write> aov_r: array<vec4<f32>>;

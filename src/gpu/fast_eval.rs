@@ -6,7 +6,7 @@ use super::context::{GpuContext, compute_pipeline};
 use super::shaders;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::fast_params::FastHairParams;
-use crate::scattering::lut::{LutTexture, Luts};
+use crate::scattering::lut::Luts;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -25,23 +25,25 @@ pub struct FastQuery {
 
 const _: () = assert!(std::mem::size_of::<FastQuery>() == 112);
 
-/// The C_k table as a storage buffer (texels as in [`LutTexture`]; the H_k tables feed only the
-/// CPU's circular-Gaussian fits, which the GPU does not evaluate).
+/// The C_k table and the R table as one storage buffer (C_k's texels as in
+/// [`crate::scattering::lut::LutTexture`], as f32 bits; the H_k tables feed only the CPU's
+/// circular-Gaussian fits, which the GPU does not evaluate).
 pub struct GpuLuts {
     pub c: wgpu::Buffer,
 }
 
 impl GpuLuts {
+    /// `lut_c` (lut.wgsl): C_k's texels, then the R table's entries.
     pub fn new(device: &wgpu::Device, luts: &Luts) -> Self {
-        let make = |label: &str, t: &LutTexture| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(&t.texels),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
+        let words: Vec<u32> = (luts.c.texels.iter().map(|v| v.to_bits()))
+            .chain(luts.r.gpu.iter().copied())
+            .collect();
         Self {
-            c: make("lut C_k", &luts.c),
+            c: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("lut C_k and R"),
+                contents: bytemuck::cast_slice(&words),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
         }
     }
 }

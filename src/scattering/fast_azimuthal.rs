@@ -23,7 +23,7 @@
 //!   +-h_2 beside h = 0, found by bisection.
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
-use super::lut::{Luts, lut_sample_c, lut_sample_h, wrap_angle_f32};
+use super::lut::{Luts, lut_sample_c, lut_sample_h, lut_sample_r, wrap_angle_f32};
 use std::f32::consts::{PI, SQRT_2, TAU};
 
 pub type Rgb32 = [f32; 3];
@@ -245,8 +245,22 @@ pub fn n_r_coefficients(eta: f32, theta_d: f32) -> [f32; 7] {
     c
 }
 
-/// calN_R(lambda', dphi, theta_d) = sum_k C_k(theta_d, eta) calC_k(lambda', dphi) (Xu Eq. 14).
+/// calN_R(lambda', dphi, theta_d) = sum_k C_k(theta_d, eta) calC_k(lambda', dphi) (Xu Eq. 14), read by
+/// parts from the R table: (1/4) (F0 calC_1 + (1 - F0) calD) ([`crate::scattering::lut::RTable`]).
 pub fn inner_integral_r(luts: &Luts, eta: f32, theta_d: f32, lambda_prime: f32, dphi: f32) -> f32 {
+    let f0 = ((1.0 - eta) / (1.0 + eta)).powi(2);
+    let [c1, d] = lut_sample_r(luts, lambda_prime, dphi, theta_d.cos());
+    0.25 * (f0 * c1 + (1.0 - f0) * d)
+}
+
+/// [`inner_integral_r`] as Xu Eq. 14 writes it, from the seven C_k (the R table's reference).
+pub fn inner_integral_r_ck(
+    luts: &Luts,
+    eta: f32,
+    theta_d: f32,
+    lambda_prime: f32,
+    dphi: f32,
+) -> f32 {
     let ck = n_r_coefficients(eta, theta_d);
     let table = lut_sample_c(luts, lambda_prime, dphi);
     (1..7).map(|k| ck[k] * table[k]).sum()
