@@ -2,6 +2,8 @@
 // every grid point for every light, the swept transmittance and the forward-scattering terms;
 // `grid_shadow` reads them trilinearly. Two vec4 per (point, light), light-major:
 // (ln transmittance, ln T_f RGB), (sigma_f^2 RGB, optical depth behind the point along the light's travel).
+// ln transmittance (<= 0) is stored with its sign bit set outside the occluder and clear inside
+// (`grid_ln_t_stored`), so that `grid_transmittance` reads one word per corner; -abs reads it back.
 
 // One SRBF light (twin of GpuLight in src/render/shading.rs); read by the grid build and shading.
 struct GpuLight {
@@ -99,7 +101,8 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
         let c = grid_corner(g, cell, corner);
         let i = c.i;
         let w = c.w;
-        let a = shadow_values[2u * (light * n + i)];
+        let stored = shadow_values[2u * (light * n + i)];
+        let a = vec4<f32>(-abs(stored.x), stored.yzw);
         let b = shadow_values[2u * (light * n + i) + 1u];
         v0 = v0 + w * a;
         v1 = v1 + w * b;
@@ -118,9 +121,19 @@ fn grid_shadow(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> GridShadow {
     return GridShadow(exp(v0.x), exp(v0.yzw), v1.xyz, max(v1.w, 0.0));
 }
 
+// ln T (<= 0) as stored: its sign bit set for a point outside the occluder, clear inside.
+fn grid_ln_t_stored(ln_t: f32, inside: bool) -> f32 {
+    let m = bitcast<u32>(ln_t) & 0x7fffffffu;
+    return bitcast<f32>(select(m | 0x80000000u, m, inside));
+}
+
+fn grid_ln_t_inside(stored: f32) -> bool {
+    return (bitcast<u32>(stored) & 0x80000000u) == 0u;
+}
+
 // grid_shadow's transmittance alone (single scattering reads only it, three times per light and
-// segment, and the head's shading): per corner the log transmittance and the inside flag, two floats
-// where grid_shadow loads two vec4. The same sums in the same order, so the same value.
+// segment, and the head's shading): per corner one word, the log transmittance with the inside flag
+// in its sign bit, where grid_shadow loads two vec4. The same sums in the same order, so the same value.
 fn grid_transmittance(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> f32 {
     let cell = grid_cell(g, p);
     let n = g.dims.x * g.dims.y * g.dims.z;
@@ -132,9 +145,10 @@ fn grid_transmittance(g: ShadowGridInfo, p: vec3<f32>, light: u32) -> f32 {
         let c = grid_corner(g, cell, corner);
         let i = c.i;
         let w = c.w;
-        let t = shadow_values[2u * (light * n + i)].x;
+        let stored = shadow_values[2u * (light * n + i)].x;
+        let t = -abs(stored);
         v = v + w * t;
-        if (shadow_values[2u * (light * n + i) + 1u].w >= 0.0) {
+        if (!grid_ln_t_inside(stored)) {
             o = o + w * t;
             wo = wo + w;
         } else {

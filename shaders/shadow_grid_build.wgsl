@@ -280,21 +280,22 @@ fn accumulate(e: u32, d: SweepDirection, f: PathIntegrals, forward: bool, first:
 // finish in sweep.rs: the stored value from the sums (transmittances as logarithms: attenuation falls
 // off exponentially into the hair, so interpolating its logarithm follows it between grid points far
 // better).
-// A point in a voxel more than half inside the occluder gets depth_behind = GRID_INSIDE_SOLID: the
-// lookup leaves it out of its interpolation (FiberDensity::inside_solid).
+// A point in a voxel more than half inside the occluder gets depth_behind = GRID_INSIDE_SOLID and ln T
+// stored with its sign bit clear (grid_ln_t_stored): the lookup leaves it out of its interpolation
+// (FiberDensity::inside_solid). ln T is at most 0 (the sweeps' sums may round above 1).
 fn finish(e: u32, g: ShadowGridInfo) {
     let v0 = shadow_values[2u * e];
     let v1 = shadow_values[2u * e + 1u];
-    let t = log(max(v0.x, GRID_MIN_TRANSMITTANCE));
+    let t = min(log(max(v0.x, GRID_MIN_TRANSMITTANCE)), 0.0);
     let n = g.dims.x * g.dims.y * g.dims.z;
     let voxel = forward_voxel_at(grid_point(g, e % n));
     let inside = voxel >= 0 && volume[3u * u32(voxel) + 2u].w > 0.5;
     if (g.forward == 0u) {
-        shadow_values[2u * e] = vec4<f32>(t, vec3<f32>(t));
+        shadow_values[2u * e] = vec4<f32>(grid_ln_t_stored(t, inside), vec3<f32>(t));
         shadow_values[2u * e + 1u] = vec4<f32>(0.0, 0.0, 0.0, select(0.0, GRID_INSIDE_SOLID, inside));
         return;
     }
-    shadow_values[2u * e] = vec4<f32>(t, log(max(v0.yzw, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
+    shadow_values[2u * e] = vec4<f32>(grid_ln_t_stored(t, inside), log(max(v0.yzw, vec3<f32>(GRID_MIN_TRANSMITTANCE))));
     let behind = select(v1.w, GRID_INSIDE_SOLID, inside);
     shadow_values[2u * e + 1u] = vec4<f32>(v1.xyz / max(v0.yzw - vec3<f32>(v0.x), vec3<f32>(1e-12)), behind);
 }

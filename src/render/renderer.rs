@@ -1725,7 +1725,8 @@ impl Renderer {
             .map_err(RenderError::Gpu)?;
         Ok(v.into_iter()
             .map(|e| crate::shadow::grid::GridShadow {
-                transmittance: e[0],
+                // ln T, the occluder flag in its sign bit (`grid_ln_t_stored`).
+                transmittance: -e[0].abs(),
                 transmittance_f: [e[1], e[2], e[3]],
                 sigma_f2: [e[4], e[5], e[6]],
                 depth_behind: e[7],

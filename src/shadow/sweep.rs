@@ -423,10 +423,11 @@ fn accumulate(acc: &mut Accumulator, d: &SweepDirection, f: &PathIntegrals, forw
 }
 
 /// A point's stored value from its accumulator (twin of `finish` in the WGSL): transmittances as
-/// logarithms floored at [`GRID_MIN_TRANSMITTANCE`], sigma_f^2 the forward-scattered light's average.
+/// logarithms floored at [`GRID_MIN_TRANSMITTANCE`] (ln T at most 0), sigma_f^2 the forward-scattered light's average.
 fn finish(acc: &Accumulator, forward: bool) -> GridShadow {
     let ln = |t: f32| t.max(GRID_MIN_TRANSMITTANCE).ln();
-    let t = ln(acc[0]);
+    // At most 0: the GPU keeps the occluder flag in its sign bit (`grid_ln_t_stored`).
+    let t = ln(acc[0]).min(0.0);
     if !forward {
         return GridShadow {
             transmittance: t,
