@@ -3,7 +3,8 @@
 // GPU agree to rounding. Bindings are declared by the module that includes this file:
 //   lut_c (u32 words): C_0..C_6 (128 x 64 x 7, f32 bits), then from R_BASE the R table (RTable:
 //   128 x 64 x R_TABLE_X half pairs (calC_1, calD), scaled by HALF_SCALE). (The H_k tables feed only
-//   the CPU's circular-Gaussian fits.)
+//   the CPU's circular-Gaussian fits.) HALF_SCALE comes from azimuthal_table.wgsl, which every
+//   includer of this file prepends too (fast_model_library).
 
 const LUT_W: u32 = 128u;
 const LUT_H: u32 = 64u;

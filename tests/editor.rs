@@ -458,8 +458,9 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
 }
 
 /// An eta change: the viewport keeps the old index until the new one's azimuthal table is ready (no
-/// frame reads a table made for another index), shows it first with the table's draft (built at once, a
-/// tenth of the build), then converges with the table to what a headless render of the session makes.
+/// frame reads a table made for another index), shows it first with the table's draft (built at once,
+/// about a twelfth of the build), then converges with the tables to what a headless render of the
+/// session makes.
 #[test]
 fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
     let dir = tmp("eta");

@@ -10,7 +10,7 @@ use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, WorkUnit};
-use strandlight::render::renderer::{build_draft_table, build_tables};
+use strandlight::render::renderer::{TableBuild, build_draft_table, build_tables};
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::Preset;
@@ -192,7 +192,7 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     );
     let c = progressive.read_frame(&ctx).expect("read");
     assert_eq!(difference(&b, &c), 0.0, "eta waits for its azimuthal table");
-    // Its draft (the editor's, at once; a twentieth of the table's build): the new eta shows. The
+    // Its draft (the editor's, at once; a twelfth of the table's build): the new eta shows. The
     // forward and dual tables stay until the tables come (the grid, whose forward terms read the
     // forward table, is kept), and the renderer still asks for them; the tables then rebuild the
     // grid as a refinement (no preview: the draft showed the change).
@@ -252,6 +252,59 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     println!("eta 1.55 -> 1.62 with its tables: difference to render_frame {d:.1e}");
     assert_eq!(d, 0.0);
     assert!(difference(&b, &c) > 1e-3, "the new eta changed the image");
+
+    // An undo while a draft shows: a third eta's draft on screen, then back to 1.62, whose tables the
+    // process keeps. They owe a preview (the image shows the draft's eta) and the image is 1.62's
+    // again, exactly.
+    progressive.set_preview(PreviewMode::Fixed(3));
+    let mut third = eta_params;
+    third.eta = 1.7;
+    assert!(progressive.set_params_deferred(&ctx, &strandlight::render::HairLook::new(third)));
+    assert!(progressive.set_azimuthal_table(&ctx, &third, &build_draft_table(&third)));
+    refine_all(&mut progressive, &ctx);
+    assert!(
+        progressive.set_params_deferred(&ctx, &eta_look),
+        "a draft's renderer asks for tables"
+    );
+    let kept = TableBuild::build(&eta_params, Some(progressive.azimuthal_table()), true);
+    assert!(
+        !kept.azimuthal_only(),
+        "the process keeps the tables of eta 1.62"
+    );
+    assert!(progressive.take_tables(&ctx, &eta_params, &kept));
+    let units = refine_all(&mut progressive, &ctx);
+    assert!(
+        units.iter().any(|u| matches!(u, WorkUnit::Preview { .. })),
+        "tables for another index than the draft's show with a preview"
+    );
+    let undone = progressive.read_frame(&ctx).expect("read");
+    assert_eq!(difference(&c, &undone), 0.0, "the undo is 1.62's image");
+    // A kept azimuthal table shown ahead of its tables (eta 1.55's, under another beta_R), then an
+    // undo to the parameters the forward and dual tables are for: the renderer still asks for
+    // tables (its azimuthal table is another index's), and they bring 1.62's image back.
+    let mut other = params;
+    other.beta_r *= 1.2;
+    assert!(progressive.set_params_deferred(&ctx, &strandlight::render::HairLook::new(other)));
+    let ahead = TableBuild::build(&other, Some(progressive.azimuthal_table()), true);
+    assert!(
+        ahead.azimuthal_only() && !ahead.azimuthal().draft,
+        "eta 1.55's table is kept, not its tables under this beta_R"
+    );
+    assert!(progressive.take_tables(&ctx, &other, &ahead));
+    assert!(
+        progressive.set_params_deferred(&ctx, &eta_look),
+        "an azimuthal table of another index asks for tables"
+    );
+    let back = TableBuild::build(&eta_params, Some(progressive.azimuthal_table()), true);
+    assert!(progressive.take_tables(&ctx, &eta_params, &back));
+    refine_all(&mut progressive, &ctx);
+    let undone = progressive.read_frame(&ctx).expect("read");
+    assert_eq!(
+        difference(&c, &undone),
+        0.0,
+        "the second undo is 1.62's image"
+    );
+    progressive.set_preview(PreviewMode::Off);
 
     // A light set of another size: the grid's values are made anew for it, the samples its sweeps
     // read (the pyramid's, light-independent) are kept; the image is a new renderer's with those

@@ -562,7 +562,7 @@ impl LiveScene {
                 .map(|(_, t)| t.azimuthal().clone())
                 .filter(|t| t.fits_hair(&params))
                 .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
-            // A newer build replaces an older one; set_tables ignores stale tables anyway. It
+            // A newer build replaces an older one; take_tables ignores stale tables anyway. It
             // starts once the change's preview is on screen (`step`): on two cores the build
             // would slow the preview, and a slider drag would start one per frame.
             self.held_tables = None;

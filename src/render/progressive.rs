@@ -333,7 +333,7 @@ pub struct Refinement {
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
-    /// The part of the budget the units after the preview are sized to ([`Renderer::set_budget_share`]).
+    /// The part of the budget units are sized to, but the preview's shading ([`Renderer::set_budget_share`]).
     budget_share: f64,
     /// Seconds per shadow-grid entry, per sample of its sweeps and per deposited segment (None: not
     /// measured yet).
@@ -781,9 +781,10 @@ impl Renderer {
         self.refinement.budget = budget.max(Duration::from_micros(100));
     }
 
-    /// Sizes the units after the preview to `share` (0.1 to 1) of the budget, the preview's to all
-    /// of it: for a software GPU while a CPU job (the tables' build) takes part of its cores, which
-    /// stretches units past their measured costs ([`crate::editor::live::budget_share`]).
+    /// Sizes units to `share` (0.1 to 1) of the budget, all but the preview's shading bands (which
+    /// keep all of it, as the preview's target does): for a software GPU while a CPU job (the
+    /// tables' build) takes part of its cores, which stretches units past their measured costs
+    /// ([`crate::editor::live::budget_share`]).
     pub fn set_budget_share(&mut self, share: f64) {
         self.refinement.budget_share = share.clamp(0.1, 1.0);
     }

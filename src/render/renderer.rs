@@ -831,9 +831,10 @@ impl Renderer {
     }
 
     /// Whether `params` need tables this renderer does not hold: other parameters than the
-    /// absorption, or the azimuthal table is a draft ([`build_draft_table`]).
+    /// absorption, or an azimuthal table not made for them (a draft, [`build_draft_table`], or one
+    /// shown ahead of its tables for another index: [`Renderer::set_azimuthal_table`]).
     pub fn tables_needed(&self, params: &HairParams) -> bool {
-        !same_tables(params, &self.tables_for) || self.azimuthal.draft
+        !same_tables(params, &self.tables_for) || !self.azimuthal.fits_hair(params)
     }
 
     /// Writes the look's fast parameters, with the azimuthal table's eta and eccentricity while the
@@ -923,9 +924,10 @@ impl Renderer {
             bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
         let azimuthal_changed = !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal);
-        // The table after its draft: the change is on screen (the draft's), and the refinement
-        // goes on as a refinement.
-        let after_draft = azimuthal_changed && self.azimuthal.draft;
+        // The table after its draft (or after a kept table for its index, shown ahead of its
+        // tables): the index is on screen, and the refinement goes on as a refinement. Tables for
+        // another index (an undo while a draft shows) owe a preview.
+        let after_draft = azimuthal_changed && self.azimuthal.made_for_hair(params);
         // Whether the forward and dual tables are new (the grid's forward terms read the forward
         // table): not for tables of the parameters these were built for.
         let others_changed = !same_tables(params, &self.tables_for);

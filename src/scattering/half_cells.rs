@@ -3,7 +3,8 @@
 //! a WGSL lookup and its Rust twin read the same numbers. Values are scaled by [`HALF_SCALE`] (a
 //! power of two: exact either way) so that those from 6e-8 (the smallest normal half float) to 64
 //! keep 11 significant bits; larger ones saturate, smaller ones are 0. WGSL: `HALF_SCALE` in
-//! `shaders/azimuthal_table.wgsl`, and `unpack2x16float` reads a pair.
+//! `shaders/azimuthal_table.wgsl`, and `unpack2x16float` reads a pair. Users: the azimuthal table's
+//! cells and the R table (`lut.rs`, `RTable`).
 //!
 //! Only for tables whose values enter a lookup without cancellation. The azimuthal table's cells
 //! do (a rule's weights times positive exponentials). The C_k table does not: N_R sums C_k's

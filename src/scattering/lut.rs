@@ -41,7 +41,7 @@ pub const R_TABLE_X: usize = 64;
 /// c = |cos(phi/2)| and x = -cos(theta_d), N_R = (1/4) c F, so
 ///   calN_R = (1/4) (F0 calC_1 + (1 - F0) calD),  calD(lambda', dphi, x) = sum_n binom(5, n) x^n calC_(n+1)
 /// (n = 0..5). Each cell holds (calC_1, calD) at a C_k texel and a sample of x, uniform over [-1, 0],
-/// in half precision ([`super::half_cells`]): a lookup reads 8 words where C_k's read 24 (the GPU's
+/// in half precision ([`super::half_cells`]): a lookup reads 8 words where C_k's read 24-28 (the GPU's
 /// loads cost per word on lavapipe). calD's sum of alternating terms is taken once per cell in
 /// f64, and the stored parts are positive: no cancellation is left to the rounding (which it was
 /// when C_k itself went to half precision: R against brute force grew from median 0.11 % /
