@@ -322,7 +322,8 @@ fn edit_run(
     }
     // As the editor: units after the preview take a share of the budget while tables are wanted or
     // built (on a software GPU the build takes its cores).
-    let share = |building: bool| strandlight::editor::live::budget_share(ctx, building);
+    let building_share = strandlight::editor::live::budget_share(ctx, true);
+    let share = |building: bool| if building { building_share } else { 1.0 };
     renderer.set_budget_share(share(spawn.is_some() || worker.is_some()));
     let run = refine_run(ctx, renderer, |r, run| {
         'between: {

@@ -257,6 +257,8 @@ pub struct LiveScene {
     wanted_tables: Option<(HairParams, Arc<AzimuthalTable>)>,
     /// Tables built but not yet handed to the renderer (see `step`).
     held_tables: Option<Tables>,
+    /// The budget's share for units while tables are wanted or built ([`budget_share`], found once).
+    building_share: f64,
     /// The last table build died (a draft in the renderer then stays).
     tables_failed: bool,
     pub progress: Option<Progress>,
@@ -372,6 +374,7 @@ impl LiveScene {
             wanted_camera: None,
             wanted_tables: None,
             held_tables: None,
+            building_share: budget_share(&ctx, true),
             tables_failed: false,
             progress: None,
             refine_started: Instant::now(),
@@ -771,7 +774,7 @@ impl LiveScene {
         }
         let building = self.wanted_tables.is_some() || self.tables.is_some();
         self.renderer
-            .set_budget_share(budget_share(&self.ctx, building));
+            .set_budget_share(if building { self.building_share } else { 1.0 });
         let progress = self.renderer.refine(&self.ctx)?;
         // A unit that finished between the two polls.
         self.note_ready(progress.ready);

@@ -894,13 +894,18 @@ impl Renderer {
             return false;
         }
         if !Arc::ptr_eq(&self.azimuthal, table) {
-            ctx.queue
-                .write_buffer(&self.azimuthal_table, 0, table.gpu_bytes());
-            self.azimuthal = table.clone();
-            self.write_params(ctx);
+            self.upload_azimuthal(ctx, table);
             self.restart_refinement();
         }
         true
+    }
+
+    /// The azimuthal table to the GPU, and the parameters a frame reads with it (`write_params`).
+    fn upload_azimuthal(&mut self, ctx: &GpuContext, table: &Arc<AzimuthalTable>) {
+        ctx.queue
+            .write_buffer(&self.azimuthal_table, 0, table.gpu_bytes());
+        self.azimuthal = table.clone();
+        self.write_params(ctx);
     }
 
     /// Uploads tables built for `params`; ignored (false) when the look has moved on since.
@@ -932,10 +937,7 @@ impl Renderer {
         // table): not for tables of the parameters these were built for.
         let others_changed = !same_tables(params, &self.tables_for);
         if azimuthal_changed {
-            ctx.queue
-                .write_buffer(&self.azimuthal_table, 0, tables.azimuthal.gpu_bytes());
-            self.azimuthal = tables.azimuthal.clone();
-            self.write_params(ctx);
+            self.upload_azimuthal(ctx, &tables.azimuthal);
         }
         self.tables_for = *params;
         // The forward and dual tables are read only with multiple scattering (the grid's forward

@@ -26,11 +26,17 @@ const HALF_MIN_NORMAL: f32 = 6.103_515_6e-5;
 /// The half-precision bits of v (scaled by [`HALF_SCALE`], saturated at the largest half float,
 /// flushed to zero below the smallest normal one).
 pub fn half_bits(v: f32) -> u16 {
+    half::f16::from_f32(scaled_for_half(v)).to_bits()
+}
+
+/// v scaled by [`HALF_SCALE`], 0 below the smallest normal half float, clamped to the largest.
+fn scaled_for_half(v: f32) -> f32 {
     let s = v * HALF_SCALE;
     if s.abs() < HALF_MIN_NORMAL {
-        return 0;
+        0.0
+    } else {
+        s.clamp(-65504.0, 65504.0)
     }
-    half::f16::from_f32(s.clamp(-65504.0, 65504.0)).to_bits()
 }
 
 /// [`half_bits`] of every value, and the values replaced by what the bits hold: the same bits as
@@ -39,12 +45,7 @@ pub fn half_bits(v: f32) -> u16 {
 pub fn round_to_half_bits(values: &mut [f32]) -> Vec<u16> {
     use half::slice::HalfFloatSliceExt;
     for v in values.iter_mut() {
-        let s = *v * HALF_SCALE;
-        *v = if s.abs() < HALF_MIN_NORMAL {
-            0.0
-        } else {
-            s.clamp(-65504.0, 65504.0)
-        };
+        *v = scaled_for_half(*v);
     }
     let mut halves = vec![half::f16::ZERO; values.len()];
     halves.convert_from_f32_slice(values);

@@ -109,15 +109,21 @@ impl LutTexture {
         }
     }
 
-    /// Bilinear sample at axis positions (tx, ty) in [0, 1] (clamped), into `out` (one value per channel).
-    pub fn sample(&self, tx: f32, ty: f32, out: &mut [f32]) {
+    /// The texel cell at axis positions (tx, ty) in [0, 1] (clamped): its lower corner (x0, y0) and
+    /// the weights (wx, wy) of the next texels (WGSL: `lut_coord`).
+    pub fn cell(&self, tx: f32, ty: f32) -> (usize, usize, f32, f32) {
         let fx = tx.clamp(0.0, 1.0) * (self.width - 1) as f32;
         let fy = ty.clamp(0.0, 1.0) * (self.height - 1) as f32;
         let (x0, y0) = (
             (fx as usize).min(self.width - 2),
             (fy as usize).min(self.height - 2),
         );
-        let (wx, wy) = (fx - x0 as f32, fy - y0 as f32);
+        (x0, y0, fx - x0 as f32, fy - y0 as f32)
+    }
+
+    /// Bilinear sample at axis positions (tx, ty) in [0, 1] (clamped), into `out` (one value per channel).
+    pub fn sample(&self, tx: f32, ty: f32, out: &mut [f32]) {
+        let (x0, y0, wx, wy) = self.cell(tx, ty);
         // The two texels of each row side by side: (x0, x0 + 1) at y0 and at y0 + 1.
         let ch = self.channels;
         let pair = |y: usize| {
@@ -183,12 +189,17 @@ impl Luts {
 
 /// C_0..C_6 at (lambda', dphi) (Xu Eq. 14); dphi is folded into [0, pi] (C_k is even and 2 pi-periodic).
 pub fn lut_sample_c(luts: &Luts, lambda_prime: f32, dphi: f32) -> [f32; 7] {
+    let (tx, ty) = c_axes(lambda_prime, dphi);
+    let mut out = [0.0; 7];
+    luts.c.sample(tx, ty, &mut out);
+    out
+}
+
+/// C_k's axis positions of (lambda', dphi): lambda' clamped and log-spaced, dphi folded into [0, pi].
+fn c_axes(lambda_prime: f32, dphi: f32) -> (f32, f32) {
     let l = lambda_prime.clamp(LAMBDA_MIN, LAMBDA_MAX);
     let tx = (l / LAMBDA_MIN).log10() / 4.0;
-    let d = wrap_angle_f32(dphi).abs();
-    let mut out = [0.0; 7];
-    luts.c.sample(tx, d / std::f32::consts::PI, &mut out);
-    out
+    (tx, wrap_angle_f32(dphi).abs() / std::f32::consts::PI)
 }
 
 /// (calC_1, calD) of [`RTable`] at (lambda', dphi, theta_d): bilinear in (lambda', dphi) as
@@ -196,18 +207,11 @@ pub fn lut_sample_c(luts: &Luts, lambda_prime: f32, dphi: f32) -> [f32; 7] {
 /// `lut_sample_r`).
 pub fn lut_sample_r(luts: &Luts, lambda_prime: f32, dphi: f32, cos_theta_d: f32) -> [f32; 2] {
     let c = &luts.c;
-    let l = lambda_prime.clamp(LAMBDA_MIN, LAMBDA_MAX);
-    let tx = (l / LAMBDA_MIN).log10() / 4.0;
-    let ty = wrap_angle_f32(dphi).abs() / std::f32::consts::PI;
-    let fx = tx.clamp(0.0, 1.0) * (c.width - 1) as f32;
-    let fy = ty.clamp(0.0, 1.0) * (c.height - 1) as f32;
+    let (tx, ty) = c_axes(lambda_prime, dphi);
+    let (x0, y0, wx, wy) = c.cell(tx, ty);
     let fz = (1.0 - cos_theta_d.abs()).clamp(0.0, 1.0) * (R_TABLE_X - 1) as f32;
-    let (x0, y0, z0) = (
-        (fx as usize).min(c.width - 2),
-        (fy as usize).min(c.height - 2),
-        (fz as usize).min(R_TABLE_X - 2),
-    );
-    let (wx, wy, wz) = (fx - x0 as f32, fy - y0 as f32, fz - z0 as f32);
+    let z0 = (fz as usize).min(R_TABLE_X - 2);
+    let wz = fz - z0 as f32;
     let cells = &luts.r.cells;
     let slice = |z: usize| -> [f32; 2] {
         let at = |y: usize, x: usize| cells[(z * c.height + y) * c.width + x];
