@@ -97,32 +97,43 @@ fn deposit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     }
 }
 
+// The sums' index of neighbour n (0..27, x fastest) of voxel i, or -1 outside the volume.
+fn neighbour_voxel(i: vec3<i32>, n: u32) -> i32 {
+    let d = info.dims;
+    let q = i + vec3<i32>(i32(n % 3u), i32((n / 3u) % 3u), i32(n / 9u)) - vec3<i32>(1);
+    if (any(q < vec3<i32>(0)) || any(q >= vec3<i32>(d))) {
+        return -1;
+    }
+    return i32((u32(q.z) * d.y + u32(q.y)) * d.x + u32(q.x));
+}
+
 // The absorption of an empty voxel: the length-weighted mean over its 26 neighbours (0 if they are
 // empty too), so the forward march sees the absorption of the fibers its trilinear density counts.
+// The lengths first: most empty voxels have no hair around them, and their absorption sums are not
+// read (an empty neighbour's are zero: the result is the same).
 fn neighbour_absorption(v: u32) -> vec3<f32> {
     let d = info.dims;
     let i = vec3<i32>(vec3<u32>(v % d.x, (v / d.x) % d.y, v / (d.x * d.y)));
     var len = 0.0;
-    var sig = vec3<f32>(0.0);
-    for (var dz = -1; dz <= 1; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let q = i + vec3<i32>(dx, dy, dz);
-                if (any(q < vec3<i32>(0)) || any(q >= vec3<i32>(d))) {
-                    continue;
-                }
-                let u = (u32(q.z) * d.y + u32(q.y)) * d.x + u32(q.x);
-                len = len + f32(atomicLoad(&sums[u * CHANNELS])) / FIXED_SCALE;
-                sig = sig + vec3<f32>(
-                    f32(atomicLoad(&sums[u * CHANNELS + 7u])),
-                    f32(atomicLoad(&sums[u * CHANNELS + 8u])),
-                    f32(atomicLoad(&sums[u * CHANNELS + 9u])),
-                ) / FIXED_SCALE;
-            }
+    for (var n = 0u; n < 27u; n++) {
+        let u = neighbour_voxel(i, n);
+        if (u >= 0) {
+            len = len + f32(atomicLoad(&sums[u32(u) * CHANNELS])) / FIXED_SCALE;
         }
     }
     if (len <= 0.0) {
         return vec3<f32>(0.0);
+    }
+    var sig = vec3<f32>(0.0);
+    for (var n = 0u; n < 27u; n++) {
+        let u = neighbour_voxel(i, n);
+        if (u >= 0 && atomicLoad(&sums[u32(u) * CHANNELS]) != 0u) {
+            sig = sig + vec3<f32>(
+                f32(atomicLoad(&sums[u32(u) * CHANNELS + 7u])),
+                f32(atomicLoad(&sums[u32(u) * CHANNELS + 8u])),
+                f32(atomicLoad(&sums[u32(u) * CHANNELS + 9u])),
+            ) / FIXED_SCALE;
+        }
     }
     return sig / len;
 }
@@ -145,7 +156,11 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     if (len <= 0.0) {
         volume[3u * v] = vec4<f32>(a_s, 0.0, 0.0, 0.0);
         volume[3u * v + 1u] = vec4<f32>(0.0);
-        volume[3u * v + 2u] = vec4<f32>(select(neighbour_absorption(v), vec3<f32>(SOLID_SIGMA_A), a_s > 0.0), solid[v]);
+        var sig = vec3<f32>(SOLID_SIGMA_A);
+        if (a_s <= 0.0) {
+            sig = neighbour_absorption(v);
+        }
+        volume[3u * v + 2u] = vec4<f32>(sig, solid[v]);
         return;
     }
     let rho = len / (info.voxel * info.voxel * info.voxel);

@@ -56,20 +56,25 @@ fn forward_voxel_at(p: vec3<f32>) -> i32 {
 }
 
 // The integrals of a shadow path (twin of PathIntegrals in src/shadow/forward.rs): tau = integral c ds,
-// per channel integral c (1 - a_f) ds, integral c a_f ds, integral c a_f beta_f^2 ds; per cm at a point.
+// per channel integral c a_f ds, integral c a_f beta_f^2 ds; per cm at a point. T_f's loss integral
+// c (1 - a_f) ds is tau - mass (path_loss).
 struct PathIntegrals {
     tau: f32,
-    loss: vec3<f32>,
     mass: vec3<f32>,
     spread: vec3<f32>,
 }
 
 fn path_add_scaled(s: PathIntegrals, o: PathIntegrals, h: f32) -> PathIntegrals {
-    return PathIntegrals(s.tau + h * o.tau, s.loss + h * o.loss, s.mass + h * o.mass, s.spread + h * o.spread);
+    return PathIntegrals(s.tau + h * o.tau, s.mass + h * o.mass, s.spread + h * o.spread);
 }
 
 fn path_zero() -> PathIntegrals {
-    return PathIntegrals(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    return PathIntegrals(0.0, vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+// PathIntegrals::loss: per channel tau - mass, at least 0.
+fn path_loss(s: PathIntegrals) -> vec3<f32> {
+    return max(vec3<f32>(s.tau) - s.mass, vec3<f32>(0.0));
 }
 
 // The integrands at x along omega, the pyramid read at level `lod`: crossing density and inclination
@@ -98,7 +103,6 @@ fn forward_integrand_of(e: Extinction, sig: vec3<f32>, omega: vec3<f32>) -> Path
     out.tau = c;
     for (var ch = 0u; ch < 3u; ch++) {
         let f = forward_lookup(theta, sig[ch]);
-        out.loss[ch] = c * (1.0 - f.x);
         out.mass[ch] = c * f.x;
         out.spread[ch] = c * f.y;
     }
@@ -109,7 +113,7 @@ fn forward_integrand_of(e: Extinction, sig: vec3<f32>, omega: vec3<f32>) -> Path
 fn path_scattering(s: PathIntegrals) -> ForwardScattering {
     var out: ForwardScattering;
     out.direct_fraction = exp(-s.tau);
-    out.transmittance_f = exp(-s.loss);
+    out.transmittance_f = exp(-path_loss(s));
     for (var ch = 0u; ch < 3u; ch++) {
         out.sigma_f2[ch] = forward_spread_weighted(s.mass[ch], s.spread[ch]);
     }

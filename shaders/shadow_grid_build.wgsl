@@ -43,7 +43,7 @@ struct BuildRange {
 @group(0) @binding(8) var<storage, read> build_range: BuildRange;
 
 // Per light of the dispatch (from the first one's): two slices (the previous and the current one) of path
-// integrals, three vec4 per point: (tau, loss), (mass, 0), (spread, 0).
+// integrals, two vec4 per point: (tau, mass), (spread, 0) (SCRATCH_BYTES in src/render/shadow_grid.rs).
 @group(0) @binding(9) var<storage, read_write> sweep_scratch: array<vec4<f32>>;
 
 const SWEEP_GROUP: u32 = 128u;
@@ -192,53 +192,53 @@ fn build_midplane_samples(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Without multiple scattering only tau is swept: one vec4 read and written per point.
 fn scratch_load(base: u32, i: u32, forward: bool) -> PathIntegrals {
-    let x0 = sweep_scratch[base + 3u * i];
+    let x0 = sweep_scratch[base + 2u * i];
     if (!forward) {
-        return PathIntegrals(x0.x, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+        return PathIntegrals(x0.x, vec3<f32>(0.0), vec3<f32>(0.0));
     }
-    let x1 = sweep_scratch[base + 3u * i + 1u];
-    let x2 = sweep_scratch[base + 3u * i + 2u];
-    return PathIntegrals(x0.x, x0.yzw, x1.xyz, x2.xyz);
+    return PathIntegrals(x0.x, x0.yzw, sweep_scratch[base + 2u * i + 1u].xyz);
 }
 
 fn scratch_store(base: u32, i: u32, f: PathIntegrals, forward: bool) {
-    sweep_scratch[base + 3u * i] = vec4<f32>(f.tau, f.loss);
+    sweep_scratch[base + 2u * i] = vec4<f32>(f.tau, f.mass);
     if (forward) {
-        sweep_scratch[base + 3u * i + 1u] = vec4<f32>(f.mass, 0.0);
-        sweep_scratch[base + 3u * i + 2u] = vec4<f32>(f.spread, 0.0);
+        sweep_scratch[base + 2u * i + 1u] = vec4<f32>(f.spread, 0.0);
     }
 }
 
-// bilinear_corners in sweep.rs: corner `corner` ((0, 0), (1, 0), (0, 1), (1, 1)) of the nb x nc lattice's
-// points around (u, v): its index v nb + u, its bilinear weight, and whether it lies in the lattice.
-struct BilinearCorner {
-    i: u32,
-    w: f32,
-    inside: bool,
+// SweepLattice in sweep.rs: where a sweep reads, alike for all its points (the shift is the sweep's).
+// Point (ib, ic) reads the previous slice at (ib, ic) + shift: columns ib + slice_offset.x and the next
+// with weights 1 - slice_frac.x and slice_frac.x, rows alike; and the plane's fine samples at
+// (R ib, R ic) + mid_offset and the next, with weights from mid_frac.
+struct SweepLattice {
+    slice_offset: vec2<i32>,
+    slice_frac: vec2<f32>,
+    mid_offset: vec2<i32>,
+    mid_frac: vec2<f32>,
 }
 
-fn bilinear_corner(u: f32, v: f32, nb: u32, nc: u32, corner: u32) -> BilinearCorner {
-    let u0 = floor(u);
-    let v0 = floor(v);
-    let ou = f32(corner & 1u);
-    let ov = f32(corner >> 1u);
-    let iu = u0 + ou;
-    let iv = v0 + ov;
-    if (iu < 0.0 || iv < 0.0 || iu >= f32(nb) || iv >= f32(nc)) {
-        return BilinearCorner(0u, 0.0, false);
-    }
-    let w = select(1.0 - (u - u0), u - u0, ou == 1.0) * select(1.0 - (v - v0), v - v0, ov == 1.0);
-    return BilinearCorner(u32(iv) * nb + u32(iu), w, true);
+fn sweep_lattice(ax: SweepAxes) -> SweepLattice {
+    let s = floor(ax.shift);
+    // The midpoint (ib + 1/2 + shift / 2) in fine points (point i at (i + 1/2) / R spacings).
+    let r = f32(MIDPLANE_REFINE);
+    let m = vec2<f32>(0.5 * (r - 1.0)) + 0.5 * r * ax.shift;
+    let mf = floor(m);
+    return SweepLattice(vec2<i32>(s), ax.shift - s, vec2<i32>(mf), m - mf);
 }
 
-// slice_bilinear in sweep.rs: the previous slice at (u, v), zero outside it.
-fn slice_bilinear(base: u32, nb: u32, nc: u32, u: f32, v: f32, forward: bool) -> PathIntegrals {
+// slice_row in sweep.rs: row iv of the previous slice read between columns u0 and u0 + 1 (weights
+// 1 - f and f), zero off the slice.
+fn slice_row(base: u32, nb: u32, nc: u32, u0: i32, f: f32, iv: i32, forward: bool) -> PathIntegrals {
     var out = path_zero();
-    for (var corner = 0u; corner < 4u; corner++) {
-        let c = bilinear_corner(u, v, nb, nc, corner);
-        if (c.inside) {
-            out = path_add_scaled(out, scratch_load(base, c.i, forward), c.w);
-        }
+    if (iv < 0 || iv >= i32(nc)) {
+        return out;
+    }
+    let row = u32(iv) * nb;
+    if (u0 >= 0 && u0 < i32(nb)) {
+        out = path_add_scaled(out, scratch_load(base, row + u32(u0), forward), 1.0 - f);
+    }
+    if (u0 + 1 >= 0 && u0 + 1 < i32(nb)) {
+        out = path_add_scaled(out, scratch_load(base, row + u32(u0 + 1), forward), f);
     }
     return out;
 }
@@ -266,8 +266,9 @@ fn accumulate(e: u32, d: SweepDirection, f: PathIntegrals, forward: bool, first:
         v1.w = f.tau;
     } else {
         v0.x = v0.x + d.weight * direct;
+        let tf3 = exp(-path_loss(f));
         for (var ch = 0u; ch < 3u; ch++) {
-            let tf = exp(-f.loss[ch]);
+            let tf = tf3[ch];
             let s = d.weight * max(tf - direct, 0.0);
             v0[1u + ch] = v0[1u + ch] + d.weight * tf;
             v1[ch] = v1[ch] + s * forward_spread_weighted(f.mass[ch], f.spread[ch]);
@@ -348,19 +349,20 @@ fn midplane(g: ShadowGridInfo, ax: SweepAxes, k: u32) -> Midplane {
     return Midplane(midplane_offset(g, ax.a) + j * nc * nb, nb, nc);
 }
 
-fn midplane_sample(plane: Midplane, shift: vec2<f32>, ib: u32, ic: u32) -> MidpointSample {
-    // In fine points: grid point ib is at (ib + 1/2) R - 1/2.
-    let r = f32(MIDPLANE_REFINE);
-    let u = (f32(ib) + 0.5 + 0.5 * shift.x) * r - 0.5;
-    let v = (f32(ic) + 0.5 + 0.5 * shift.y) * r - 0.5;
+fn midplane_sample(plane: Midplane, lat: SweepLattice, ib: u32, ic: u32) -> MidpointSample {
+    let u0 = i32(MIDPLANE_REFINE * ib) + lat.mid_offset.x;
+    let v0 = i32(MIDPLANE_REFINE * ic) + lat.mid_offset.y;
     var out = MidpointSample(Extinction(0.0, vec3<f32>(0.0), vec3<f32>(0.0)), 0.0, vec3<f32>(0.0), false);
     var absorbing = 0.0;
     for (var corner = 0u; corner < 4u; corner++) {
-        let c = bilinear_corner(u, v, plane.nb, plane.nc, corner);
-        if (!c.inside) {
+        let high_u = (corner & 1u) == 1u;
+        let high_v = corner >= 2u;
+        let iu = u0 + select(0, 1, high_u);
+        let iv = v0 + select(0, 1, high_v);
+        if (iu < 0 || iv < 0 || iu >= i32(plane.nb) || iv >= i32(plane.nc)) {
             continue;
         }
-        let i = plane.base + c.i;
+        let i = plane.base + u32(iv) * plane.nb + u32(iu);
         let s0 = grid_samples[3u * i];
         let a = bitcast<f32>(s0.x);
         if (a < 0.0) {
@@ -372,7 +374,7 @@ fn midplane_sample(plane: Midplane, shift: vec2<f32>, ib: u32, ic: u32) -> Midpo
         let n_zz_solid = unpack2x16unorm(s1.x);
         let n_xy_xz = unpack2x16snorm(s1.y);
         let sigma_rg = unpack2x16float(s2.x);
-        let w = c.w;
+        let w = select(1.0 - lat.mid_frac.x, lat.mid_frac.x, high_u) * select(1.0 - lat.mid_frac.y, lat.mid_frac.y, high_v);
         let wa = w * a;
         out.inside = true;
         out.e.a = out.e.a + wa;
@@ -450,7 +452,7 @@ fn build_shadow_grid(
     let n = g.dims.x * g.dims.y * g.dims.z;
     let forward = g.forward != 0u;
     let area = max(max(g.dims.x * g.dims.y, g.dims.x * g.dims.z), g.dims.y * g.dims.z);
-    let scratch = 6u * area * scratch_slot;
+    let scratch = 4u * area * scratch_slot;
     for (var slot = slot0; slot < slot1; slot++) {
         let d = slot_direction(l, slot, forward);
         if (d.weight == 0.0) {
@@ -468,25 +470,36 @@ fn build_shadow_grid(
         let sc = strides[ax.c];
         // Whether the path carries the forward-scattering terms (the depth behind reads tau alone).
         let carried = forward && !d.behind;
+        let lat = sweep_lattice(ax);
         for (var i = 0u; i < na; i++) {
             let k = select(i, na - 1u - i, ax.towards_high);
-            let cur = scratch + 3u * area * (i & 1u);
-            let prev = scratch + 3u * area * ((i + 1u) & 1u);
+            let cur = scratch + 2u * area * (i & 1u);
+            let prev = scratch + 2u * area * ((i + 1u) & 1u);
             let plane = midplane(g, ax, k);
-            for (var q = lid; q < nb * nc; q += SWEEP_GROUP) {
-                // q = ic nb + ib by float division (integer division is scalar on lavapipe): q + 1/2
-                // lies 1/2 from a multiple of nb, far beyond WGSL's 2.5 ulp while nb nc < 10^6 (a
-                // slice has at most 256^2 points).
-                let ic = u32((f32(q) + 0.5) / f32(nb));
-                let ib = q - ic * nb;
-                var up = path_zero();
+            // An invocation walks column ib along c: point ic reads the previous slice's rows
+            // ic + slice_offset.y (lo) and the next (hi), each row read once for the column.
+            for (var ib = lid; ib < nb; ib += SWEEP_GROUP) {
+                let u0 = i32(ib) + lat.slice_offset.x;
+                let fu = lat.slice_frac.x;
+                let fv = lat.slice_frac.y;
+                var lo = path_zero();
+                var hi = path_zero();
                 if (i > 0u) {
-                    up = slice_bilinear(prev, nb, nc, f32(ib) + ax.shift.x, f32(ic) + ax.shift.y, carried);
+                    lo = slice_row(prev, nb, nc, u0, fu, lat.slice_offset.y, carried);
+                    hi = slice_row(prev, nb, nc, u0, fu, lat.slice_offset.y + 1, carried);
                 }
-                let p = k * sa + ib * sb + ic * sc;
-                let f = sweep_integrand(midplane_sample(plane, ax.shift, ib, ic), d.omega, carried, d.behind);
-                scratch_store(cur, q, path_add_scaled(up, f, ax.step), carried);
-                accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
+                for (var ic = 0u; ic < nc; ic++) {
+                    var up = path_zero();
+                    if (i > 0u) {
+                        up = path_add_scaled(path_add_scaled(path_zero(), lo, 1.0 - fv), hi, fv);
+                        lo = hi;
+                        hi = slice_row(prev, nb, nc, u0, fu, i32(ic) + lat.slice_offset.y + 2, carried);
+                    }
+                    let p = k * sa + ib * sb + ic * sc;
+                    let f = sweep_integrand(midplane_sample(plane, lat, ib, ic), d.omega, carried, d.behind);
+                    scratch_store(cur, ic * nb + ib, path_add_scaled(up, f, ax.step), carried);
+                    accumulate(light * n + p, d, path_add_scaled(up, f, max(ax.step - g.skip, 0.0)), forward, slot == 0u);
+                }
             }
             storageBarrier();
         }

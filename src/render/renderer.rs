@@ -574,7 +574,9 @@ impl Renderer {
         )?;
         check(
             "the shadow sweeps' working memory",
-            grid.largest_slice() as u64 * 96 * lights.len().max(1) as u64,
+            grid.largest_slice() as u64
+                * super::shadow_grid::SCRATCH_BYTES
+                * lights.len().max(1) as u64,
         )?;
         check(
             "the shadow sweeps' samples",

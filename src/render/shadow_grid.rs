@@ -44,6 +44,11 @@ pub struct GpuShadowGrid {
 /// Bytes of one of the sweeps' samples ([`crate::shadow::sample_packing`]).
 pub const SAMPLE_BYTES: u64 = 24;
 
+/// Bytes of the sweeps' working memory per point of a light's largest slice: two slices (the previous
+/// and the current one) of two vec4, (tau, mass) and (spread, 0) (`sweep_scratch` in
+/// `shaders/shadow_grid_build.wgsl`).
+pub const SCRATCH_BYTES: u64 = 2 * 2 * 16;
+
 impl GpuShadowGrid {
     pub fn new(
         device: &wgpu::Device,
@@ -77,7 +82,7 @@ impl GpuShadowGrid {
             }),
             scratch: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("shadow sweep scratch"),
-                size: grid.largest_slice() as u64 * 2 * 48 * light_count.max(1) as u64,
+                size: grid.largest_slice() as u64 * SCRATCH_BYTES * light_count.max(1) as u64,
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),

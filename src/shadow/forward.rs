@@ -127,12 +127,12 @@ pub struct ForwardScattering {
 }
 
 /// The integrals of a shadow path (per cm when read at a point, `forward_integrand`; cm-weighted
-/// sums along a path): tau = integral c ds and per channel integral c (1 - a_f) ds, integral c a_f ds
-/// and integral c a_f beta_f^2 ds. Cone marches and light-space sweeps add them up alike.
+/// sums along a path): tau = integral c ds and per channel integral c a_f ds and integral c a_f
+/// beta_f^2 ds. Cone marches and light-space sweeps add them up alike. The loss integral c (1 - a_f) ds
+/// of T_f is tau - mass ([`PathIntegrals::loss`]), not carried.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PathIntegrals {
     pub tau: f32,
-    pub loss: [f32; 3],
     pub mass: [f32; 3],
     pub spread: [f32; 3],
 }
@@ -142,17 +142,22 @@ impl PathIntegrals {
     pub fn add_scaled(&self, o: &PathIntegrals, h: f32) -> PathIntegrals {
         PathIntegrals {
             tau: self.tau + h * o.tau,
-            loss: std::array::from_fn(|c| self.loss[c] + h * o.loss[c]),
             mass: std::array::from_fn(|c| self.mass[c] + h * o.mass[c]),
             spread: std::array::from_fn(|c| self.spread[c] + h * o.spread[c]),
         }
+    }
+
+    /// Channel c's loss integral c (1 - a_f) ds = tau - mass, the optical depth of T_f (at least 0:
+    /// the forward share a_f is at most 1, the difference may round below).
+    pub fn loss(&self, c: usize) -> f32 {
+        (self.tau - self.mass[c]).max(0.0)
     }
 
     /// The direct fraction, T_f and sigma_f^2 of a path with these integrals.
     pub fn scattering(&self) -> ForwardScattering {
         ForwardScattering {
             direct_fraction: (-self.tau).exp(),
-            transmittance_f: self.loss.map(|l| (-l).exp()),
+            transmittance_f: std::array::from_fn(|c| (-self.loss(c)).exp()),
             sigma_f2: std::array::from_fn(|c| {
                 forward_spread_weighted(self.mass[c], self.spread[c])
             }),
@@ -207,7 +212,6 @@ pub fn forward_integrand_of(
     };
     for (ch, &sig) in sigma_a.iter().enumerate() {
         let (a_f, spread) = table.lookup_symmetric(theta, sig);
-        out.loss[ch] = c * (1.0 - a_f);
         out.mass[ch] = c * a_f;
         out.spread[ch] = c * spread;
     }

@@ -262,17 +262,25 @@ impl MidplaneSamples {
         ic: u32,
     ) -> Option<GridSample> {
         let j = if ax.towards_high { k + 1 } else { k };
-        // In fine points: grid point ib is at (ib + 1/2) R - 1/2.
-        let r = MIDPLANE_REFINE as f32;
-        let (u, v) = (
-            (ib as f32 + 0.5 + 0.5 * ax.shift[0]) * r - 0.5,
-            (ic as f32 + 0.5 + 0.5 * ax.shift[1]) * r - 0.5,
+        let lattice = SweepLattice::new(ax);
+        let r = MIDPLANE_REFINE as i32;
+        let (u0, v0) = (
+            r * ib as i32 + lattice.mid_offset[0],
+            r * ic as i32 + lattice.mid_offset[1],
         );
         let (nb, nc) = Self::fine_dims(grid, ax.a);
         let plane = self.offsets[ax.a] + j as usize * nc * nb;
         let mut out = GridSample::default();
         let (mut inside, mut absorbing) = (false, 0.0);
-        for (i, w) in bilinear_corners(u, v, nb as u32, nc as u32) {
+        let [fu, fv] = lattice.mid_frac;
+        for corner in 0..4 {
+            let (high_u, high_v) = (corner & 1 == 1, corner >= 2);
+            let (iu, iv) = (u0 + high_u as i32, v0 + high_v as i32);
+            if iu < 0 || iv < 0 || iu >= nb as i32 || iv >= nc as i32 {
+                continue;
+            }
+            let i = iv as usize * nb + iu as usize;
+            let w = if high_u { fu } else { 1.0 - fu } * if high_v { fv } else { 1.0 - fv };
             let Some(s) = &self.samples[plane + i] else {
                 continue;
             };
@@ -301,29 +309,70 @@ fn other_axes(a: usize) -> (usize, usize) {
     }
 }
 
-/// The slice's integrals at the continuous position (u, v) (in points along b, c), bilinear; points
-/// outside the slice are outside the grid, where no hair is: zero.
-fn slice_bilinear(slice: &[PathIntegrals], nb: u32, nc: u32, u: f32, v: f32) -> PathIntegrals {
-    bilinear_corners(u, v, nb, nc).fold(PathIntegrals::default(), |out, (i, w)| {
-        out.add_scaled(&slice[i], w)
-    })
+/// Where a sweep reads, alike for all its points (the shift is the sweep's; twin of `SweepLattice` in
+/// `shaders/shadow_grid_build.wgsl`): point (ib, ic) reads the previous slice at (ib, ic) + shift,
+/// between columns ib + slice_offset\[0\] and the next (weights 1 - slice_frac\[0\] and
+/// slice_frac\[0\]), rows alike; and the plane's fine samples at (R ib, R ic) + mid_offset and the
+/// next, weights from mid_frac (its midpoint, (ib + 1/2 + shift / 2) spacings, in fine points).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweepLattice {
+    pub slice_offset: [i32; 2],
+    pub slice_frac: [f32; 2],
+    pub mid_offset: [i32; 2],
+    pub mid_frac: [f32; 2],
 }
 
-/// The lattice points around the continuous position (u, v) of an nb x nc lattice (index
-/// v nb + u), with their bilinear weights, in the order (0, 0), (1, 0), (0, 1), (1, 1); points
-/// outside the lattice left out (twin of `bilinear_corner` in `shaders/shadow_grid_build.wgsl`).
-fn bilinear_corners(u: f32, v: f32, nb: u32, nc: u32) -> impl Iterator<Item = (usize, f32)> {
-    let (u0, v0) = (u.floor(), v.floor());
-    let (fu, fv) = (u - u0, v - v0);
-    (0..4).filter_map(move |corner| {
-        let (ou, ov) = ((corner & 1) as f32, (corner >> 1) as f32);
-        let (iu, iv) = (u0 + ou, v0 + ov);
-        if iu < 0.0 || iv < 0.0 || iu >= nb as f32 || iv >= nc as f32 {
-            return None;
+impl SweepLattice {
+    pub fn new(ax: &SweepAxes) -> Self {
+        let r = MIDPLANE_REFINE as f32;
+        let s = ax.shift.map(f32::floor);
+        let m = ax.shift.map(|x| 0.5 * (r - 1.0) + 0.5 * r * x);
+        let mf = m.map(f32::floor);
+        Self {
+            slice_offset: s.map(|x| x as i32),
+            slice_frac: [ax.shift[0] - s[0], ax.shift[1] - s[1]],
+            mid_offset: mf.map(|x| x as i32),
+            mid_frac: [m[0] - mf[0], m[1] - mf[1]],
         }
-        let w = if ou == 1.0 { fu } else { 1.0 - fu } * if ov == 1.0 { fv } else { 1.0 - fv };
-        Some((iv as usize * nb as usize + iu as usize, w))
-    })
+    }
+
+    /// The previous slice read at (ib, ic) + shift: rows ic + slice_offset\[1\] and the next, each
+    /// [`slice_row`] (the GPU walks a column along c and reads each row once).
+    fn slice_bilinear(
+        &self,
+        slice: &[PathIntegrals],
+        nb: u32,
+        nc: u32,
+        ib: u32,
+        ic: u32,
+    ) -> PathIntegrals {
+        let u0 = ib as i32 + self.slice_offset[0];
+        let v0 = ic as i32 + self.slice_offset[1];
+        let fu = self.slice_frac[0];
+        let lo = slice_row(slice, nb, nc, u0, fu, v0);
+        let hi = slice_row(slice, nb, nc, u0, fu, v0 + 1);
+        let fv = self.slice_frac[1];
+        PathIntegrals::default()
+            .add_scaled(&lo, 1.0 - fv)
+            .add_scaled(&hi, fv)
+    }
+}
+
+/// Row iv of the slice read between columns u0 and u0 + 1 (weights 1 - f and f); points outside the
+/// slice are outside the grid, where no hair is: zero (`slice_row` in the WGSL).
+fn slice_row(slice: &[PathIntegrals], nb: u32, nc: u32, u0: i32, f: f32, iv: i32) -> PathIntegrals {
+    let mut out = PathIntegrals::default();
+    if iv < 0 || iv >= nc as i32 {
+        return out;
+    }
+    let row = iv as usize * nb as usize;
+    if u0 >= 0 && u0 < nb as i32 {
+        out = out.add_scaled(&slice[row + u0 as usize], 1.0 - f);
+    }
+    if u0 + 1 >= 0 && u0 + 1 < nb as i32 {
+        out = out.add_scaled(&slice[row + (u0 + 1) as usize], f);
+    }
+    out
 }
 
 /// The integrands at a sample along omega (a sweep's, `sweep_integrand` in the WGSL): with the
@@ -361,6 +410,7 @@ pub fn sweep(
     mut visit: impl FnMut(usize, &PathIntegrals),
 ) {
     let ax = SweepAxes::new(grid, omega);
+    let lattice = SweepLattice::new(&ax);
     let (nb, nc) = (grid.dims[ax.b], grid.dims[ax.c]);
     let mut prev: Vec<PathIntegrals> = Vec::new();
     for i in 0..grid.dims[ax.a] {
@@ -372,13 +422,7 @@ pub fn sweep(
                 let up = if prev.is_empty() {
                     PathIntegrals::default()
                 } else {
-                    slice_bilinear(
-                        &prev,
-                        nb,
-                        nc,
-                        ib as f32 + ax.shift[0],
-                        ic as f32 + ax.shift[1],
-                    )
+                    lattice.slice_bilinear(&prev, nb, nc, ib, ic)
                 };
                 let f = sweep_integrand(
                     samples.midpoint(grid, &ax, k, ib, ic).as_ref(),
@@ -414,7 +458,7 @@ fn accumulate(acc: &mut Accumulator, d: &SweepDirection, f: &PathIntegrals, forw
     acc[0] += d.weight * direct;
     if forward {
         for c in 0..3 {
-            let tf = (-f.loss[c]).exp();
+            let tf = (-f.loss(c)).exp();
             let s = d.weight * (tf - direct).max(0.0);
             acc[1 + c] += d.weight * tf;
             acc[4 + c] += s * forward_spread_weighted(f.mass[c], f.spread[c]);
