@@ -1,6 +1,7 @@
 // The fiber-density volume on the GPU. Twin of FiberDensity::build (src/shadow/fiber_density.rs):
 // `deposit` runs one invocation per segment and adds its sub-sampled length, orientation tensor,
-// absorption and diameter into the voxels in fixed point (portable u32 atomics); `resolve` runs one
+// absorption and diameter into the voxels in fixed point (portable u32 atomics; one add per run of
+// sub-samples in a voxel); `resolve` runs one
 // invocation per voxel and turns the sums into the extinction a = rho_L D, the tensor M = rho_L D <u u^T>,
 // the mean absorption and rho_L.
 
@@ -74,27 +75,42 @@ fn deposit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     let d = 0.5 * (points[i].w + points[i + 1u].w);
     let steps = max(u32(ceil(l / (0.25 * info.voxel))), 1u);
     let dl = l / f32(steps);
-    // The tensor's off-diagonal terms can be negative: store u u^T + 1 (all >= 0) and remove the
-    // offset in `resolve` (the sum of dl is the length channel).
+    // Consecutive sub-samples in the same voxel are added as one run (a segment's direction,
+    // absorption and diameter are its own): about a quarter of the atomics of one add per sub-sample.
+    var run_voxel = -1;
+    var run_steps = 0u;
     for (var k = 0u; k < steps; k++) {
         let x = a + (b - a) * ((f32(k) + 0.5) / f32(steps));
         let v = voxel_index(x);
-        if (v < 0) {
-            continue;
+        if (v != run_voxel) {
+            if (run_voxel >= 0) {
+                deposit_run(u32(run_voxel), f32(run_steps) * dl, u, sig, d);
+            }
+            run_voxel = v;
+            run_steps = 0u;
         }
-        let vi = u32(v);
-        add_fixed(vi, 0u, dl);
-        add_fixed(vi, 1u, dl * u.x * u.x);
-        add_fixed(vi, 2u, dl * u.y * u.y);
-        add_fixed(vi, 3u, dl * u.z * u.z);
-        add_fixed(vi, 4u, dl * (u.x * u.y + 1.0));
-        add_fixed(vi, 5u, dl * (u.x * u.z + 1.0));
-        add_fixed(vi, 6u, dl * (u.y * u.z + 1.0));
-        add_fixed(vi, 7u, dl * sig.x);
-        add_fixed(vi, 8u, dl * sig.y);
-        add_fixed(vi, 9u, dl * sig.z);
-        add_fixed(vi, 10u, dl * d);
+        run_steps = run_steps + 1u;
     }
+    if (run_voxel >= 0) {
+        deposit_run(u32(run_voxel), f32(run_steps) * dl, u, sig, d);
+    }
+}
+
+// A run of length `len` of a segment (unit direction u, absorption sig, diameter d) added to voxel vi.
+// The tensor's off-diagonal terms can be negative: store u u^T + 1 (all >= 0) and remove the offset
+// in `resolve` (the sum of the lengths is the length channel).
+fn deposit_run(vi: u32, len: f32, u: vec3<f32>, sig: vec3<f32>, d: f32) {
+    add_fixed(vi, 0u, len);
+    add_fixed(vi, 1u, len * u.x * u.x);
+    add_fixed(vi, 2u, len * u.y * u.y);
+    add_fixed(vi, 3u, len * u.z * u.z);
+    add_fixed(vi, 4u, len * (u.x * u.y + 1.0));
+    add_fixed(vi, 5u, len * (u.x * u.z + 1.0));
+    add_fixed(vi, 6u, len * (u.y * u.z + 1.0));
+    add_fixed(vi, 7u, len * sig.x);
+    add_fixed(vi, 8u, len * sig.y);
+    add_fixed(vi, 9u, len * sig.z);
+    add_fixed(vi, 10u, len * d);
 }
 
 // The sums' index of neighbour n (0..27, x fastest) of voxel i, or -1 outside the volume.
