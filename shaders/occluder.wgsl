@@ -122,6 +122,22 @@ fn shade_occluder(s: Surface) -> vec3<f32> {
     return info.albedo / PI * sum;
 }
 
+// The occluder's triangle (+ 1; 0: none) at each of the pixel's samples, each sample read once (a
+// multisampled load is dear on lavapipe); 0 past the texture's samples (2 or 4).
+fn occluder_samples(xy: vec2<i32>) -> vec4<u32> {
+    var ids = vec4<u32>(visible_occluder(textureLoad(visibility, xy, 0).x), visible_occluder(textureLoad(visibility, xy, 1).x), 0u, 0u);
+    if (textureNumSamples(visibility) > 2u) {
+        ids.z = visible_occluder(textureLoad(visibility, xy, 2).x);
+        ids.w = visible_occluder(textureLoad(visibility, xy, 3).x);
+    }
+    return ids;
+}
+
+// Component s of v (no dynamic vector indexing: lavapipe spills it to memory).
+fn sample_id(v: vec4<u32>, s: u32) -> u32 {
+    return select(select(select(v.x, v.y, s == 1u), v.z, s == 2u), v.w, s == 3u);
+}
+
 @compute @workgroup_size(8, 8)
 fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let y = batch.row0 + id.y;
@@ -129,28 +145,26 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let xy = vec2<i32>(vec2<u32>(id.x, y));
+    let ids = occluder_samples(xy);
+    if (all(ids == vec4<u32>(0u))) {
+        return;
+    }
     let pixel = y * camera.size.x + id.x;
     let ray = pixel_ray(camera, f32(id.x) + 0.5, f32(y) + 0.5);
     var sum = vec3<f32>(0.0);
     let samples = textureNumSamples(visibility);
     for (var s = 0u; s < samples; s++) {
-        let tri = visible_occluder(textureLoad(visibility, xy, i32(s)).x);
+        let tri = sample_id(ids, s);
         if (tri == 0u) {
             continue;
         }
-        // Each distinct triangle once, with its share of the samples.
-        var seen = false;
-        var count = 0u;
-        for (var o = 0u; o < samples; o++) {
-            let other = visible_occluder(textureLoad(visibility, xy, i32(o)).x);
-            if (other == tri) {
-                seen = seen || o < s;
-                count = count + 1u;
-            }
-        }
-        if (seen) {
+        // Each distinct triangle once (at its first sample), with its share of the samples.
+        let same = ids == vec4<u32>(tri);
+        if (any(same & (vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(s)))) {
             continue;
         }
+        let c = select(vec4<u32>(0u), vec4<u32>(1u), same);
+        let count = c.x + c.y + c.z + c.w;
         sum = sum + f32(count) / f32(samples) * shade_occluder(occluder_surface(tri - 1u, ray));
     }
     // Seen through the hair in front of it.
