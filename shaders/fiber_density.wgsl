@@ -126,7 +126,8 @@ fn neighbour_voxel(i: vec3<i32>, n: u32) -> i32 {
 // The absorption of an empty voxel: the length-weighted mean over its 26 neighbours (0 if they are
 // empty too), so the forward march sees the absorption of the fibers its trilinear density counts.
 // The lengths first: most empty voxels have no hair around them, and their absorption sums are not
-// read (an empty neighbour's are zero: the result is the same).
+// read (a neighbour of no length holds no absorption, unless its runs were all under the fixed
+// point's 2^-20 cm, whose absorption is left out).
 fn neighbour_absorption(v: u32) -> vec3<f32> {
     let d = info.dims;
     let i = vec3<i32>(vec3<u32>(v % d.x, (v / d.x) % d.y, v / (d.x * d.y)));

@@ -47,6 +47,8 @@ struct BuildRange {
 @group(0) @binding(9) var<storage, read_write> sweep_scratch: array<vec4<f32>>;
 
 const SWEEP_GROUP: u32 = 128u;
+// The fewest points of a run a sweep's invocation walks along c (build_shadow_grid).
+const RUN_MIN: u32 = 8u;
 
 struct SweepDirection {
     omega: vec3<f32>,
@@ -219,7 +221,8 @@ struct SweepLattice {
 
 fn sweep_lattice(ax: SweepAxes) -> SweepLattice {
     let s = floor(ax.shift);
-    // The midpoint (ib + 1/2 + shift / 2) in fine points (point i at (i + 1/2) / R spacings).
+    // The midpoint (ib + 1/2 + shift / 2) spacings is (ib + 1/2 + shift / 2) R - 1/2 in fine points
+    // (point i at (i + 1/2) / R spacings): R ib + m.
     let r = f32(MIDPLANE_REFINE);
     let m = vec2<f32>(0.5 * (r - 1.0)) + 0.5 * r * ax.shift;
     let mf = floor(m);
@@ -476,24 +479,33 @@ fn build_shadow_grid(
             let cur = scratch + 2u * area * (i & 1u);
             let prev = scratch + 2u * area * ((i + 1u) & 1u);
             let plane = midplane(g, ax, k);
-            // An invocation walks column ib along c: point ic reads the previous slice's rows
-            // ic + slice_offset.y (lo) and the next (hi), each row read once for the column.
-            for (var ib = lid; ib < nb; ib += SWEEP_GROUP) {
+            // An invocation walks a run of column ib along c: point ic reads the previous slice's rows
+            // ic + slice_offset.y (lo) and the next (hi), each row read once for the run. The columns
+            // are cut into runs (of at least RUN_MIN points) until the workgroup's invocations have
+            // one each, so that a GPU keeps its lanes busy; the run's first point reads two rows.
+            let runs = max(min(SWEEP_GROUP / nb, nc / RUN_MIN), 1u);
+            let run = (nc + runs - 1u) / runs;
+            for (var t = lid; t < nb * runs; t += SWEEP_GROUP) {
+                let ib = t % nb;
+                let ic0 = (t / nb) * run;
+                let ic1 = min(ic0 + run, nc);
                 let u0 = i32(ib) + lat.slice_offset.x;
                 let fu = lat.slice_frac.x;
                 let fv = lat.slice_frac.y;
                 var lo = path_zero();
                 var hi = path_zero();
                 if (i > 0u) {
-                    lo = slice_row(prev, nb, nc, u0, fu, lat.slice_offset.y, carried);
-                    hi = slice_row(prev, nb, nc, u0, fu, lat.slice_offset.y + 1, carried);
+                    lo = slice_row(prev, nb, nc, u0, fu, i32(ic0) + lat.slice_offset.y, carried);
+                    hi = slice_row(prev, nb, nc, u0, fu, i32(ic0) + lat.slice_offset.y + 1, carried);
                 }
-                for (var ic = 0u; ic < nc; ic++) {
+                for (var ic = ic0; ic < ic1; ic++) {
                     var up = path_zero();
                     if (i > 0u) {
                         up = path_add_scaled(path_add_scaled(path_zero(), lo, 1.0 - fv), hi, fv);
-                        lo = hi;
-                        hi = slice_row(prev, nb, nc, u0, fu, i32(ic) + lat.slice_offset.y + 2, carried);
+                        if (ic + 1u < ic1) {
+                            lo = hi;
+                            hi = slice_row(prev, nb, nc, u0, fu, i32(ic) + lat.slice_offset.y + 2, carried);
+                        }
                     }
                     let p = k * sa + ib * sb + ic * sc;
                     let f = sweep_integrand(midplane_sample(plane, lat, ib, ic), d.omega, carried, d.behind);

@@ -29,7 +29,8 @@ pub struct BenchArgs {
     /// Untimed frames first.
     #[arg(long, default_value_t = 3)]
     pub warmup: usize,
-    /// Rebuilds of the shadow grid alone, timed by wall clock (`shadow_grid_wall_ms`: their median).
+    /// Rebuilds of the shadow grid alone, timed by wall clock (at least 1; `shadow_grid_wall_ms`: their
+    /// median, the upper middle one of an even count).
     #[arg(long, default_value_t = 3)]
     pub grid_runs: usize,
     /// No self-shadowing.
@@ -105,6 +106,7 @@ struct SceneReport {
     /// its work, so `gpu_ms_median.shadow_grid` reads ~0 there after the first frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     shadow_grid_wall_ms: Option<f64>,
+    /// The fastest of those rebuilds.
     #[serde(skip_serializing_if = "Option::is_none")]
     shadow_grid_wall_ms_min: Option<f64>,
     /// The same frame by progressive refinement (volume and grid rebuilt unless --keep-volume).

@@ -32,7 +32,8 @@ pub struct GpuShadowGrid {
     pub grid: ShadowGrid,
     pub info: wgpu::Buffer,
     pub values: wgpu::Buffer,
-    /// Two slices of path integrals per light (three vec4 per point), the sweeps' working memory.
+    /// Two slices of path integrals per light (two vec4 per point, [`SCRATCH_BYTES`]), the sweeps'
+    /// working memory.
     pub scratch: wgpu::Buffer,
     /// What the sweeps read on the planes between the grid's slices (six words a point:
     /// [`crate::shadow::sweep::MidplaneSamples`]), built after each new pyramid.
