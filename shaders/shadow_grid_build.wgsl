@@ -481,8 +481,9 @@ fn build_shadow_grid(
             let plane = midplane(g, ax, k);
             // An invocation walks a run of column ib along c: point ic reads the previous slice's rows
             // ic + slice_offset.y (lo) and the next (hi), each row read once for the run. The columns
-            // are cut into runs (of at least RUN_MIN points) until the workgroup's invocations have
-            // one each, so that a GPU keeps its lanes busy; the run's first point reads two rows.
+            // are cut into as many runs as the workgroup has invocations for, as long as a run keeps
+            // RUN_MIN points (a column's last run may be shorter), so that a GPU keeps more of its lanes
+            // busy; the run's first point reads two rows.
             let runs = max(min(SWEEP_GROUP / nb, nc / RUN_MIN), 1u);
             let run = (nc + runs - 1u) / runs;
             for (var t = lid; t < nb * runs; t += SWEEP_GROUP) {

@@ -337,7 +337,7 @@ impl SweepLattice {
     }
 
     /// The previous slice read at (ib, ic) + shift: rows ic + slice_offset\[1\] and the next, each
-    /// [`slice_row`] (the GPU walks a column along c and reads each row once).
+    /// [`slice_row`] (the GPU walks runs of a column along c and reads each row once per run).
     fn slice_bilinear(
         &self,
         slice: &[PathIntegrals],
