@@ -474,25 +474,25 @@ fn build_shadow_grid(
         // Whether the path carries the forward-scattering terms (the depth behind reads tau alone).
         let carried = forward && !d.behind;
         let lat = sweep_lattice(ax);
+        // An invocation walks a run of column ib along c: point ic reads the previous slice's rows
+        // ic + slice_offset.y (lo) and the next (hi), each row read once for the run. The columns
+        // are cut into as many runs as the workgroup has invocations for, as long as a run keeps
+        // RUN_MIN points (a column's last run may be shorter), so that a GPU keeps more of its lanes
+        // busy; the run's first point reads two rows.
+        let runs = max(min(SWEEP_GROUP / nb, nc / RUN_MIN), 1u);
+        let run = (nc + runs - 1u) / runs;
+        let fu = lat.slice_frac.x;
+        let fv = lat.slice_frac.y;
         for (var i = 0u; i < na; i++) {
             let k = select(i, na - 1u - i, ax.towards_high);
             let cur = scratch + 2u * area * (i & 1u);
             let prev = scratch + 2u * area * ((i + 1u) & 1u);
             let plane = midplane(g, ax, k);
-            // An invocation walks a run of column ib along c: point ic reads the previous slice's rows
-            // ic + slice_offset.y (lo) and the next (hi), each row read once for the run. The columns
-            // are cut into as many runs as the workgroup has invocations for, as long as a run keeps
-            // RUN_MIN points (a column's last run may be shorter), so that a GPU keeps more of its lanes
-            // busy; the run's first point reads two rows.
-            let runs = max(min(SWEEP_GROUP / nb, nc / RUN_MIN), 1u);
-            let run = (nc + runs - 1u) / runs;
             for (var t = lid; t < nb * runs; t += SWEEP_GROUP) {
                 let ib = t % nb;
                 let ic0 = (t / nb) * run;
                 let ic1 = min(ic0 + run, nc);
                 let u0 = i32(ib) + lat.slice_offset.x;
-                let fu = lat.slice_frac.x;
-                let fv = lat.slice_frac.y;
                 var lo = path_zero();
                 var hi = path_zero();
                 if (i > 0u) {

@@ -330,7 +330,7 @@ fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {
     use strandlight::shadow::cone::crossings;
     use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::grid::ShadowGrid;
-    use strandlight::shadow::sweep::{MidplaneSamples, SweepAxes, sweep_lod};
+    use strandlight::shadow::sweep::{MidplaneSamples, SweepAxes, SweepLattice, sweep_lod};
     let v = clump_volume();
     let pyramid = DensityPyramid::build(&v);
     let grid = ShadowGrid::around(
@@ -348,6 +348,7 @@ fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {
     for _ in 0..24 {
         let omega = sample_srbf(&mut r, Vec3::X, 10.0);
         let ax = SweepAxes::new(&grid, omega);
+        let lattice = SweepLattice::new(&ax);
         for i in (0..grid.point_count()).step_by(7) {
             let p = grid.point(i);
             let idx = ((p - grid.origin) / grid.spacing - 0.5).round();
@@ -358,7 +359,7 @@ fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {
             }
             let exact = pyramid.crossings_at(mid, omega, lod);
             let read = samples
-                .midpoint(&grid, &ax, k, ib, ic)
+                .midpoint(&grid, &ax, &lattice, k, ib, ic)
                 .map_or(0.0, |s| crossings(s.a, s.m, omega));
             if exact <= 0.0 && read <= 0.0 {
                 continue;

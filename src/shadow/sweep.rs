@@ -252,17 +252,18 @@ impl MidplaneSamples {
     /// The samples at the midpoint of the path from slice `k`'s point (ib, ic) to the previous
     /// slice of sweep `ax` (`midplane_sample` in the WGSL): on the plane between the two slices at
     /// (ib, ic) + shift / 2, bilinear in that plane (the absorption weighted by the extinction, as the
-    /// fibers crossed weigh it); None when no sample around it is inside the volume.
+    /// fibers crossed weigh it); None when no sample around it is inside the volume. `lattice` is the
+    /// sweep's ([`SweepLattice::new`] of `ax`, found once per sweep).
     pub fn midpoint(
         &self,
         grid: &ShadowGrid,
         ax: &SweepAxes,
+        lattice: &SweepLattice,
         k: u32,
         ib: u32,
         ic: u32,
     ) -> Option<GridSample> {
         let j = if ax.towards_high { k + 1 } else { k };
-        let lattice = SweepLattice::new(ax);
         let r = MIDPLANE_REFINE as i32;
         let (u0, v0) = (
             r * ib as i32 + lattice.mid_offset[0],
@@ -425,7 +426,7 @@ pub fn sweep(
                     lattice.slice_bilinear(&prev, nb, nc, ib, ic)
                 };
                 let f = sweep_integrand(
-                    samples.midpoint(grid, &ax, k, ib, ic).as_ref(),
+                    samples.midpoint(grid, &ax, &lattice, k, ib, ic).as_ref(),
                     table,
                     omega,
                     behind,
