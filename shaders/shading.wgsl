@@ -43,6 +43,10 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(26) var<storage, read_write> segment_trt: array<vec4<f32>>;
 @group(0) @binding(27) var<storage, read_write> segment_ms_global: array<vec4<f32>>;
 @group(0) @binding(28) var<storage, read_write> segment_ms_local: array<vec4<f32>>;
+// Multiple scattering's samples (see `ms_key`): per key 1 + the first light of the last batch that
+// claimed it, and the keys listed by the claim (work_count[1] of them).
+@group(0) @binding(30) var<storage, read_write> ms_batches: array<atomic<u32>>;
+@group(0) @binding(31) var<storage, read_write> ms_list: array<u32>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -166,9 +170,9 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
 // direction do not: each visible segment is shaded once per light batch. Its single scattering
 // response to each light is evaluated once, at its midpoint, and weighted by the light's
 // transmittance at its ends and its midpoint (`shade_segment_single`); its multiple scattering, which
-// varies slowly (spread over sigma_f and read from the coarse shadow grid), once at its midpoint. Every
-// fragment takes the single scattering between the three samples at its own point (`between_samples`)
-// and the segment's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that
+// varies slowly (spread over sigma_f and read from the coarse shadow grid), once per pair of
+// consecutive segments at the point they share (`ms_key`). Every fragment takes the single scattering
+// between the three samples at its own point (`between_samples`) and its pair's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that
 // cover ~8 pixels each (S1): ~8x fewer responses than one per fragment.
 
 // The point of segment `seg` at t (0: its first point, 1: its second; absorption linear along it).
@@ -238,21 +242,60 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
                 trtb = trt;
             }
         }
-        if (!painted) {
+        // The midpoint's response: end a's unless the ends' absorption differs (no logarithms and
+        // exponentials for the unpainted hair's equal ends).
+        var rm = ra; var ttm = tta; var trtm = trta;
+        if (painted) {
+            rm = between_ends(ra, rb, 0.5);
+            ttm = between_ends(tta, ttb, 0.5);
+            trtm = between_ends(trta, trtb, 0.5);
+        } else {
             rb = ra;
             ttb = tta;
             trtb = trta;
         }
-        r0 = r0 + t.x * ra; r1 = r1 + t.y * between_ends(ra, rb, 0.5); r2 = r2 + t.z * rb;
-        tt0 = tt0 + t.x * tta; tt1 = tt1 + t.y * between_ends(tta, ttb, 0.5); tt2 = tt2 + t.z * ttb;
-        trt0 = trt0 + t.x * trta; trt1 = trt1 + t.y * between_ends(trta, trtb, 0.5); trt2 = trt2 + t.z * trtb;
+        r0 = r0 + t.x * ra; r1 = r1 + t.y * rm; r2 = r2 + t.z * rb;
+        tt0 = tt0 + t.x * tta; tt1 = tt1 + t.y * ttm; tt2 = tt2 + t.z * ttb;
+        trt0 = trt0 + t.x * trta; trt1 = trt1 + t.y * trtm; trt2 = trt2 + t.z * trtb;
     }
     return SegmentSingle(array(r0, r1, r2), array(tt0, tt1, tt2), array(trt0, trt1, trt2));
 }
 
+// Multiple scattering varies slowly along a strand (spread over sigma_f, read from the coarse shadow
+// grid): it is evaluated once per pair of consecutive segments of a strand, segments 2k and 2k + 1
+// when segment 2k + 1 continues segment 2k and the pair's three points have the same absorption
+// (unpainted hair, a uniform dye), at the point they share, and read by both (twin: shade.rs,
+// `ms_key`). A segment without such a partner (the last of a strand with an odd count, paint that
+// varies along the pair) keeps its own sample at its midpoint. The key of a pair is its even
+// segment.
+fn ms_paired(even: u32) -> bool {
+    if (even + 1u >= arrayLength(&segments) || segments[even + 1u] != segments[even] + 1u) {
+        return false;
+    }
+    let i0 = segments[even];
+    let s = absorption[i0 + 1u].xyz;
+    return all(absorption[i0].xyz == s) && all(absorption[i0 + 2u].xyz == s);
+}
+
+fn ms_key(seg: u32) -> u32 {
+    let even = seg & ~1u;
+    return select(seg, even, ms_paired(even));
+}
+
+// The point multiple scattering is evaluated at for key `key` (twin: shade.rs, `ms_point`): a pair's
+// shared point, its tangent the pair's chord, or an unpaired segment's midpoint.
+fn ms_point(key: u32) -> ShadingPoint {
+    if ((key & 1u) == 1u || !ms_paired(key)) {
+        return segment_point(key, 0.5);
+    }
+    let i0 = segments[key];
+    return ShadingPoint(points[i0 + 1u].xyz, points[i0 + 2u].xyz - points[i0].xyz, absorption[i0 + 1u].xyz);
+}
+
 // Lists the segments of the batch's rows' kept fragments that this light batch has not shaded: a
 // segment's `segment_batches` entry holds 1 + the first light of the last batch that claimed it (0:
-// none; light batches run in order, so one claim per segment and batch wins).
+// none; light batches run in order, so one claim per segment and batch wins). With multiple
+// scattering, likewise their multiple scattering's keys (`ms_key`) in `ms_list`.
 @compute @workgroup_size(8, 8)
 fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     let y = batch.row0 + id.y;
@@ -269,6 +312,12 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             let seg = f.x - 1u;
             if (atomicMax(&segment_batches[seg], batch.first + 1u) <= batch.first) {
                 work_list[atomicAdd(&work_count[0], 1u)] = seg;
+                if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
+                    let key = ms_key(seg);
+                    if (atomicMax(&ms_batches[key], batch.first + 1u) <= batch.first) {
+                        ms_list[atomicAdd(&work_count[1], 1u)] = key;
+                    }
+                }
             }
         }
     }
@@ -312,50 +361,63 @@ fn count_first_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// The workgroups of `shade_segments`' two kinds: (single scattering, multiple scattering), each kind's
+// invocations rounded up to workgroups of 64 on its own.
+fn segment_groups() -> vec2<u32> {
+    let single = select((atomicLoad(&work_count[0]) + 63u) / 64u, 0u, (batch.flags & FLAG_SINGLE_KEPT) != 0u);
+    let multiple = select(0u, (atomicLoad(&work_count[1]) + 63u) / 64u, (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u);
+    return vec2<u32>(single, multiple);
+}
+
 // The indirect dispatch of `shade_segments`: one invocation per listed segment (its single scattering)
-// (none with FLAG_SINGLE_KEPT) and with multiple scattering a second (its midpoint's), in workgroups of
-// 64 (each kind's rounded up on its own: the kinds' workgroups alternate), as rows of at most 65535
+// (none with FLAG_SINGLE_KEPT) and with multiple scattering one per listed key (its sample's), in
+// workgroups of 64 (the kinds' workgroups alternate while both last), as rows of at most 65535
 // workgroups.
 @compute @workgroup_size(1)
 fn segment_dispatch() {
-    let single = (batch.flags & FLAG_SINGLE_KEPT) == 0u;
-    let multiple = (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u;
-    let kinds = select(0u, 1u, single) + select(0u, 1u, multiple);
-    let groups = kinds * ((atomicLoad(&work_count[0]) + 63u) / 64u);
+    let g = segment_groups();
+    let groups = g.x + g.y;
     work_args[0] = min(groups, 65535u);
     work_args[1] = (groups + 65534u) / 65535u;
     work_args[2] = 1u;
 }
 
-// Invocation i < n (n segments listed; i after the workgroups' interleaving below): single scattering
-// of listed segment i; i >= n: multiple scattering at the midpoint of listed segment i - n. A workgroup
-// runs one kind, so a SIMD group runs one of them (single and multiple scattering in one light loop spill on lavapipe and cost ~3x as
-// much as apart). The first light batch (first == 0, every segment's first: the batches run in order)
-// stores the segment's radiance, the others add to it, so nothing needs clearing. With FLAG_SINGLE_KEPT
-// every invocation i < n is listed segment i's multiple scattering, and its single scattering stays.
+// Invocations of the single-scattering kind each shade listed segment j (`shade_segment_single`),
+// those of the multiple-scattering kind listed key j at its sample (`ms_point`). A workgroup runs one
+// kind, so a SIMD group runs one of them (single and multiple scattering in one light loop spill on
+// lavapipe and cost ~3x as much as apart). The first light batch (first == 0, every segment's first:
+// the batches run in order) stores the radiance, the others add to it, so nothing needs clearing.
+// With FLAG_SINGLE_KEPT every workgroup is of the multiple-scattering kind, and the segments' single
+// scattering stays.
 @compute @workgroup_size(64)
 fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     // Rows of the indirect dispatch are 65535 workgroups wide whenever there is more than one.
     let g = id.x + id.y * 65535u * 64u;
-    let n = atomicLoad(&work_count[0]);
     let shadows = (batch.flags & FLAG_SHADOWS) != 0u;
     let restart = batch.first == 0u;
-    // With the single scattering kept, every invocation is a segment's multiple scattering.
-    let n_single = select(n, 0u, (batch.flags & FLAG_SINGLE_KEPT) != 0u);
-    // Both kinds: the workgroups alternate between them (even: the single scattering of 64 listed
-    // segments, odd: the same segments' multiple scattering), so that every contiguous share of the
-    // dispatch holds both (lavapipe gives each of its threads one contiguous share of a dispatch's
-    // workgroups: with the kinds in halves, one thread had all of the single scattering and the other
-    // all of the multiple, and the slower kind set the time).
-    var i = g;
-    if (n_single > 0u && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-        let w = g / 64u;
-        let j = (w >> 1u) * 64u + g % 64u;
-        let kind = select(0u, n_single, (w & 1u) == 1u);
-        i = select(n_single + n, kind + j, j < n);
+    // The workgroups alternate between the kinds while both have some left (even: single, odd:
+    // multiple), the rest are the longer kind's, so that every contiguous share of the dispatch holds
+    // both (lavapipe gives each of its threads one contiguous share of a dispatch's workgroups: with
+    // the kinds in halves, one thread had all of the single scattering and the other all of the
+    // multiple, and the slower kind set the time).
+    let groups = segment_groups();
+    let w = g / 64u;
+    let both = min(groups.x, groups.y);
+    var multiple = groups.x == 0u;
+    var group = w;
+    if (w < 2u * both) {
+        multiple = (w & 1u) == 1u;
+        group = w >> 1u;
+    } else if (both > 0u) {
+        multiple = groups.y > groups.x;
+        group = w - both;
     }
-    if (i < n_single) {
-        let seg = work_list[i];
+    let j = group * 64u + g % 64u;
+    if (!multiple) {
+        if (j >= atomicLoad(&work_count[0])) {
+            return;
+        }
+        let seg = work_list[j];
         let mid = segment_point(seg, 0.5);
         let l = shade_segment_single(mid, segment_point(seg, 0.0), segment_point(seg, 1.0), normalize(camera.eye - mid.position), batch.first, batch.count, shadows);
         for (var s = 0u; s < SINGLE_SAMPLES; s++) {
@@ -364,12 +426,16 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             segment_tt[k] = select(segment_tt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.tt[s], 0.0);
             segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
         }
-    } else if (i < n_single + n && (batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-        let seg = work_list[i - n_single];
-        let sp = segment_point(seg, 0.5);
+    } else if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u && j < atomicLoad(&work_count[1])) {
+        let key = ms_list[j];
+        // A repaint lists every segment of its pairs: the pair's key alone shades it.
+        if (ms_key(key) != key) {
+            return;
+        }
+        let sp = ms_point(key);
         let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
-        segment_ms_global[seg] = select(segment_ms_global[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);
-        segment_ms_local[seg] = select(segment_ms_local[seg], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_local, 0.0);
+        segment_ms_global[key] = select(segment_ms_global[key], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);
+        segment_ms_local[key] = select(segment_ms_local[key], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_local, 0.0);
     }
 }
 
@@ -423,8 +489,9 @@ fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             out.tt = out.tt + w * between_samples(segment_tt[k].xyz, segment_tt[k + 1u].xyz, segment_tt[k + 2u].xyz, t);
             out.trt = out.trt + w * between_samples(segment_trt[k].xyz, segment_trt[k + 1u].xyz, segment_trt[k + 2u].xyz, t);
             if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-                out.ms_global = out.ms_global + w * segment_ms_global[seg].xyz;
-                out.ms_local = out.ms_local + w * segment_ms_local[seg].xyz;
+                let key = ms_key(seg);
+                out.ms_global = out.ms_global + w * segment_ms_global[key].xyz;
+                out.ms_local = out.ms_local + w * segment_ms_local[key].xyz;
             }
             weight = weight + w;
         }

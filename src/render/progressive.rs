@@ -28,6 +28,7 @@
 use super::preview::preview_target;
 use super::renderer::{RenderError, Renderer};
 use super::segment_shading::last_light_batch;
+use super::shade::strand_partner;
 use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use super::shadow_grid::SWEEP_SLOTS;
 use super::targets::FrameTargets;
@@ -865,6 +866,9 @@ impl Renderer {
             for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
                 if let Ok(k) = self.segment_first.binary_search(&p) {
                     segments.push(k as u32);
+                    // Its multiple-scattering partner (its pair's sample may move with the paint:
+                    // both are shaded again, and both gathered).
+                    segments.extend(strand_partner(&self.segment_first, k as u32));
                 }
             }
         }
@@ -1846,13 +1850,18 @@ impl Renderer {
                     return;
                 };
                 let end = (first + segments).min(self.repaint.len() as u32);
-                let part = &self.repaint[(first.min(end)) as usize..end as usize];
+                let start = first.min(end) as usize;
+                let part = &self.repaint[start..end as usize];
                 if let Some(s) = &self.segment_targets {
                     ctx.queue
                         .write_buffer(&s.work_list, 0, bytemuck::cast_slice(part));
-                    let count = part.len() as u32;
+                    // Multiple scattering: the same list (it holds whole pairs, [`strand_partner`]):
+                    // each pair's key alone shades it.
                     ctx.queue
-                        .write_buffer(&s.work_count, 0, bytemuck::bytes_of(&count));
+                        .write_buffer(&s.ms_list, 0, bytemuck::cast_slice(part));
+                    let count = [part.len() as u32; 2];
+                    ctx.queue
+                        .write_buffer(&s.work_count, 0, bytemuck::cast_slice(&count));
                 }
                 let inputs = self.shading_inputs();
                 self.shading_pass.encode_repaint(device, enc, &inputs, b);

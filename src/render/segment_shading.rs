@@ -2,7 +2,8 @@
 //! `shade_segments` and `gather_segments` of `shaders/shading.wgsl`): per light batch, the visible
 //! segments of the rows' kept K-buffer fragments are listed once, each is shaded (each light's
 //! single-scattering response once at its midpoint, weighted by the light's transmittance at its
-//! ends and midpoint; multiple scattering at its midpoint), and once every batch has shaded them the
+//! ends and midpoint; multiple scattering once per pair of consecutive segments of a strand, at the
+//! point they share: [`super::shade::ShadingHair::ms_key`]), and once every batch has shaded them the
 //! rows' pixels gather their fragments' radiance, single scattering interpolated along each segment.
 //! The per-fragment pass ([`super::shading`]) shades the frame and preview without
 //! `RenderSettings::segment_shading`, a view in which a segment subtends more than
@@ -24,9 +25,14 @@ pub const RADIANCE_BYTES_PER_SEGMENT: u64 = 16 * SINGLE_SAMPLES;
 pub struct SegmentTargets {
     /// Per segment: 1 + the first light of the last batch that shaded it (0: none).
     pub batches: wgpu::Buffer,
-    /// [0]: segments listed by the unit's claim.
+    /// [0]: segments listed by the unit's claim, [1]: multiple scattering's keys (`ms_key` of
+    /// `shaders/shading.wgsl`, [`super::shade::ms_key`]).
     pub work_count: wgpu::Buffer,
     pub work_list: wgpu::Buffer,
+    /// Per multiple-scattering key: 1 + the first light of the last batch that shaded it (0: none).
+    pub ms_batches: wgpu::Buffer,
+    /// The keys listed by the unit's claim (or a repaint's, written by the caller).
+    pub ms_list: wgpu::Buffer,
     /// `shade_segments`' indirect dispatch.
     pub work_args: wgpu::Buffer,
     /// R, TT, TRT at each segment's t = 0, 1/2, 1 (index 3 segment + 2 t), MS.global and MS.local
@@ -53,8 +59,10 @@ impl SegmentTargets {
         let none = wgpu::BufferUsages::empty();
         Some(Self {
             batches: buffer("segment batches", 4 * n, none),
-            work_count: buffer("segment work count", 4, none),
+            work_count: buffer("segment work count", 8, none),
             work_list: buffer("segment work list", 4 * n, none),
+            ms_batches: buffer("multiple scattering batches", 4 * n, none),
+            ms_list: buffer("multiple scattering work list", 4 * n, none),
             work_args: buffer("segment dispatch", 12, wgpu::BufferUsages::INDIRECT),
             radiance: std::array::from_fn(|c| {
                 let samples = if c < 3 { SINGLE_SAMPLES } else { 1 };
@@ -71,6 +79,7 @@ impl SegmentTargets {
     /// radiance of each segment it claims).
     pub fn clear(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.clear_buffer(&self.batches, 0, None);
+        encoder.clear_buffer(&self.ms_batches, 0, None);
     }
 }
 
@@ -141,10 +150,14 @@ impl SegmentShadingPass {
             &[
                 (0, inputs.camera),
                 (2, batch),
+                (5, inputs.segments),
+                (6, inputs.absorption),
                 (18, &targets.kbuffer.fragments),
                 (20, &segments.batches),
                 (21, &segments.work_count),
                 (22, &segments.work_list),
+                (30, &segments.ms_batches),
+                (31, &segments.ms_list),
             ],
         );
         let pixels = Workgroups::Direct(width.div_ceil(8), rows.div_ceil(8));
@@ -159,8 +172,9 @@ impl SegmentShadingPass {
         self.encode_listed(device, encoder, inputs, segments, batch);
     }
 
-    /// One light batch over the segments already listed in `work_list` (`work_count` of them: a
-    /// repaint's, written by the caller): the dispatch's size and the shading, no claim.
+    /// One light batch over the segments already listed in `work_list` and the keys in `ms_list`
+    /// (`work_count` of them: a repaint's, written by the caller): the dispatch's size and the
+    /// shading, no claim.
     pub fn encode_listed(
         &self,
         device: &wgpu::Device,
@@ -189,7 +203,11 @@ impl SegmentShadingPass {
             None,
         );
         let mut entries = inputs.shading_entries(batch);
-        entries.extend([(21, &segments.work_count), (22, &segments.work_list)]);
+        entries.extend([
+            (21, &segments.work_count),
+            (22, &segments.work_list),
+            (31, &segments.ms_list),
+        ]);
         entries.extend((24..).zip(&segments.radiance));
         let shade = bind(device, &self.shade, "shade segments", &entries);
         let listed = Workgroups::Indirect(&segments.work_args);
@@ -215,6 +233,7 @@ impl SegmentShadingPass {
             (2, batch),
             (4, inputs.points),
             (5, inputs.segments),
+            (6, inputs.absorption),
             (18, &targets.kbuffer.fragments),
         ];
         entries.extend((13..).zip(&targets.components));

@@ -90,6 +90,53 @@ impl ShadingHair<'_> {
             segment: seg,
         }
     }
+
+    /// `ms_paired` of the WGSL: whether segments `even` and `even` + 1 share a multiple-scattering
+    /// sample: the second continues the first and their three points' absorption is the same.
+    fn ms_paired(&self, even: u32) -> bool {
+        if strand_partner(&self.segments, even).is_none() {
+            return false;
+        }
+        let i0 = self.segments[even as usize] as usize;
+        let s = self.sigma_a[i0 + 1];
+        self.sigma_a[i0] == s && self.sigma_a[i0 + 2] == s
+    }
+
+    /// `ms_key` of the WGSL: multiple scattering varies slowly along a strand (spread over sigma_f,
+    /// read from the coarse shadow grid), so it is evaluated once per pair of consecutive segments of
+    /// a strand (2k and 2k + 1, when 2k + 1 continues 2k and the pair's three points have the same
+    /// absorption) at the point they share ([`ShadingHair::ms_point`]), and read by both: the key of
+    /// segment `seg`'s pair is its even segment; a segment without a pair (the last of a strand
+    /// with an odd count, paint that varies along the pair) is its own key, sampled at its midpoint.
+    pub fn ms_key(&self, seg: u32) -> u32 {
+        let even = seg & !1;
+        if self.ms_paired(even) { even } else { seg }
+    }
+
+    /// `ms_point` of the WGSL: where multiple scattering is evaluated for key `key`
+    /// ([`ShadingHair::ms_key`]): a pair's shared point, its tangent the pair's chord, or an
+    /// unpaired segment's midpoint.
+    pub fn ms_point(&self, key: u32) -> ShadingPoint {
+        if key & 1 == 1 || !self.ms_paired(key) {
+            return self.segment_point(key, 0.5);
+        }
+        let i0 = self.segments[key as usize] as usize;
+        let p = &self.hair.positions;
+        ShadingPoint {
+            position: p[i0 + 1],
+            tangent: p[i0 + 2] - p[i0],
+            sigma_a: self.sigma_a[i0 + 1],
+            segment: key,
+        }
+    }
+}
+
+/// The segment that makes a multiple-scattering pair with segment `seg` where their absorption allows
+/// ([`ShadingHair::ms_key`]): 2k + 1 for 2k and 2k for 2k + 1, when 2k + 1 continues 2k in its
+/// strand (`segments`: each segment's first point).
+pub fn strand_partner(segments: &[u32], seg: u32) -> Option<u32> {
+    let even = (seg & !1) as usize;
+    (even + 1 < segments.len() && segments[even + 1] == segments[even] + 1).then_some(seg ^ 1)
 }
 
 /// FiberFrame::from_tangent in f32 (twin of `fiber_frame` in `shaders/camera.wgsl`): (u, v, w).
@@ -207,8 +254,8 @@ pub type SegmentSingle = [[Rgb; 3]; 3];
 /// `shade_segment_single` of the WGSL: a segment's single scattering at t = 0, 1/2, 1 towards omega_o,
 /// each light's response at the midpoint `mid` (its tangent and view), scaled by the light's
 /// transmittance at each sample (`ends`: the segment's ends, their positions and absorption). One
-/// response per light where the ends' absorption is the same; where it differs one at each end's,
-/// the midpoint's between them ([`between_ends`]).
+/// response per light where the ends' absorption is the same (the midpoint's that response too);
+/// where it differs one at each end's, the midpoint's between them ([`between_ends`]).
 #[allow(clippy::too_many_arguments)]
 pub fn shade_segment_single(
     luts: &Luts,
@@ -253,7 +300,8 @@ pub fn shade_segment_single(
                     let (a, b) = (k * ma[lobe][c], k * mb[lobe][c]);
                     out[s][lobe][c] += t * match s {
                         0 => a,
-                        1 => between_ends(a, b, 0.5),
+                        1 if painted => between_ends(a, b, 0.5),
+                        1 => a,
                         _ => b,
                     };
                 }
@@ -383,8 +431,9 @@ pub fn between_samples(a: f32, m: f32, b: f32, t: f32) -> f32 {
 /// The frame's segment shading on the CPU (twin of `shade_segments` and `gather_segments`): for each
 /// pixel of `pixels`, every kept fragment's weight times its segment's radiance: single scattering
 /// (R, TT, TRT) from `single` (`shade_segment_single` with the segment's midpoint, its ends and the
-/// direction to the eye from the midpoint) between its samples at the fragment's point ([`between_samples`]), multiple
-/// scattering that of its midpoint by `multiple` towards the eye.
+/// direction to the eye from the midpoint) between its samples at the fragment's point
+/// ([`between_samples`]), multiple scattering that of its pair's point ([`ShadingHair::ms_key`],
+/// [`ShadingHair::ms_point`]) by `multiple` towards the eye.
 pub fn shade_pixels_by_segment(
     frame: &Frame,
     camera: &CameraUniform,
@@ -414,7 +463,8 @@ pub fn shade_pixels_by_segment(
                 let omega_o = (eye - mid.position).normalize();
                 let ends = [hair.segment_point(seg, 0.0), hair.segment_point(seg, 1.0)];
                 let ss = single(&mid, ends, omega_o);
-                let ms = multiple(&mid, omega_o);
+                let at = hair.ms_point(hair.ms_key(seg));
+                let ms = multiple(&at, (eye - at.position).normalize());
                 let w = weight as f32;
                 for c in 0..5 {
                     for ch in 0..3 {
