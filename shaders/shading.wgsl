@@ -13,6 +13,8 @@
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 // By segment: multiple scattering alone, the segments' single scattering kept (shading.rs).
 const FLAG_SINGLE_KEPT: u32 = 8u;
+// A repaint's batch: the work lists hold its segments, written by the caller, not claims.
+const FLAG_REPAINT: u32 = 16u;
 
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -44,9 +46,13 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(27) var<storage, read_write> segment_ms_global: array<vec4<f32>>;
 @group(0) @binding(28) var<storage, read_write> segment_ms_local: array<vec4<f32>>;
 // Multiple scattering's samples (see `ms_key`): per key 1 + the first light of the last batch that
-// claimed it, and the keys listed by the claim (work_count[1] of them).
+// claimed it, and the keys listed by the claim (work_count[1] of them); per segment its key, found by
+// the frame's first light batch and read by the others and the gather (the pairing reads the
+// absorption, which a brush dab may change while a frame refines: each segment keeps the key whose
+// sample was written).
 @group(0) @binding(30) var<storage, read_write> ms_batches: array<atomic<u32>>;
 @group(0) @binding(31) var<storage, read_write> ms_list: array<u32>;
+@group(0) @binding(32) var<storage, read_write> ms_keys: array<u32>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -172,7 +178,8 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
 // transmittance at its ends and its midpoint (`shade_segment_single`); its multiple scattering, which
 // varies slowly (spread over sigma_f and read from the coarse shadow grid), once per pair of
 // consecutive segments at the point they share (`ms_key`). Every fragment takes the single scattering
-// between the three samples at its own point (`between_samples`) and its pair's multiple scattering. A full-resolution pixel keeps ~10 fragments of segments that
+// between the three samples at its own point (`between_samples`) and its pair's multiple scattering.
+// A full-resolution pixel keeps ~10 fragments of segments that
 // cover ~8 pixels each (S1): ~8x fewer responses than one per fragment.
 
 // The point of segment `seg` at t (0: its first point, 1: its second; absorption linear along it).
@@ -265,9 +272,9 @@ fn shade_segment_single(mid: ShadingPoint, a: ShadingPoint, b: ShadingPoint, ome
 // grid): it is evaluated once per pair of consecutive segments of a strand, segments 2k and 2k + 1
 // when segment 2k + 1 continues segment 2k and the pair's three points have the same absorption
 // (unpainted hair, a uniform dye), at the point they share, and read by both (twin: shade.rs,
-// `ms_key`). A segment without such a partner (the last of a strand with an odd count, paint that
-// varies along the pair) keeps its own sample at its midpoint. The key of a pair is its even
-// segment.
+// `ms_key`). A segment without such a partner (a strand's first or last segment where the pairs,
+// counted over the whole hair, straddle its ends; paint that varies along the pair) keeps its own
+// sample at its midpoint. The key of a pair is its even segment.
 fn ms_paired(even: u32) -> bool {
     if (even + 1u >= arrayLength(&segments) || segments[even + 1u] != segments[even] + 1u) {
         return false;
@@ -283,13 +290,27 @@ fn ms_key(seg: u32) -> u32 {
 }
 
 // The point multiple scattering is evaluated at for key `key` (twin: shade.rs, `ms_point`): a pair's
-// shared point, its tangent the pair's chord, or an unpaired segment's midpoint.
+// shared point, its tangent the pair's chord (the first segment's where the pair folds back onto
+// its first point), or an unpaired segment's midpoint.
 fn ms_point(key: u32) -> ShadingPoint {
     if ((key & 1u) == 1u || !ms_paired(key)) {
         return segment_point(key, 0.5);
     }
     let i0 = segments[key];
-    return ShadingPoint(points[i0 + 1u].xyz, points[i0 + 2u].xyz - points[i0].xyz, absorption[i0 + 1u].xyz);
+    let a = points[i0].xyz;
+    let m = points[i0 + 1u].xyz;
+    let chord = points[i0 + 2u].xyz - a;
+    return ShadingPoint(m, select(m - a, chord, dot(chord, chord) > 0.0), absorption[i0 + 1u].xyz);
+}
+
+// The key of a claimed segment: found by the frame's first light batch, kept for the others.
+fn claimed_key(seg: u32) -> u32 {
+    if (batch.first == 0u) {
+        let key = ms_key(seg);
+        ms_keys[seg] = key;
+        return key;
+    }
+    return ms_keys[seg];
 }
 
 // Lists the segments of the batch's rows' kept fragments that this light batch has not shaded: a
@@ -313,7 +334,7 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             if (atomicMax(&segment_batches[seg], batch.first + 1u) <= batch.first) {
                 work_list[atomicAdd(&work_count[0], 1u)] = seg;
                 if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-                    let key = ms_key(seg);
+                    let key = claimed_key(seg);
                     if (atomicMax(&ms_batches[key], batch.first + 1u) <= batch.first) {
                         ms_list[atomicAdd(&work_count[1], 1u)] = key;
                     }
@@ -427,10 +448,14 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
         }
     } else if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u && j < atomicLoad(&work_count[1])) {
-        let key = ms_list[j];
-        // A repaint lists every segment of its pairs: the pair's key alone shades it.
-        if (ms_key(key) != key) {
-            return;
+        var key = ms_list[j];
+        // A repaint lists every segment of its pairs (FLAG_REPAINT): the pair's key alone shades it.
+        if ((batch.flags & FLAG_REPAINT) != 0u) {
+            let seg = key;
+            key = claimed_key(seg);
+            if (key != seg) {
+                return;
+            }
         }
         let sp = ms_point(key);
         let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
@@ -462,7 +487,7 @@ fn between_samples(a: vec3<f32>, m: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32
 }
 
 // The batch's rows' components: every kept fragment's weight times its segment's radiance at the
-// fragment's point (single scattering between the samples, multiple scattering the segment's);
+// fragment's point (single scattering between the samples, multiple scattering its key's, `ms_keys`);
 // .w of R the weight shaded (the hair's alpha).
 @compute @workgroup_size(8, 8)
 fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -489,7 +514,7 @@ fn gather_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             out.tt = out.tt + w * between_samples(segment_tt[k].xyz, segment_tt[k + 1u].xyz, segment_tt[k + 2u].xyz, t);
             out.trt = out.trt + w * between_samples(segment_trt[k].xyz, segment_trt[k + 1u].xyz, segment_trt[k + 2u].xyz, t);
             if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u) {
-                let key = ms_key(seg);
+                let key = ms_keys[seg];
                 out.ms_global = out.ms_global + w * segment_ms_global[key].xyz;
                 out.ms_local = out.ms_local + w * segment_ms_local[key].xyz;
             }

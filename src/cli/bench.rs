@@ -13,6 +13,7 @@ use strandlight::render::preview::PreviewMode;
 use strandlight::render::progressive::{ImageReady, UNIT_PASSES};
 use strandlight::render::renderer::TableBuild;
 use strandlight::render::scene::{StandardScene, default_environment};
+use strandlight::render::shade::ShadingHair;
 use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
@@ -97,6 +98,10 @@ struct SceneReport {
     /// Kept fragments with a weight, and the distinct segments among them.
     fragments: usize,
     visible_segments: usize,
+    /// Points whose multiple scattering the frame evaluates by segment: one per pair of consecutive
+    /// visible segments of a strand that share it (`ShadingHair::ms_key`), one per segment without.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ms_points: Option<usize>,
     /// The shading pass's median GPU time per light per shaded point, microseconds (all threads of
     /// the GPU: compare with `bench-fast`'s one-thread CPU figure only as a ratio).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -490,10 +495,16 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let kept = (0..frame.pixel_count())
             .flat_map(|i| frame.kept_fragments(i).iter().filter(|f| f.weight > 0.0));
         let fragments = kept.clone().count();
-        let visible_segments = kept
-            .map(|f| f.id)
-            .collect::<std::collections::HashSet<_>>()
-            .len();
+        let visible: std::collections::HashSet<u32> = kept.map(|f| f.id).collect();
+        let visible_segments = visible.len();
+        let ms_points = (renderer.shades_segments() && !args.single_scattering).then(|| {
+            let shading = ShadingHair::new(&hair, &sigma_a);
+            visible
+                .iter()
+                .map(|&id| shading.ms_key(id - 1))
+                .collect::<std::collections::HashSet<_>>()
+                .len()
+        });
         let shaded_points = if renderer.shades_segments() {
             visible_segments
         } else {
@@ -631,6 +642,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             shaded_points,
             fragments,
             visible_segments,
+            ms_points,
             shading_us_per_light_per_point,
             shadow_grid_wall_ms,
             shadow_grid_wall_ms_min,

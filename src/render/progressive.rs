@@ -119,7 +119,7 @@ pub enum WorkUnit {
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
     /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over
-    /// `segments` of the segments at the changed points, from the `first`-th (in parts sized to the
+    /// `segments` of the segments at the changed points (and their partners), from the `first`-th (in parts sized to the
     /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part).
     Repaint {
         batch: u32,
@@ -836,12 +836,13 @@ impl Renderer {
     }
 
     /// A brush dab on an image converged by segment: the segments that join the changed points
-    /// `changed` are shaded again under every light ([`WorkUnit::Repaint`] units, light batch by light
+    /// `changed`, and each one's multiple-scattering partner ([`strand_partner`]: their shared
+    /// sample may move with the paint), are shaded again under every light ([`WorkUnit::Repaint`] units, light batch by light
     /// batch, each in parts sized to the budget) and
     /// the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of a
     /// restart. The dab shows at full
     /// resolution after work on its segments alone; every other segment's radiance depends on its
-    /// own points only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
+    /// own points (and its pair's, with them here) only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
     /// False, nothing planned, when the image is not converged by segment: the caller restarts.
     pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
         let r = &self.refinement;

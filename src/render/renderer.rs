@@ -282,14 +282,15 @@ pub struct RenderSettings {
     /// test against ray shooting the worst mean-colour error was 16 % at 32 points, 9.5 % at 48).
     pub shadow_grid_resolution: u32,
     /// Shade each visible segment once (each light's single-scattering response at its midpoint,
-    /// weighted by the light's transmittance at its ends and midpoint; multiple scattering at its
-    /// midpoint) instead of every kept fragment at its own point (false): ~8x fewer responses at full
-    /// resolution (S1 on lavapipe: 8.9 s a frame against 101 s, one sitting). On by default; its cost
+    /// weighted by the light's transmittance at its ends and midpoint; multiple scattering once per
+    /// pair of consecutive segments of a strand with the same absorption, at the point they share:
+    /// `shade::ShadingHair::ms_key`) instead of every kept fragment at its own point (false): ~8x
+    /// fewer responses at full resolution (S1 on lavapipe: 8.9 s a frame against 101 s, one sitting). On by default; its cost
     /// against per-fragment shading is 0.42 % relative RMSE (`tests/render.rs`), and on the blond clump
     /// of `tests/ms_reference.rs` it stays as close to ray shooting (9.0 % against 9.7 %). Each light's
-    /// response reads the absorption at the segment's midpoint (the mean of its points'), so paint
-    /// that differs between a segment's two points shades as a step at segment resolution there, not
-    /// as a gradient between them.
+    /// response reads the absorption at each of the segment's ends where they differ (the midpoint's
+    /// between them), so paint keeps its gradient along the segment; a pair whose points' absorption
+    /// differs gets a multiple-scattering sample per segment.
     pub segment_shading: bool,
 }
 

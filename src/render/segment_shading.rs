@@ -18,7 +18,7 @@ use crate::gpu::context::{bind_entries as bind, compute_pipeline};
 pub const SINGLE_SAMPLES: u64 = 3;
 
 /// Bytes of a single-scattering component's radiance per segment (three samples, RGBA f32); a
-/// multiple-scattering component's is a third (the midpoint's).
+/// multiple-scattering component's is a third (one sample per key, indexed by its segment).
 pub const RADIANCE_BYTES_PER_SEGMENT: u64 = 16 * SINGLE_SAMPLES;
 
 /// The per-segment buffers (sized by the hair's segments, not by the image).
@@ -31,12 +31,15 @@ pub struct SegmentTargets {
     pub work_list: wgpu::Buffer,
     /// Per multiple-scattering key: 1 + the first light of the last batch that shaded it (0: none).
     pub ms_batches: wgpu::Buffer,
-    /// The keys listed by the unit's claim (or a repaint's, written by the caller).
+    /// The keys listed by the unit's claim (a repaint's segments, written by the caller).
     pub ms_list: wgpu::Buffer,
+    /// Per segment its key, found by the frame's first light batch (the others and the gather read
+    /// it: the pairing reads the absorption, which a dab may change while the frame refines).
+    pub ms_keys: wgpu::Buffer,
     /// `shade_segments`' indirect dispatch.
     pub work_args: wgpu::Buffer,
     /// R, TT, TRT at each segment's t = 0, 1/2, 1 (index 3 segment + 2 t), MS.global and MS.local
-    /// at its midpoint (index segment). Written by a frame's first light batch, added to by the others.
+    /// at each key's sample (index key: [`super::shade::ShadingHair::ms_point`]). Written by a frame's first light batch, added to by the others.
     pub radiance: [wgpu::Buffer; 5],
 }
 
@@ -63,6 +66,7 @@ impl SegmentTargets {
             work_list: buffer("segment work list", 4 * n, none),
             ms_batches: buffer("multiple scattering batches", 4 * n, none),
             ms_list: buffer("multiple scattering work list", 4 * n, none),
+            ms_keys: buffer("multiple scattering keys", 4 * n, none),
             work_args: buffer("segment dispatch", 12, wgpu::BufferUsages::INDIRECT),
             radiance: std::array::from_fn(|c| {
                 let samples = if c < 3 { SINGLE_SAMPLES } else { 1 };
@@ -158,6 +162,7 @@ impl SegmentShadingPass {
                 (22, &segments.work_list),
                 (30, &segments.ms_batches),
                 (31, &segments.ms_list),
+                (32, &segments.ms_keys),
             ],
         );
         let pixels = Workgroups::Direct(width.div_ceil(8), rows.div_ceil(8));
@@ -207,6 +212,7 @@ impl SegmentShadingPass {
             (21, &segments.work_count),
             (22, &segments.work_list),
             (31, &segments.ms_list),
+            (32, &segments.ms_keys),
         ]);
         entries.extend((24..).zip(&segments.radiance));
         let shade = bind(device, &self.shade, "shade segments", &entries);
@@ -233,8 +239,8 @@ impl SegmentShadingPass {
             (2, batch),
             (4, inputs.points),
             (5, inputs.segments),
-            (6, inputs.absorption),
             (18, &targets.kbuffer.fragments),
+            (32, &segments.ms_keys),
         ];
         entries.extend((13..).zip(&targets.components));
         entries.extend((24..).zip(&segments.radiance));

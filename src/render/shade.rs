@@ -106,25 +106,31 @@ impl ShadingHair<'_> {
     /// read from the coarse shadow grid), so it is evaluated once per pair of consecutive segments of
     /// a strand (2k and 2k + 1, when 2k + 1 continues 2k and the pair's three points have the same
     /// absorption) at the point they share ([`ShadingHair::ms_point`]), and read by both: the key of
-    /// segment `seg`'s pair is its even segment; a segment without a pair (the last of a strand
-    /// with an odd count, paint that varies along the pair) is its own key, sampled at its midpoint.
+    /// segment `seg`'s pair is its even segment; a segment without a pair (a strand's first or last
+    /// segment where the pairs, counted over the whole hair, straddle its ends; paint that varies
+    /// along the pair) is its own key, sampled at its midpoint.
     pub fn ms_key(&self, seg: u32) -> u32 {
         let even = seg & !1;
         if self.ms_paired(even) { even } else { seg }
     }
 
     /// `ms_point` of the WGSL: where multiple scattering is evaluated for key `key`
-    /// ([`ShadingHair::ms_key`]): a pair's shared point, its tangent the pair's chord, or an
-    /// unpaired segment's midpoint.
+    /// ([`ShadingHair::ms_key`]): a pair's shared point, its tangent the pair's chord (the first
+    /// segment's where the pair folds back onto its first point), or an unpaired segment's midpoint.
     pub fn ms_point(&self, key: u32) -> ShadingPoint {
         if key & 1 == 1 || !self.ms_paired(key) {
             return self.segment_point(key, 0.5);
         }
         let i0 = self.segments[key as usize] as usize;
         let p = &self.hair.positions;
+        let chord = p[i0 + 2] - p[i0];
         ShadingPoint {
             position: p[i0 + 1],
-            tangent: p[i0 + 2] - p[i0],
+            tangent: if chord.dot(chord) > 0.0 {
+                chord
+            } else {
+                p[i0 + 1] - p[i0]
+            },
             sigma_a: self.sigma_a[i0 + 1],
             segment: key,
         }
