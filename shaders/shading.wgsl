@@ -13,8 +13,6 @@
 const FLAG_MULTIPLE_SCATTERING: u32 = 2u;
 // By segment: multiple scattering alone, the segments' single scattering kept (shading.rs).
 const FLAG_SINGLE_KEPT: u32 = 8u;
-// A repaint's batch: the work lists hold its segments, written by the caller, not claims.
-const FLAG_REPAINT: u32 = 16u;
 
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -53,6 +51,9 @@ const FLAG_REPAINT: u32 = 16u;
 @group(0) @binding(30) var<storage, read_write> ms_batches: array<atomic<u32>>;
 @group(0) @binding(31) var<storage, read_write> ms_list: array<u32>;
 @group(0) @binding(32) var<storage, read_write> ms_keys: array<u32>;
+// A repaint's candidates for multiple scattering (work_count[2] of them, written by the caller):
+// its segments and their partners.
+@group(0) @binding(33) var<storage, read> ms_candidates: array<u32>;
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -344,6 +345,21 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// A repaint's multiple-scattering list: of its candidates (its segments and their partners, whole
+// pairs), the keys (`claimed_key`: found on the first light batch, kept for the others), one
+// invocation each, in workgroups of 64 as rows of 65535.
+@compute @workgroup_size(64)
+fn list_repaint_keys(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x + id.y * 65535u * 64u;
+    if (i >= atomicLoad(&work_count[2])) {
+        return;
+    }
+    let seg = ms_candidates[i];
+    if (claimed_key(seg) == seg) {
+        ms_list[atomicAdd(&work_count[1], 1u)] = seg;
+    }
+}
+
 // Where a frame's segment shading lies, for progressive refinement's bands (twin:
 // src/render/row_segments.rs, `row_segments`): per image row, the segments whose topmost kept
 // fragment lies in it, which are exactly the segments a band of rows claims when the bands run from
@@ -448,15 +464,7 @@ fn shade_segments(@builtin(global_invocation_id) id: vec3<u32>) {
             segment_trt[k] = select(segment_trt[k], vec4<f32>(0.0), restart) + vec4<f32>(l.trt[s], 0.0);
         }
     } else if ((batch.flags & FLAG_MULTIPLE_SCATTERING) != 0u && j < atomicLoad(&work_count[1])) {
-        var key = ms_list[j];
-        // A repaint lists every segment of its pairs (FLAG_REPAINT): the pair's key alone shades it.
-        if ((batch.flags & FLAG_REPAINT) != 0u) {
-            let seg = key;
-            key = claimed_key(seg);
-            if (key != seg) {
-                return;
-            }
-        }
+        let key = ms_list[j];
         let sp = ms_point(key);
         let l = shade_point(sp, normalize(camera.eye - sp.position), batch.first, batch.count, shadows, false, true);
         segment_ms_global[key] = select(segment_ms_global[key], vec4<f32>(0.0), restart) + vec4<f32>(l.ms_global, 0.0);

@@ -119,7 +119,8 @@ pub enum WorkUnit {
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
     /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over
-    /// `segments` of the segments at the changed points (and their partners), from the `first`-th (in parts sized to the
+    /// `segments` of the segments at the changed points (with their partners' multiple
+    /// scattering), from the `first`-th (in parts sized to the
     /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part).
     Repaint {
         batch: u32,
@@ -836,14 +837,14 @@ impl Renderer {
     }
 
     /// A brush dab on an image converged by segment: the segments that join the changed points
-    /// `changed`, and each one's multiple-scattering partner ([`strand_partner`]: their shared
-    /// sample may move with the paint), are shaded again under every light ([`WorkUnit::Repaint`] units, light batch by light
-    /// batch, each in parts sized to the budget) and
-    /// the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of a
-    /// restart. The dab shows at full
-    /// resolution after work on its segments alone; every other segment's radiance depends on its
-    /// own points (and its pair's, with them here) only and stays. (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].)
-    /// False, nothing planned, when the image is not converged by segment: the caller restarts.
+    /// `changed` are shaded again under every light, and their multiple-scattering partners'
+    /// multiple scattering ([`strand_partner`]: a pair's shared sample may move with the paint)
+    /// ([`WorkUnit::Repaint`] units, light batch by light batch, each in parts sized to the budget),
+    /// and the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of
+    /// a restart. The dab shows at full resolution after work on its segments alone; every other
+    /// segment's radiance depends on its own points (and its pair's, shaded here) only and stays.
+    /// (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].) False, nothing
+    /// planned, when the image is not converged by segment: the caller restarts.
     pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
         let r = &self.refinement;
         let ready = self.by_segment
@@ -867,9 +868,6 @@ impl Renderer {
             for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
                 if let Ok(k) = self.segment_first.binary_search(&p) {
                     segments.push(k as u32);
-                    // Its multiple-scattering partner (its pair's sample may move with the paint:
-                    // both are shaded again, and both gathered).
-                    segments.extend(strand_partner(&self.segment_first, k as u32));
                 }
             }
         }
@@ -901,7 +899,13 @@ impl Renderer {
     fn start_repaint(&mut self, mut segments: Vec<u32>) {
         segments.sort_unstable();
         segments.dedup();
-        self.repaint_rows = self.rows_covered(&segments);
+        // The partners' multiple scattering is shaded again too (a pair's sample may move with the
+        // paint), so their rows are gathered.
+        let with_partners: Vec<u32> = segments
+            .iter()
+            .flat_map(|&s| std::iter::once(s).chain(strand_partner(&self.segment_first, s)))
+            .collect();
+        self.repaint_rows = self.rows_covered(&with_partners);
         self.repaint = segments;
         self.refinement.stage = Stage::Repaint { batch: 0, first: 0 };
     }
@@ -1853,19 +1857,32 @@ impl Renderer {
                 let end = (first + segments).min(self.repaint.len() as u32);
                 let start = first.min(end) as usize;
                 let part = &self.repaint[start..end as usize];
+                let mut candidates = Vec::new();
                 if let Some(s) = &self.segment_targets {
                     ctx.queue
                         .write_buffer(&s.work_list, 0, bytemuck::cast_slice(part));
-                    // Multiple scattering: the same list (it holds whole pairs, [`strand_partner`]):
-                    // each pair's key alone shades it.
-                    ctx.queue
-                        .write_buffer(&s.ms_list, 0, bytemuck::cast_slice(part));
-                    let count = [part.len() as u32; 2];
+                    // Multiple scattering's candidates: the part's segments and the partners not
+                    // listed themselves (each once in the whole repaint: a segment has one partner),
+                    // whole pairs for the GPU's keys ([`strand_partner`]).
+                    candidates = part.to_vec();
+                    candidates.extend(part.iter().filter_map(|&s| {
+                        strand_partner(&self.segment_first, s)
+                            .filter(|p| self.repaint.binary_search(p).is_err())
+                    }));
+                    if !candidates.is_empty() {
+                        ctx.queue.write_buffer(
+                            &s.ms_candidates,
+                            0,
+                            bytemuck::cast_slice(&candidates),
+                        );
+                    }
+                    let count = [part.len() as u32, 0, candidates.len() as u32];
                     ctx.queue
                         .write_buffer(&s.work_count, 0, bytemuck::cast_slice(&count));
                 }
                 let inputs = self.shading_inputs();
-                self.shading_pass.encode_repaint(device, enc, &inputs, b);
+                self.shading_pass
+                    .encode_repaint(device, enc, &inputs, b, candidates.len() as u32);
             }
             WorkUnit::RepaintGather { row0, rows } => {
                 // The last batch's flags (what the segments hold) over the band.

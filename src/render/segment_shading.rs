@@ -26,13 +26,16 @@ pub struct SegmentTargets {
     /// Per segment: 1 + the first light of the last batch that shaded it (0: none).
     pub batches: wgpu::Buffer,
     /// [0]: segments listed by the unit's claim, [1]: multiple scattering's keys (`ms_key` of
-    /// `shaders/shading.wgsl`, [`super::shade::ms_key`]).
+    /// `shaders/shading.wgsl`, [`super::shade::ShadingHair::ms_key`]), [2]: a repaint's candidates.
     pub work_count: wgpu::Buffer,
     pub work_list: wgpu::Buffer,
     /// Per multiple-scattering key: 1 + the first light of the last batch that shaded it (0: none).
     pub ms_batches: wgpu::Buffer,
-    /// The keys listed by the unit's claim (a repaint's segments, written by the caller).
+    /// The keys listed by the unit's claim (or a repaint's, by `list_repaint_keys`).
     pub ms_list: wgpu::Buffer,
+    /// A repaint's candidates for multiple scattering (its segments and their partners, written by
+    /// the caller; work_count[2] of them).
+    pub ms_candidates: wgpu::Buffer,
     /// Per segment its key, found by the frame's first light batch (the others and the gather read
     /// it: the pairing reads the absorption, which a dab may change while the frame refines).
     pub ms_keys: wgpu::Buffer,
@@ -62,11 +65,12 @@ impl SegmentTargets {
         let none = wgpu::BufferUsages::empty();
         Some(Self {
             batches: buffer("segment batches", 4 * n, none),
-            work_count: buffer("segment work count", 8, none),
+            work_count: buffer("segment work count", 12, none),
             work_list: buffer("segment work list", 4 * n, none),
             ms_batches: buffer("multiple scattering batches", 4 * n, none),
             ms_list: buffer("multiple scattering work list", 4 * n, none),
             ms_keys: buffer("multiple scattering keys", 4 * n, none),
+            ms_candidates: buffer("multiple scattering candidates", 4 * n, none),
             work_args: buffer("segment dispatch", 12, wgpu::BufferUsages::INDIRECT),
             radiance: std::array::from_fn(|c| {
                 let samples = if c < 3 { SINGLE_SAMPLES } else { 1 };
@@ -87,9 +91,10 @@ impl SegmentTargets {
     }
 }
 
-/// The four pipelines.
+/// The five pipelines.
 pub struct SegmentShadingPass {
     claim: wgpu::ComputePipeline,
+    repaint_keys: wgpu::ComputePipeline,
     dispatch: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
     gather: wgpu::ComputePipeline,
@@ -126,6 +131,7 @@ impl SegmentShadingPass {
     pub fn new(device: &wgpu::Device, module: &wgpu::ShaderModule) -> Self {
         Self {
             claim: compute_pipeline(device, module, "claim_segments"),
+            repaint_keys: compute_pipeline(device, module, "list_repaint_keys"),
             dispatch: compute_pipeline(device, module, "segment_dispatch"),
             shade: compute_pipeline(device, module, "shade_segments"),
             gather: compute_pipeline(device, module, "gather_segments"),
@@ -177,6 +183,47 @@ impl SegmentShadingPass {
         self.encode_listed(device, encoder, inputs, segments, batch);
     }
 
+    /// A repaint's multiple-scattering keys: of the `candidates` in `ms_candidates` (written by the
+    /// caller, with the counts: work_count[1] zero), those that are their own key, listed in
+    /// `ms_list`.
+    pub fn encode_repaint_keys(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ShadingInputs,
+        segments: &SegmentTargets,
+        batch: &wgpu::Buffer,
+        candidates: u32,
+    ) {
+        if candidates == 0 {
+            return;
+        }
+        let keys = bind(
+            device,
+            &self.repaint_keys,
+            "repaint keys",
+            &[
+                (2, batch),
+                (5, inputs.segments),
+                (6, inputs.absorption),
+                (21, &segments.work_count),
+                (31, &segments.ms_list),
+                (32, &segments.ms_keys),
+                (33, &segments.ms_candidates),
+            ],
+        );
+        let groups = candidates.div_ceil(64);
+        let rows = Workgroups::Direct(groups.min(65535), groups.div_ceil(65535));
+        run(
+            encoder,
+            "repaint keys",
+            &self.repaint_keys,
+            &keys,
+            rows,
+            None,
+        );
+    }
+
     /// One light batch over the segments already listed in `work_list` and the keys in `ms_list`
     /// (`work_count` of them: a repaint's, written by the caller): the dispatch's size and the
     /// shading, no claim.
@@ -212,7 +259,6 @@ impl SegmentShadingPass {
             (21, &segments.work_count),
             (22, &segments.work_list),
             (31, &segments.ms_list),
-            (32, &segments.ms_keys),
         ]);
         entries.extend((24..).zip(&segments.radiance));
         let shade = bind(device, &self.shade, "shade segments", &entries);

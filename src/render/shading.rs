@@ -20,9 +20,6 @@ pub const FLAG_SEGMENTS: u32 = 4;
 /// A batch by segment shades multiple scattering alone: the segments' single scattering is kept from
 /// the last converged pass ([`super::Renderer::keeps_single_scattering`]).
 pub const FLAG_SINGLE_KEPT: u32 = 8;
-/// A repaint's batch: the segment work lists were written by the caller (no claim); its multiple
-/// scattering finds each listed segment's key on the first light batch.
-pub const FLAG_REPAINT: u32 = 16;
 
 /// One SRBF light as the shaders read it.
 #[repr(C)]
@@ -348,27 +345,26 @@ impl ShadingPass {
         );
     }
 
-    /// A repaint's light batch: the segments listed in the segment targets' work list and
-    /// multiple-scattering list (the same segments, whole pairs: written by the caller) shaded again,
-    /// no claim ([`FLAG_REPAINT`]; the rows gather after the last batch:
-    /// [`Self::encode_repaint_gather`]).
+    /// A repaint's light batch, no claim (written by the caller: the segments in the segment
+    /// targets' work list, `candidates` segments and partners in `ms_candidates`, the counts): the
+    /// candidates' keys listed, then the listed segments and keys shaded again (the rows gather
+    /// after the last batch: [`Self::encode_repaint_gather`]).
     pub fn encode_repaint(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         inputs: &ShadingInputs,
         batch: &ShadeBatch,
+        candidates: u32,
     ) {
         let Some(segments) = inputs.segment_targets else {
             return;
         };
-        let uniform = batch_uniform(
-            device,
-            &ShadeBatch {
-                flags: batch.flags | FLAG_REPAINT,
-                ..*batch
-            },
-        );
+        let uniform = batch_uniform(device, batch);
+        if batch.flags & FLAG_MULTIPLE_SCATTERING != 0 {
+            self.segments
+                .encode_repaint_keys(device, encoder, inputs, segments, &uniform, candidates);
+        }
         self.segments
             .encode_listed(device, encoder, inputs, segments, &uniform);
     }
