@@ -44,10 +44,10 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(27) var<storage, read_write> segment_ms_global: array<vec4<f32>>;
 @group(0) @binding(28) var<storage, read_write> segment_ms_local: array<vec4<f32>>;
 // Multiple scattering's samples (see `ms_key`): per key 1 + the first light of the last batch that
-// claimed it, and the keys listed by the claim (work_count[1] of them); per segment its key, found by
-// the frame's first light batch and read by the others and the gather (the pairing reads the
-// absorption, which a brush dab may change while a frame refines: each segment keeps the key whose
-// sample was written).
+// claimed it, and the keys listed by the claim or by `list_repaint_keys` (work_count[1] of them);
+// per segment its key, found by the frame's (or a repaint's) first light batch and read by the
+// others and the gather (the pairing reads the absorption, which a brush dab may change while a
+// frame refines: each segment keeps the key whose sample was written).
 @group(0) @binding(30) var<storage, read_write> ms_batches: array<atomic<u32>>;
 @group(0) @binding(31) var<storage, read_write> ms_list: array<u32>;
 @group(0) @binding(32) var<storage, read_write> ms_keys: array<u32>;
@@ -304,7 +304,8 @@ fn ms_point(key: u32) -> ShadingPoint {
     return ShadingPoint(m, select(m - a, chord, dot(chord, chord) > 0.0), absorption[i0 + 1u].xyz);
 }
 
-// The key of a claimed segment: found by the frame's first light batch, kept for the others.
+// The key of a claimed (or repainted) segment: found by the frame's (or the repaint's) first light
+// batch, kept for the others.
 fn claimed_key(seg: u32) -> u32 {
     if (batch.first == 0u) {
         let key = ms_key(seg);

@@ -505,7 +505,7 @@ fn tables_after_convergence_shade_multiple_scattering_alone() {
 }
 
 /// A brush dab on the converged image (`repaint_points`): only the segments at the changed points are
-/// shaded again (`Repaint` units light batch by light batch, each batch in parts sized to the
+/// shaded again, with their multiple-scattering partners' multiple scattering (`Repaint` units light batch by light batch, each batch in parts sized to the
 /// budget), and the image equals the one a restart converges to; on an image still refining the dab
 /// is refused (the caller restarts).
 #[test]

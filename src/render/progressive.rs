@@ -127,8 +127,8 @@ pub enum WorkUnit {
         first: u32,
         segments: u32,
     },
-    /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments cover gathered
-    /// from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
+    /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments and their
+    /// partners cover gathered from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
     /// took 30-60 ms on S1 on lavapipe, which pushed the last part that carried them to 60-95 ms).
     RepaintGather { row0: u32, rows: u32 },
 }

@@ -29,20 +29,23 @@ pub struct SegmentTargets {
     /// `shaders/shading.wgsl`, [`super::shade::ShadingHair::ms_key`]), [2]: a repaint's candidates.
     pub work_count: wgpu::Buffer,
     pub work_list: wgpu::Buffer,
-    /// Per multiple-scattering key: 1 + the first light of the last batch that shaded it (0: none).
+    /// Per multiple-scattering key: 1 + the first light of the last batch that claimed it (0: none;
+    /// repaints list their keys without it).
     pub ms_batches: wgpu::Buffer,
     /// The keys listed by the unit's claim (or a repaint's, by `list_repaint_keys`).
     pub ms_list: wgpu::Buffer,
     /// A repaint's candidates for multiple scattering (its segments and their partners, written by
     /// the caller; work_count[2] of them).
     pub ms_candidates: wgpu::Buffer,
-    /// Per segment its key, found by the frame's first light batch (the others and the gather read
-    /// it: the pairing reads the absorption, which a dab may change while the frame refines).
+    /// Per segment its key, found by the frame's (or a repaint's) first light batch (the others and
+    /// the gather read it: the pairing reads the absorption, which a dab may change while the frame
+    /// refines).
     pub ms_keys: wgpu::Buffer,
     /// `shade_segments`' indirect dispatch.
     pub work_args: wgpu::Buffer,
     /// R, TT, TRT at each segment's t = 0, 1/2, 1 (index 3 segment + 2 t), MS.global and MS.local
-    /// at each key's sample (index key: [`super::shade::ShadingHair::ms_point`]). Written by a frame's first light batch, added to by the others.
+    /// at each key's sample (index key: [`super::shade::ShadingHair::ms_point`]). Written by a
+    /// frame's first light batch, added to by the others.
     pub radiance: [wgpu::Buffer; 5],
 }
 
@@ -225,8 +228,8 @@ impl SegmentShadingPass {
     }
 
     /// One light batch over the segments already listed in `work_list` and the keys in `ms_list`
-    /// (`work_count` of them: a repaint's, written by the caller): the dispatch's size and the
-    /// shading, no claim.
+    /// (`work_count` of them: a repaint's segments written by the caller, its keys by
+    /// [`Self::encode_repaint_keys`]): the dispatch's size and the shading, no claim.
     pub fn encode_listed(
         &self,
         device: &wgpu::Device,
