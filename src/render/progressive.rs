@@ -899,15 +899,24 @@ impl Renderer {
     fn start_repaint(&mut self, mut segments: Vec<u32>) {
         segments.sort_unstable();
         segments.dedup();
-        // The partners' multiple scattering is shaded again too (a pair's sample may move with the
-        // paint), so their rows are gathered.
+        // With multiple scattering the partners' is shaded again too (a pair's sample may move with
+        // the paint), so their rows are gathered.
         let with_partners: Vec<u32> = segments
             .iter()
-            .flat_map(|&s| std::iter::once(s).chain(strand_partner(&self.segment_first, s)))
+            .flat_map(|&s| std::iter::once(s).chain(self.repaint_partner(s)))
             .collect();
         self.repaint_rows = self.rows_covered(&with_partners);
         self.repaint = segments;
         self.refinement.stage = Stage::Repaint { batch: 0, first: 0 };
+    }
+
+    /// The segment whose multiple scattering a repaint of segment `s` shades too: its
+    /// [`strand_partner`], with multiple scattering on.
+    fn repaint_partner(&self, s: u32) -> Option<u32> {
+        self.settings
+            .multiple_scattering
+            .then(|| strand_partner(&self.segment_first, s))
+            .flatten()
     }
 
     /// The image rows where `segments` may leave fragments: their ends' projections, widened by
@@ -1866,7 +1875,7 @@ impl Renderer {
                     // whole pairs for the GPU's keys ([`strand_partner`]).
                     candidates = part.to_vec();
                     candidates.extend(part.iter().filter_map(|&s| {
-                        strand_partner(&self.segment_first, s)
+                        self.repaint_partner(s)
                             .filter(|p| self.repaint.binary_search(p).is_err())
                     }));
                     if !candidates.is_empty() {
