@@ -505,9 +505,10 @@ fn tables_after_convergence_shade_multiple_scattering_alone() {
 }
 
 /// A brush dab on the converged image (`repaint_points`): only the segments at the changed points are
-/// shaded again, with their multiple-scattering partners' multiple scattering (`Repaint` units light batch by light batch, each batch in parts sized to the
-/// budget), and the image equals the one a restart converges to; on an image still refining the dab
-/// is refused (the caller restarts).
+/// shaded again, with the multiple scattering of the partners whose pair the dab joined or split
+/// (`Repaint` units light batch by light batch, each batch in parts sized to the budget), and the
+/// image equals the one a restart converges to (a build that shaded no partner missed it by 2.4e-4);
+/// on an image still refining the dab is refused (the caller restarts).
 #[test]
 fn a_dab_repaints_its_segments_and_equals_a_restart() {
     let ctx = context();

@@ -119,16 +119,16 @@ pub enum WorkUnit {
     /// Preview rows [row0, row0 + rows) under every light (the first unit clears the preview).
     Preview { row0: u32, rows: u32 },
     /// A brush dab's repaint ([`Renderer::repaint_points`]): frame batch `batch`'s lights over
-    /// `segments` of the segments at the changed points (with their partners' multiple
-    /// scattering), from the `first`-th (in parts sized to the
+    /// `segments` of the segments at the changed points (with the multiple scattering of the
+    /// partners whose pair the dab joined or split), from the `first`-th (in parts sized to the
     /// budget: a 1-3k-segment stroke took 100-370 ms a batch on S1 on lavapipe in one part).
     Repaint {
         batch: u32,
         first: u32,
         segments: u32,
     },
-    /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments and their
-    /// partners cover gathered from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
+    /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments and the
+    /// partners it shaded cover gathered from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
     /// took 30-60 ms on S1 on lavapipe, which pushed the last part that carried them to 60-95 ms).
     RepaintGather { row0: u32, rows: u32 },
 }
@@ -837,12 +837,13 @@ impl Renderer {
     }
 
     /// A brush dab on an image converged by segment: the segments that join the changed points
-    /// `changed` are shaded again under every light, and their multiple-scattering partners'
-    /// multiple scattering ([`strand_partner`]: a pair's shared sample may move with the paint)
+    /// `changed` are shaded again under every light, with the multiple scattering of their partners
+    /// whose pair the dab joined or split ([`Renderer::repaint_partner`])
     /// ([`WorkUnit::Repaint`] units, light batch by light batch, each in parts sized to the budget),
     /// and the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of
     /// a restart. The dab shows at full resolution after work on its segments alone; every other
-    /// segment's radiance depends on its own points (and its pair's, shaded here) only and stays.
+    /// segment's radiance depends on its own points (and its pair's sharing, whose changes are
+    /// shaded here) only and stays.
     /// (The volume and grid follow later: [`Renderer::rebuild_stale_volume`].) False, nothing
     /// planned, when the image is not converged by segment: the caller restarts.
     pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
@@ -887,6 +888,7 @@ impl Renderer {
                 // Converged, or planned and not started: one repaint of them all.
                 if !stage.image_converged() {
                     segments.append(&mut self.repaint);
+                    self.flips_pending.append(&mut self.repaint_flips);
                 }
                 segments.append(&mut self.repaint_pending);
                 self.start_repaint(segments);
@@ -899,8 +901,12 @@ impl Renderer {
     fn start_repaint(&mut self, mut segments: Vec<u32>) {
         segments.sort_unstable();
         segments.dedup();
-        // With multiple scattering the partners' is shaded again too (a pair's sample may move with
-        // the paint), so their rows are gathered.
+        let mut flips = std::mem::take(&mut self.flips_pending);
+        flips.sort_unstable();
+        flips.dedup();
+        self.repaint_flips = flips;
+        // With multiple scattering the partners' is shaded again too where the paint moved their
+        // pair's sample, so their rows are gathered.
         let with_partners: Vec<u32> = segments
             .iter()
             .flat_map(|&s| std::iter::once(s).chain(self.repaint_partner(s)))
@@ -911,12 +917,18 @@ impl Renderer {
     }
 
     /// The segment whose multiple scattering a repaint of segment `s` shades too: its
-    /// [`strand_partner`], with multiple scattering on.
+    /// [`strand_partner`], with multiple scattering on, where the paint joined or split their pair
+    /// ([`Renderer::repaint_flips`]: the partner's sample moved between its own midpoint and the
+    /// pair's shared point). A pair that stays joined moves its sample only when its shared point's
+    /// absorption changes, and both its segments are repainted then; one that stays split keeps
+    /// each segment's own.
     fn repaint_partner(&self, s: u32) -> Option<u32> {
-        self.settings
-            .multiple_scattering
-            .then(|| strand_partner(&self.segment_first, s))
-            .flatten()
+        if !self.settings.multiple_scattering
+            || self.repaint_flips.binary_search(&(s & !1)).is_err()
+        {
+            return None;
+        }
+        strand_partner(&self.segment_first, s)
     }
 
     /// The image rows where `segments` may leave fragments: their ends' projections, widened by
@@ -977,6 +989,8 @@ impl Renderer {
         };
         // Whatever the new plan shades, it shades whole: no repaint waits.
         self.repaint_pending.clear();
+        self.flips_pending.clear();
+        self.repaint_flips.clear();
         let r = &mut self.refinement;
         r.preview_started = false;
         r.preview_new_view = false;

@@ -420,6 +420,14 @@ pub struct Renderer {
     pub(super) repaint_rows: std::ops::Range<u32>,
     /// Segments of dabs that came while a repaint was under way: repainted after it.
     pub(super) repaint_pending: Vec<u32>,
+    /// Whether each pair of segments 2k, 2k + 1 shares its multiple-scattering sample (index k:
+    /// [`super::shade::ms_paired`] at the absorption on the GPU), kept to notice a dab that changes it.
+    pub(super) ms_pairs: Vec<bool>,
+    /// The pairs (their even segments) whose sharing dabs changed since the last repaint started:
+    /// their partners' multiple scattering moved ([`Renderer::repaint_points`]).
+    pub(super) flips_pending: Vec<u32>,
+    /// The pairs whose sharing changed for the repaint under way (sorted even segments).
+    pub(super) repaint_flips: Vec<u32>,
     /// Every [`super::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
     /// preview draws (None for a hair of few strands).
     pub(super) preview_strands: Option<super::kbuffer::SegmentSubset>,
@@ -457,6 +465,13 @@ fn environment_buffer(device: &wgpu::Device, map: Option<&BackgroundMap>) -> wgp
         contents: bytemuck::cast_slice(texels),
         usage: wgpu::BufferUsages::STORAGE,
     })
+}
+
+/// [`super::shade::ms_paired`] of every pair of segments 2k, 2k + 1 (index k).
+fn all_ms_pairs(segment_first: &[u32], sigma_a: &[[f32; 3]]) -> Vec<bool> {
+    (0..segment_first.len().div_ceil(2))
+        .map(|k| super::shade::ms_paired(segment_first, sigma_a, 2 * k as u32))
+        .collect()
 }
 
 fn gpu_lights(lights: &[SrbfLight]) -> Vec<GpuLight> {
@@ -626,6 +641,8 @@ impl Renderer {
             })
         };
         let gpu_hair_segments = gpu_hair.segment_count;
+        let segment_first = super::shade::segment_starts(hair);
+        let ms_pairs = all_ms_pairs(&segment_first, sigma_a);
         let mut renderer = Self {
             hair: gpu_hair,
             point_count: hair.point_count(),
@@ -690,10 +707,13 @@ impl Renderer {
             volume_absorption_old: false,
             shadow_grid_dirty: true,
             single_kept: false,
-            segment_first: super::shade::segment_starts(hair),
+            segment_first,
             repaint: Vec::new(),
             repaint_rows: 0..0,
             repaint_pending: Vec::new(),
+            ms_pairs,
+            flips_pending: Vec::new(),
+            repaint_flips: Vec::new(),
             row_readback: None,
             preview_strands: (hair.strand_count() >= super::preview::THIN_PREVIEW_STRANDS)
                 .then(|| {
@@ -1048,8 +1068,31 @@ impl Renderer {
                 bytemuck::cast_slice(&v),
             );
         }
+        self.note_pair_flips(sigma_a, changed);
         self.absorption_deferred();
         Ok(())
+    }
+
+    /// Updates [`Renderer::ms_pairs`] for the pairs holding the points `changed`, now at absorption
+    /// `sigma_a`, and lists those whose sharing changed in [`Renderer::flips_pending`].
+    fn note_pair_flips(&mut self, sigma_a: &[[f32; 3]], changed: &[u32]) {
+        for &i in changed {
+            // The pairs of the segment from point i and of the one to it.
+            for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
+                let Ok(k) = self.segment_first.binary_search(&p) else {
+                    continue;
+                };
+                let even = k as u32 & !1;
+                let paired = super::shade::ms_paired(&self.segment_first, sigma_a, even);
+                let Some(was) = self.ms_pairs.get_mut(k / 2) else {
+                    continue;
+                };
+                if *was != paired {
+                    *was = paired;
+                    self.flips_pending.push(even);
+                }
+            }
+        }
     }
 
     /// The absorption changed (shown at once): the volume and grid that carry it follow later.
@@ -1090,7 +1133,11 @@ impl Renderer {
         true
     }
 
-    fn upload_absorption(&self, ctx: &GpuContext, sigma_a: &[[f32; 3]]) -> Result<(), RenderError> {
+    fn upload_absorption(
+        &mut self,
+        ctx: &GpuContext,
+        sigma_a: &[[f32; 3]],
+    ) -> Result<(), RenderError> {
         if sigma_a.len() != self.point_count {
             return Err(RenderError::AbsorptionCount {
                 points: self.point_count,
@@ -1100,6 +1147,9 @@ impl Renderer {
         let v: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
         ctx.queue
             .write_buffer(&self.hair.absorption, 0, bytemuck::cast_slice(&v));
+        // Every point changes: the refinement restarts, shading every segment whole.
+        self.ms_pairs = all_ms_pairs(&self.segment_first, sigma_a);
+        self.flips_pending.clear();
         Ok(())
     }
 

@@ -94,12 +94,7 @@ impl ShadingHair<'_> {
     /// `ms_paired` of the WGSL: whether segments `even` and `even` + 1 share a multiple-scattering
     /// sample: the second continues the first and their three points' absorption is the same.
     fn ms_paired(&self, even: u32) -> bool {
-        if strand_partner(&self.segments, even).is_none() {
-            return false;
-        }
-        let i0 = self.segments[even as usize] as usize;
-        let s = self.sigma_a[i0 + 1];
-        self.sigma_a[i0] == s && self.sigma_a[i0 + 2] == s
+        ms_paired(&self.segments, self.sigma_a, even)
     }
 
     /// `ms_key` of the WGSL: multiple scattering varies slowly along a strand (spread over sigma_f,
@@ -135,6 +130,17 @@ impl ShadingHair<'_> {
             segment: key,
         }
     }
+}
+
+/// `ms_paired` of the WGSL over a hair's segments (`segments`: each one's first point) and absorption
+/// per point: whether segments `even` and `even` + 1 share a multiple-scattering sample.
+pub fn ms_paired(segments: &[u32], sigma_a: &[[f32; 3]], even: u32) -> bool {
+    if strand_partner(segments, even).is_none() {
+        return false;
+    }
+    let i0 = segments[even as usize] as usize;
+    let s = sigma_a[i0 + 1];
+    sigma_a[i0] == s && sigma_a[i0 + 2] == s
 }
 
 /// The segment that makes a multiple-scattering pair with segment `seg` where their absorption allows
