@@ -52,7 +52,7 @@ const FLAG_SINGLE_KEPT: u32 = 8u;
 @group(0) @binding(31) var<storage, read_write> ms_list: array<u32>;
 @group(0) @binding(32) var<storage, read_write> ms_keys: array<u32>;
 // A repaint's candidates for multiple scattering (work_count[2] of them, written by the caller):
-// its segments and their partners.
+// its segments and the partners of the pairs its dabs joined or split.
 @group(0) @binding(33) var<storage, read> ms_candidates: array<u32>;
 
 struct ShadingPoint {
@@ -346,8 +346,8 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// A repaint's multiple-scattering list: of its candidates (its segments and their partners, whole
-// pairs), the keys (`claimed_key`: found on the first light batch, kept for the others), one
+// A repaint's multiple-scattering list: of its candidates (its segments, and whole pairs where its
+// dabs joined or split them), the keys (`claimed_key`: found on the first light batch, kept for the others), one
 // invocation each, in workgroups of 64 as rows of 65535.
 @compute @workgroup_size(64)
 fn list_repaint_keys(@builtin(global_invocation_id) id: vec3<u32>) {

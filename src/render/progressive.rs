@@ -1884,9 +1884,13 @@ impl Renderer {
                 if let Some(s) = &self.segment_targets {
                     ctx.queue
                         .write_buffer(&s.work_list, 0, bytemuck::cast_slice(part));
-                    // Multiple scattering's candidates: the part's segments and the partners not
-                    // listed themselves (each once in the whole repaint: a segment has one partner),
-                    // whole pairs for the GPU's keys ([`strand_partner`]).
+                    // Multiple scattering's candidates: the part's segments and the partners of the
+                    // pairs the dabs joined or split, not listed themselves (each once in the whole
+                    // repaint: a segment has one partner), whole pairs for the GPU's keys there
+                    // ([`Renderer::repaint_partner`]). A pair that stays joined with one segment
+                    // listed keeps its key's sample: its shared point did not change (else both
+                    // segments are listed), and the GPU, which lists a candidate only where it is
+                    // its own key, leaves it.
                     candidates = part.to_vec();
                     candidates.extend(part.iter().filter_map(|&s| {
                         self.repaint_partner(s)

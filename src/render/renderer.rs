@@ -1034,7 +1034,9 @@ impl Renderer {
 
     /// [`Renderer::set_absorption_deferred`] for a few points (a brush dab): `sigma_a` holds every
     /// point's absorption, and only the points `changed` (sorted) are written, in runs (gaps of a few
-    /// unchanged points are written along rather than split).
+    /// unchanged points are written along rather than split). Every point not in `changed` must
+    /// hold what the renderer has already (the runs write some of them, and the pairs' sharing,
+    /// [`Renderer::ms_pairs`], reads the changed points' neighbours from `sigma_a`).
     pub fn set_absorption_points_deferred(
         &mut self,
         ctx: &GpuContext,
@@ -1644,6 +1646,7 @@ impl Renderer {
         self.refinement.complete_frame();
         // The whole frame is shaded: no dab waits for a repaint, nothing is kept.
         self.repaint_pending.clear();
+        self.flips_pending.clear();
         self.single_kept = false;
     }
 

@@ -34,8 +34,8 @@ pub struct SegmentTargets {
     pub ms_batches: wgpu::Buffer,
     /// The keys listed by the unit's claim (or a repaint's, by `list_repaint_keys`).
     pub ms_list: wgpu::Buffer,
-    /// A repaint's candidates for multiple scattering (its segments and their partners, written by
-    /// the caller; work_count[2] of them).
+    /// A repaint's candidates for multiple scattering (its segments and the partners of the pairs its
+    /// dabs joined or split, written by the caller; work_count[2] of them).
     pub ms_candidates: wgpu::Buffer,
     /// Per segment its key, found by the frame's (or a repaint's) first light batch (the others and
     /// the gather read it: the pairing reads the absorption, which a dab may change while the frame

@@ -346,9 +346,9 @@ impl ShadingPass {
     }
 
     /// A repaint's light batch, no claim (written by the caller: the segments in the segment
-    /// targets' work list, `candidates` segments and partners in `ms_candidates`, the counts): the
-    /// candidates' keys listed, then the listed segments and keys shaded again (the rows gather
-    /// after the last batch: [`Self::encode_repaint_gather`]).
+    /// targets' work list, `candidates` segments and flipped pairs' partners in `ms_candidates`, the
+    /// counts): the candidates' keys listed, then the listed segments and keys shaded again (the
+    /// rows gather after the last batch: [`Self::encode_repaint_gather`]).
     pub fn encode_repaint(
         &self,
         device: &wgpu::Device,
