@@ -623,14 +623,7 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     let middle = scene.hair.strand_count() / 2;
     let first = dab(&mut live, middle);
     assert!(live.repaint_points(&first));
-    let p = live.refine(&ctx).expect("refine");
-    assert!(matches!(
-        p.submitted,
-        Some(WorkUnit::Repaint { batch: 0, .. })
-    ));
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("poll");
+    submit_first_repaint_unit(&mut live, &ctx);
     let second = dab(&mut live, middle + 1);
     assert!(live.repaint_points(&second));
     let units = refine_all(&mut live, &ctx);
@@ -698,14 +691,7 @@ fn a_dab_repaints_its_segments_and_equals_a_restart() {
     live.set_absorption_points_deferred(&ctx, &sigma_a, &points)
         .expect("absorption");
     assert!(live.repaint_points(&points));
-    let p = live.refine(&ctx).expect("refine");
-    assert!(matches!(
-        p.submitted,
-        Some(WorkUnit::Repaint { batch: 0, .. })
-    ));
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("poll");
+    submit_first_repaint_unit(&mut live, &ctx);
     for &i in &points {
         sigma_a[i as usize] = scene.sigma_a[i as usize];
     }
@@ -858,6 +844,18 @@ fn refine_events(r: &mut Renderer, ctx: &GpuContext) -> Vec<Event> {
 }
 
 /// `restarted` restarted and refined to convergence: (the frame of `live`, the restart's frame).
+/// Refines once: the repaint planned starts (its first light batch's first part), and waits for it.
+fn submit_first_repaint_unit(live: &mut Renderer, ctx: &GpuContext) {
+    let p = live.refine(ctx).expect("refine");
+    assert!(matches!(
+        p.submitted,
+        Some(WorkUnit::Repaint { batch: 0, .. })
+    ));
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+}
+
 fn frames_after_restart(
     live: &Renderer,
     restarted: &mut Renderer,
