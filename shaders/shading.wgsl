@@ -347,8 +347,8 @@ fn claim_segments(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // A repaint's multiple-scattering list: of its candidates (its segments, and whole pairs where its
-// dabs joined or split them), the keys (`claimed_key`: found on the first light batch, kept for the others), one
-// invocation each, in workgroups of 64 as rows of 65535.
+// dabs joined or split them), the keys (`claimed_key`: found on the first light batch, kept for the
+// others), one invocation each, in workgroups of 64 as rows of 65535.
 @compute @workgroup_size(64)
 fn list_repaint_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x + id.y * 65535u * 64u;

@@ -128,8 +128,9 @@ pub enum WorkUnit {
         segments: u32,
     },
     /// After a repaint's last batch: rows [row0, row0 + rows) of those its segments and the
-    /// partners it shaded cover gathered from the segments and resolved (in bands sized to the budget: the rows of a dab's segments
-    /// took 30-60 ms on S1 on lavapipe, which pushed the last part that carried them to 60-95 ms).
+    /// partners it shaded cover gathered from the segments and resolved (in bands sized to the
+    /// budget: the rows of a dab's segments took 30-60 ms on S1 on lavapipe, which pushed the last
+    /// part that carried them to 60-95 ms).
     RepaintGather { row0: u32, rows: u32 },
 }
 
@@ -863,15 +864,10 @@ impl Renderer {
         if !ready {
             return false;
         }
-        let mut segments = Vec::new();
-        for &i in changed {
-            // The segment from point i, and the one to it (from i - 1, in the same strand).
-            for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
-                if let Ok(k) = self.segment_first.binary_search(&p) {
-                    segments.push(k as u32);
-                }
-            }
-        }
+        let mut segments: Vec<u32> = changed
+            .iter()
+            .flat_map(|&i| self.segments_at_point(i))
+            .collect();
         if segments.is_empty() {
             return true;
         }

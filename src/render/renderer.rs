@@ -1078,23 +1078,31 @@ impl Renderer {
     /// Updates [`Renderer::ms_pairs`] for the pairs holding the points `changed`, now at absorption
     /// `sigma_a`, and lists those whose sharing changed in [`Renderer::flips_pending`].
     fn note_pair_flips(&mut self, sigma_a: &[[f32; 3]], changed: &[u32]) {
-        for &i in changed {
-            // The pairs of the segment from point i and of the one to it.
-            for p in [Some(i), i.checked_sub(1)].into_iter().flatten() {
-                let Ok(k) = self.segment_first.binary_search(&p) else {
-                    continue;
-                };
-                let even = k as u32 & !1;
-                let paired = super::shade::ms_paired(&self.segment_first, sigma_a, even);
-                let Some(was) = self.ms_pairs.get_mut(k / 2) else {
-                    continue;
-                };
-                if *was != paired {
-                    *was = paired;
-                    self.flips_pending.push(even);
-                }
+        let segments: Vec<u32> = changed
+            .iter()
+            .flat_map(|&i| self.segments_at_point(i))
+            .collect();
+        for k in segments {
+            let even = k & !1;
+            let paired = super::shade::ms_paired(&self.segment_first, sigma_a, even);
+            let Some(was) = self.ms_pairs.get_mut(k as usize / 2) else {
+                continue;
+            };
+            if *was != paired {
+                *was = paired;
+                self.flips_pending.push(even);
             }
         }
+    }
+
+    /// The segments that join point `i`: the one from it and the one to it (from i - 1, in the
+    /// same strand).
+    pub(super) fn segments_at_point(&self, i: u32) -> impl Iterator<Item = u32> + '_ {
+        [Some(i), i.checked_sub(1)]
+            .into_iter()
+            .flatten()
+            .filter_map(|p| self.segment_first.binary_search(&p).ok())
+            .map(|k| k as u32)
     }
 
     /// The absorption changed (shown at once): the volume and grid that carry it follow later.

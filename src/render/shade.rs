@@ -91,12 +91,6 @@ impl ShadingHair<'_> {
         }
     }
 
-    /// `ms_paired` of the WGSL: whether segments `even` and `even` + 1 share a multiple-scattering
-    /// sample: the second continues the first and their three points' absorption is the same.
-    fn ms_paired(&self, even: u32) -> bool {
-        ms_paired(&self.segments, self.sigma_a, even)
-    }
-
     /// `ms_key` of the WGSL: multiple scattering varies slowly along a strand (spread over sigma_f,
     /// read from the coarse shadow grid), so it is evaluated once per pair of consecutive segments of
     /// a strand (2k and 2k + 1, when 2k + 1 continues 2k and the pair's three points have the same
@@ -106,14 +100,18 @@ impl ShadingHair<'_> {
     /// along the pair) is its own key, sampled at its midpoint.
     pub fn ms_key(&self, seg: u32) -> u32 {
         let even = seg & !1;
-        if self.ms_paired(even) { even } else { seg }
+        if ms_paired(&self.segments, self.sigma_a, even) {
+            even
+        } else {
+            seg
+        }
     }
 
     /// `ms_point` of the WGSL: where multiple scattering is evaluated for key `key`
     /// ([`ShadingHair::ms_key`]): a pair's shared point, its tangent the pair's chord (the first
     /// segment's where the pair folds back onto its first point), or an unpaired segment's midpoint.
     pub fn ms_point(&self, key: u32) -> ShadingPoint {
-        if key & 1 == 1 || !self.ms_paired(key) {
+        if key & 1 == 1 || !ms_paired(&self.segments, self.sigma_a, key) {
             return self.segment_point(key, 0.5);
         }
         let i0 = self.segments[key as usize] as usize;
@@ -133,7 +131,8 @@ impl ShadingHair<'_> {
 }
 
 /// `ms_paired` of the WGSL over a hair's segments (`segments`: each one's first point) and absorption
-/// per point: whether segments `even` and `even` + 1 share a multiple-scattering sample.
+/// per point: whether segments `even` and `even` + 1 share a multiple-scattering sample (the second
+/// continues the first and their three points' absorption is the same).
 pub fn ms_paired(segments: &[u32], sigma_a: &[[f32; 3]], even: u32) -> bool {
     if strand_partner(segments, even).is_none() {
         return false;
