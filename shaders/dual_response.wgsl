@@ -119,7 +119,7 @@ fn dual_integrand(p: FastHairParams, d: DualIntegrand, ti: f32) -> vec3<f32> {
 }
 
 // The dual terms' quadrature segments (twin: dual_response.rs): half the single-scattering
-// quadrature's, at least 2 (the renderer's 4 give 2: one inner node where three were).
+// quadrature's, at least 2 (the renderer's 4 give 2: one inner node).
 fn dual_quadrature_segments(m: u32) -> u32 {
     return max(m / 2u, 2u);
 }

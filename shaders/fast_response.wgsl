@@ -256,8 +256,8 @@ fn weighted_integrand(params: FastHairParams, lobe: u32, light: SrbfInFrame, phi
 // The quadrature of Sec. 4.2.2 node by node (twin: Quadrature in fast_response.rs): nodes s = 0..=m are
 // fed in order; each even node closes the pair of segments before it with their parabola, a last odd
 // node (m odd) its linear segment. One call site of the integrand per quadrature keeps the shading
-// shaders small: every call is inlined, and three call sites per quadrature made the segment kernel
-// take lavapipe 7 s to compile.
+// shaders small: every call is inlined, and with three call sites per quadrature the segment kernel
+// takes lavapipe about 7 s to compile.
 struct Quadrature {
     mu: f32,
     l: f32,
@@ -273,7 +273,7 @@ struct Quadrature {
 // Node 0, the pole -pi/2. Every integrand of the quadratures carries the longitudinal factor's
 // cos(theta_i) clamped at 0 (longitudinal_factor), so the integrand vanishes at both ends (exactly in
 // the Rust twin, where cos(FRAC_PI_2) < 0 in f32; a GPU's cos, accurate to 2^-11, could only have added
-// a spurious value there): the ends are not evaluated (an early return there had not saved the
+// a spurious value there): the ends are not evaluated (an early return there does not save the
 // integrands' table reads on lavapipe), only the m - 1 inner nodes, and quadrature_end closes the rule
 // at +pi/2.
 fn quadrature_start(mu: f32, l: f32) -> Quadrature {

@@ -122,7 +122,7 @@ fn path_scattering(s: PathIntegrals) -> ForwardScattering {
 
 // A cone of half-angle `half_angle` marched as cone_optical_depth marches it (steps of half its
 // width, pyramid levels of that width; 0: a thin ray on level 0), so the direct fraction is that
-// cone's exp(-tau). The reference the shadow grid's sweeps replaced (tests).
+// cone's exp(-tau). The reference the shadow grid's sweeps are tested against.
 fn forward_scattering(p: vec3<f32>, omega: vec3<f32>, half_angle: f32, skip: f32) -> ForwardScattering {
     let exit = pyramid_exit(p, omega);
     let tn = tan(min(half_angle, 1.5));

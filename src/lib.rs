@@ -8,6 +8,7 @@ pub mod editor;
 pub mod envmap;
 pub mod gpu;
 pub mod hair;
+pub mod live;
 pub mod paint;
 pub mod render;
 pub mod scattering;

@@ -453,7 +453,7 @@ fn the_absorption_axis_interpolates_the_exact_terms() {
         println!(
             "{name}: absorption axis against the exact absorption: median {median:.2e}, p95 {p95:.2e}, max {max:.2e}"
         );
-        // The linear reading in theta (the tables' `lookup`, M^L's before) is printed for comparison:
+        // The linear reading in theta (the tables' `lookup`) is printed for comparison:
         // at the exact theta its A_b p95 is 1.0 %, the log-linear reading's 0.84 %.
         let bound = if name.ends_with("the linear reading") {
             0.015

@@ -115,7 +115,7 @@ fn converge(h: &mut Harness<'static, EditorApp>) {
 
 /// The viewport's converged image, read back from the renderer.
 fn image(h: &Harness<'static, EditorApp>) -> Frame {
-    let live = h.state().live.as_ref().expect("a live scene");
+    let live = h.state().live.as_ref().expect("a live scene").lock();
     live.renderer.read_frame(&live.ctx).expect("read back")
 }
 
@@ -295,7 +295,7 @@ fn rebuilds_before_first_image(
     let (mut rebuilds, t) = (0, Instant::now());
     loop {
         h.step();
-        let live = h.state().live.as_ref().expect("a scene");
+        let live = h.state().live.as_ref().expect("a scene").lock();
         // A rebuild submitted in the step that showed the full image came after it.
         if live.refine_started > before
             && let Some(full) = live.full_image_in
@@ -341,7 +341,13 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     // Raising sigma_a (the dark-brown preset) darkens the hair; blond lightens it. The new absorption
     // is shaded before the volume and shadow grid are rebuilt for it (single scattering reads only the
     // grid's transmittance, which absorption does not change).
-    let started = h.state().live.as_ref().expect("a scene").refine_started;
+    let started = h
+        .state()
+        .live
+        .as_ref()
+        .expect("a scene")
+        .lock()
+        .refine_started;
     click(&mut h, "dark brown");
     let rebuilt = rebuilds_before_first_image(&mut h, started, "dark brown");
     assert_eq!(rebuilt, 0, "the first image waited for the volume");
@@ -411,7 +417,13 @@ fn a_narrower_highlight_is_sharper() {
         v[(v.len() * 999) / 1000]
     };
     let wide = r_peak(&image(&h));
-    let before = h.state().live.as_ref().expect("a scene").refine_started;
+    let before = h
+        .state()
+        .live
+        .as_ref()
+        .expect("a scene")
+        .lock()
+        .refine_started;
     slider(&h, "β_R width").set_value_accesskit(3.0);
     // The new look shows before the shadow grid is rebuilt for the new tables (with dual scattering
     // their forward terms need it): the first image is shaded with the grid already built, and the
@@ -472,7 +484,7 @@ fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
     let (mut draft_in, mut table_in) = (None, None);
     while table_in.is_none() {
         h.step();
-        let live = h.state().live.as_ref().expect("a scene");
+        let live = h.state().live.as_ref().expect("a scene").lock();
         let table = live.renderer.azimuthal_table();
         if table.eta == 1.62 {
             if table.draft {
@@ -625,7 +637,7 @@ fn navigation_orbits_zooms_and_frames() {
     h.key_press(egui::Key::Home);
     h.step();
     let framed = h.state().camera.expect("a camera");
-    let hair = h.state().live.as_ref().expect("live").hair.clone();
+    let hair = h.state().live.as_ref().expect("live").lock().hair.clone();
     let (lo, hi) = hair.bounds();
     let mid = 0.5 * (lo + hi);
     assert!((glam::Vec3::from(framed.target) - mid).length() < 1e-4);
@@ -636,7 +648,7 @@ fn navigation_orbits_zooms_and_frames() {
     // A slow orbit (a move per UI frame) shows previews while the button is held: each move waits
     // for the preview under way instead of restarting it.
     converge(&mut h);
-    let shown = h.state().live.as_ref().expect("live").previews_shown;
+    let shown = h.state().live.as_ref().expect("live").lock().previews_shown;
     h.hover_at(centre);
     h.step();
     h.event(egui::Event::PointerButton {
@@ -653,7 +665,7 @@ fn navigation_orbits_zooms_and_frames() {
         h.step();
         std::thread::sleep(Duration::from_millis(10));
     }
-    let during = h.state().live.as_ref().expect("live").previews_shown - shown;
+    let during = h.state().live.as_ref().expect("live").lock().previews_shown - shown;
     h.event(egui::Event::PointerButton {
         pos: centre + egui::vec2(60.0, 0.0),
         button: egui::PointerButton::Middle,
@@ -661,7 +673,7 @@ fn navigation_orbits_zooms_and_frames() {
         modifiers: egui::Modifiers::NONE,
     });
     h.step();
-    let live = h.state().live.as_ref().expect("live");
+    let live = h.state().live.as_ref().expect("live").lock();
     println!(
         "previews shown during a 60-frame orbit: {during} ({}x{}, preview divisor {})",
         live.display.width,
@@ -669,6 +681,7 @@ fn navigation_orbits_zooms_and_frames() {
         live.renderer.preview_factor()
     );
     assert!(during >= 2, "the viewport froze during the orbit");
+    drop(live);
     converge(&mut h);
 }
 
@@ -950,7 +963,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     let mut h = harness(session, &dir, false);
     converge(&mut h);
     let before = image(&h);
-    let sigma_before = h.state().live.as_ref().unwrap().sigma_a.clone();
+    let sigma_before = h.state().live.as_ref().unwrap().lock().sigma_a.clone();
     // B over the viewport takes the brush; the picker follows the view's depth.
     let rect = h.state().viewport_rect.expect("a viewport");
     h.hover_at(rect.center());
@@ -959,7 +972,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     h.step();
     assert_eq!(h.state().tool, strandlight::editor::brush_tool::Tool::Brush);
     let t = Instant::now();
-    while h.state().live.as_ref().unwrap().picker().is_none() {
+    while h.state().live.as_ref().unwrap().lock().picker().is_none() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(30), "no picker");
@@ -1003,7 +1016,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     );
     assert!(painted.len() > 10, "the stroke painted the hair");
     // The points painted are the picker's selection for the dabs along the path, at full strength.
-    let live = app.live.as_ref().unwrap();
+    let live = app.live.as_ref().unwrap().lock();
     let picker = live.picker().expect("picker");
     let radius = app.brush_radius_render_px();
     let to_render = |p: egui::Pos2| {
@@ -1039,11 +1052,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
         let v = layer.get().points[i as usize];
         assert_eq!(v[3], 1.0);
         assert!((0..3).all(|c| (v[c] - dye[c]).abs() < 1e-6));
-        let q = project(
-            &picker.view.camera,
-            app.live.as_ref().unwrap().hair.positions[i as usize],
-        )
-        .unwrap();
+        let q = project(&picker.view.camera, live.hair.positions[i as usize]).unwrap();
         let (dx, dy) = (rb[0] - ra[0], rb[1] - ra[1]);
         let s = (((q.x - ra[0]) * dx + (q.y - ra[1]) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
         let d = ((q.x - ra[0] - s * dx).powi(2) + (q.y - ra[1] - s * dy).powi(2)).sqrt();
@@ -1063,13 +1072,13 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
         };
         assert_eq!(*s1, want, "point {i}");
     }
+    drop(live);
     let session_after = h.state().session.clone();
     converge(&mut h);
     let after = image(&h);
     // Pixels showing a painted segment move toward the dye (bluer); the others do not change
     // (single scattering: the shadows' transmittance does not read absorption).
-    let live = h.state().live.as_ref().unwrap();
-    let hair = &live.hair;
+    let hair = h.state().live.as_ref().unwrap().lock().hair.clone();
     let painted_point = |p: u32| layer.get().points[p as usize][3] > 0.0;
     let segment_start: Vec<u32> = (0..hair.strand_count())
         .flat_map(|s| {
@@ -1128,9 +1137,9 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     // Undo restores the absorption bit for bit and the image; redo reapplies the stroke.
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    let live = h.state().live.as_ref().unwrap();
+    let sigma_now = h.state().live.as_ref().unwrap().lock().sigma_a.clone();
     assert!(
-        live.sigma_a == sigma_before,
+        sigma_now == sigma_before,
         "undo restores the absorption bit for bit"
     );
     assert!(
@@ -1196,7 +1205,7 @@ fn paint_stroke(h: &mut Harness<'static, EditorApp>, brush: strandlight::paint::
     h.key_press(egui::Key::B);
     h.step();
     let t = Instant::now();
-    while h.state().live.as_ref().unwrap().picker().is_none() {
+    while h.state().live.as_ref().unwrap().lock().picker().is_none() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(30), "no picker");
@@ -1308,7 +1317,7 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
             out_file.as_os_str(),
         ]);
     }
-    let live = again.state().live.as_ref().unwrap();
+    let live = again.state().live.as_ref().unwrap().lock();
     let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
     let bytes = std::fs::read(&hair_file).unwrap();
     let (back, _, _) =

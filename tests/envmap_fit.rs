@@ -1,4 +1,4 @@
-//! Environment loading and the SRBF fit (issue: HDR environments).
+//! Environment loading and the SRBF fit (docs/environments.md).
 
 mod common;
 

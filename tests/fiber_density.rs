@@ -252,7 +252,7 @@ fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
     }
     println!("worst absolute difference {worst:.4}");
     // Measured: 0.023 (deep inside a clump under the widest light, where the seven cones see less
-    // of the back hemisphere than G does; one averaged cone was off by 0.085).
+    // of the back hemisphere than G does; one averaged cone would be off by 0.085).
     assert!(worst < 0.04, "{worst}");
 }
 
@@ -322,7 +322,7 @@ fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
 
 /// What the sweeps read at their midpoints ([`MidplaneSamples`]: the pyramid sampled once on the
 /// planes between the grid's slices, read bilinearly) against the pyramid read at each exact midpoint
-/// (what every sweep did before): the crossing density along random directions on the clump, at the
+/// (the cone march's reading): the crossing density along random directions on the clump, at the
 /// midpoints of every seventh grid point where either reading sees hair.
 #[test]
 fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {

@@ -234,9 +234,9 @@ fn wgsl_fast_response_equals_the_rust_twin() {
     );
     println!("{beyond} values differ by more than 1e-3");
     assert!(compared >= 1000);
-    // Measured on lavapipe: p99 8.5e-6, worst 2.3e-5 (with the exact window integrals computed per
-    // point the worst was 2.8e-3: root finding near a caustic amplified f32 rounding; the azimuthal
-    // table is read, not solved). Bounded with room for other drivers' transcendentals.
+    // Measured on lavapipe: p99 8.5e-6, worst 2.3e-5 (the azimuthal table is read, not solved per
+    // point, where root finding near a caustic would amplify f32 rounding to ~3e-3). Bounded with
+    // room for other drivers' transcendentals.
     assert!(
         diffs[diffs.len() * 99 / 100] <= 1e-4,
         "p99 relative difference"

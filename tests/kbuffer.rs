@@ -1,5 +1,5 @@
 //! The ordered K-buffer (Yu 2012): coverage of sub-pixel fibres, the GPU's K-buffer against its CPU
-//! twin, the K-buffer against the A-buffer (all fragments, sorted) for K = 1 .. 16, and anti-aliasing
+//! twin, the K-buffer against the A-buffer (all fragments, sorted) for K = 1 .. 32, and anti-aliasing
 //! against a 16x supersampled render.
 
 mod common;
@@ -375,7 +375,7 @@ fn anti_aliasing_against_a_16x_supersampled_render() {
     let kbuffer = render(&coarse);
     let (colour, alpha) = compare(&kbuffer);
     let got = coverage(&mut kbuffer.beauty.iter().map(|p| p[3] as f64));
-    // The old visibility: opaque ribbons at least a pixel wide.
+    // For comparison: opaque ribbons at least a pixel wide (no sub-pixel coverage).
     let mut ribbons = coarse.clone();
     ribbons.min_width_px = 1.0;
     let wide = render(&ribbons);

@@ -1,4 +1,4 @@
-//! The exact Marschner model against brute force (issue: foundation).
+//! The exact Marschner model against brute force (docs/hair-model.md).
 //! Each test prints what it measured; run with `--nocapture` to see the tables.
 
 use rayon::prelude::*;

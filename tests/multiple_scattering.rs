@@ -77,9 +77,9 @@ fn zero_density_factors_give_single_scattering_exactly() {
     // The shadow grid takes single scattering's transmittance from the forward sweeps when dual
     // scattering is on (the same samples and sums in another function): the compiler may round them
     // differently, and at an optical depth of ~10 an ulp per step is 1e-4 of exp(-tau). Measured 0
-    // (2026-11-29, lavapipe).
+    // on lavapipe.
     assert!(worst <= 1e-4);
-    // Measured 0.023 (2026-11-29). On a sparse bob there is little hair behind a point to scatter light
+    // Measured 0.023. On a sparse bob there is little hair behind a point to scatter light
     // back (the local term's finite depth); the path tracer's share on a 300-strand blond bob under
     // the sunny and studio maps is 0.04-0.045 (tests/path_trace.rs).
     assert!(share > 0.01, "dual scattering adds light to blond hair");
@@ -109,7 +109,7 @@ fn lighter_hair_has_a_larger_multiple_scattering_share_and_dark_hair_none() {
             "the MS share falls as sigma_a grows: {shares:?}"
         );
     }
-    // Measured 0.216 (2026-11-29); the path tracer's share on a lossless 1500-strand bob in a white
+    // Measured 0.216; the path tracer's share on a lossless 1500-strand bob in a white
     // furnace is 0.22, on a 1500-strand blond bob under the sunny and studio maps 0.14-0.17.
     assert!(
         shares[0] > 0.15,

@@ -1,4 +1,4 @@
-//! The head in the picture (issue 16, part 3): drawn opaque in front of the hair behind it, shaded as a
+//! The head in the picture: drawn opaque in front of the hair behind it, shaded as a
 //! diffuse surface under the SRBF lights with the hair's shadows, and held in the fiber-density
 //! volume as a solid so it shadows the hair. On lavapipe: the occluder pass and the volume's solid
 //! against their CPU twins, the AOVs adding up to the beauty, and the head's shadow under a narrow

@@ -209,10 +209,9 @@ fn white_furnace_lossless_hair() {
 /// TRT components of both frames: the renderer's are its shadowed single scattering, the path tracer's
 /// its order 0 with shadow rays) and full transport (the beauty).
 ///
-/// Asserted: full transport within 10 % everywhere (the issue's bound). Single scattering within 5 %
-/// on the sparse bob and 10 % on the denser one, where the fiber-density volume's shadows are lighter
-/// than the explicit fibers' in sunny light (measured +9 % blond, +8 % brown; the light-space shadows
-/// of the real-time renderer issue are the place to close that). Measured (2026-11-29, d_f = d_b =
+/// Asserted: full transport within 10 % everywhere. Single scattering within 5 % on the sparse bob
+/// and 10 % on the denser one, where the fiber-density volume's shadows are lighter than the
+/// explicit fibers' in sunny light (measured +9 % blond, +8 % brown). Measured (d_f = d_b =
 /// 0.7): full transport within 2 % on the sparse bob and 5 % on the denser one; the renderer's MS share
 /// is about half the path tracer's on both (0.024 / 0.045 and 0.089 / 0.165 blond sunny), which the
 /// lighter shadows offset on the denser bob.

@@ -1,4 +1,4 @@
-//! The renderer's white furnace (issue 17): lossless hair (sigma_a = 0) in a uniform white environment
+//! The renderer's white furnace: lossless hair (sigma_a = 0) in a uniform white environment
 //! must render at the environment's radiance, not at twice it. The environment is a uniform white map
 //! fitted with the project's SRBF fit, as a user would load it; the renderer runs on the adapter
 //! (lavapipe in CI). Run with `--nocapture` for the table.

@@ -24,9 +24,13 @@ pub struct EditArgs {
     /// lost GPU device.
     #[arg(long, conflicts_with_all = ["session", "hair", "env"])]
     pub recover: Option<PathBuf>,
+    /// Print each change's times to stderr as the status bar shows them (first image, sharp image,
+    /// converged, and the UI's frames meanwhile).
+    #[arg(long)]
+    pub log_times: bool,
 }
 
-pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
+pub fn run_editor(args: EditArgs, launched: std::time::Instant) -> anyhow::Result<()> {
     let mut session = Session::default();
     if let Some(path) = args.hair {
         let blake3 = strandlight::session::assemble::file_blake3(&path).ok();
@@ -48,5 +52,7 @@ pub fn run_editor(args: EditArgs) -> anyhow::Result<()> {
         instance: None,
         recover: args.recover,
         relaunch_on_device_loss: true,
+        launched: Some(launched),
+        log_times: args.log_times,
     })
 }

@@ -1,7 +1,7 @@
 //! The command-line front end. Every subcommand calls into the library; nothing here does maths.
 
 pub mod bench;
-pub mod bench_brush;
+pub mod bench_editor;
 pub mod bench_fast;
 pub mod bench_fit;
 pub mod bsdf;
@@ -64,8 +64,10 @@ pub enum Command {
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    // The editor's first times count from here (its window and device come after).
+    let launched = std::time::Instant::now();
     match cli.command {
-        Some(Command::Edit(args)) => edit::run_editor(args),
+        Some(Command::Edit(args)) => edit::run_editor(args, launched),
         Some(Command::Bsdf(args)) => bsdf::run(*args),
         Some(Command::Info(args)) => info::run(args),
         Some(Command::MakeHair(args)) => make_hair::run(args),
@@ -79,9 +81,12 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Bench(args)) => bench::run(args),
         Some(Command::ExportHair(args)) => export_hair::run(args),
         Some(Command::GpuInfo { software }) => gpu_info::run(software),
-        None => edit::run_editor(edit::EditArgs {
-            lights: 40,
-            ..Default::default()
-        }),
+        None => edit::run_editor(
+            edit::EditArgs {
+                lights: 40,
+                ..Default::default()
+            },
+            launched,
+        ),
     }
 }

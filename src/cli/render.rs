@@ -388,6 +388,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         let map = BackgroundMap::from_environment(&env);
         renderer.set_background(&ctx, Some(&map), map.yaw);
     }
+    let frame_started = Instant::now();
     let mut frame = if tile > 0 {
         eprintln!(
             "rendering {}x{} in tiles of {tile} pixels",
@@ -413,13 +414,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         let of = if tile > 0 { " (the last tile)" } else { "" };
         eprintln!("GPU time per pass{of}: {}", list.join(", "));
     }
+    // The frame alone is what an edit in the editor costs (the renderer and its tables exist).
     eprintln!(
-        "rendered {}x{} ({} strands, {} lights) in {:.2} s",
+        "rendered {}x{} ({} strands, {} lights) in {:.2} s (frame {:.2} s)",
         settings.width,
         settings.height,
         hair.strand_count(),
         env.lights.lights.len(),
-        t.elapsed().as_secs_f64()
+        t.elapsed().as_secs_f64(),
+        frame_started.elapsed().as_secs_f64()
     );
     let mut mode = "srbf".to_string();
     if let Some(reference) = args.reference {

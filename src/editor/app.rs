@@ -4,11 +4,12 @@
 
 use super::autosave::Autosave;
 use super::export::ExportJob;
-use super::jobs::Job;
-use super::live::{LiveScene, ViewSettings, prepare};
+use super::live::{LiveScene, ViewSettings};
 use super::navigation;
 use super::panels;
 use crate::gpu::GpuContext;
+use crate::live::LiveDriver;
+use crate::live::jobs::Job;
 use crate::render::Camera;
 use crate::render::scene::Environment;
 use crate::scattering::lut::Luts;
@@ -36,6 +37,11 @@ pub struct EditorOptions {
     /// After a lost GPU device, start a new editor on the recovery file and close this one (off in
     /// tests, which read [`EditorApp::relaunch`] instead).
     pub relaunch_on_device_loss: bool,
+    /// When the process started (the first scene's times count from it; default: the app's
+    /// creation).
+    pub launched: Option<Instant>,
+    /// Print each change's times to stderr (`edit --log-times`).
+    pub log_times: bool,
 }
 
 /// A device lost this soon after a start that recovered from one is not restarted again (no loop).
@@ -58,9 +64,10 @@ pub struct Message {
 /// What a load job brings back.
 pub enum Loaded {
     /// A new scene, its renderer built on the worker too (pipelines compile there: ~1.5 s on
-    /// lavapipe that the UI thread does not wait for).
+    /// lavapipe that the UI thread does not wait for); its render thread starts when it is installed.
     Scene {
-        live: Box<LiveScene>,
+        driver: Box<LiveDriver>,
+        pictures: Arc<super::env_preview::EnvPictures>,
         warnings: Vec<String>,
     },
     /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
@@ -144,13 +151,16 @@ pub struct EditorApp {
     /// The viewport's size in physical pixels and its rectangle in points (last frame).
     pub viewport_px: [u32; 2],
     pub viewport_rect: Option<egui::Rect>,
-    /// Smoothed UI frame time: the interval between frames while the viewport refines (an idle
-    /// editor draws nothing, so the first frame after a pause is not counted).
+    /// The UI's own work per frame (its logic and panels, not the render thread's): smoothed, and
+    /// the last frames' costs (the status bar and the editor's measurements read them).
     pub frame_ms: f32,
-    /// The last frame asked to be drawn again soon (the viewport was refining).
-    refining: bool,
-    /// The frame after convergence was requested (it paints the last image).
-    painted_converged: bool,
+    pub frame_costs: std::collections::VecDeque<f32>,
+    /// Work remains for the viewport (the render thread is refining).
+    pub refining: bool,
+    /// When this frame's work started.
+    frame_started: Option<Instant>,
+    /// The first scene is still to come (its times count from the launch).
+    first_scene: bool,
     /// Set by wgpu when the device is lost (reason and message).
     device_lost: Arc<std::sync::Mutex<Option<String>>>,
     /// The first GPU validation error since the last report (wgpu's default handler panics: a
@@ -158,13 +168,16 @@ pub struct EditorApp {
     gpu_error: Arc<std::sync::Mutex<Option<String>>>,
     /// A GPU error was shown (one message, not one per frame).
     gpu_error_shown: bool,
-    last_frame: Option<Instant>,
     /// After a lost device: the arguments of the editor that takes over (`edit --recover FILE`).
     pub relaunch: Option<Vec<std::ffi::OsString>>,
     /// This editor is closing for its replacement: the recovery file stays as it is.
     relaunching: bool,
     options: EditorOptions,
     started: Instant,
+    /// The driver's restart and convergence time last logged (`--log-times`), and the UI frames
+    /// since.
+    logged: Option<(u64, Duration)>,
+    frames_since_change: usize,
     ctx: egui::Context,
 }
 
@@ -257,16 +270,19 @@ impl EditorApp {
             viewport_px: [640, 400],
             viewport_rect: None,
             frame_ms: 0.0,
+            frame_costs: Default::default(),
             refining: false,
-            painted_converged: false,
+            frame_started: None,
+            first_scene: true,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
             gpu_error_shown: false,
-            last_frame: None,
             relaunch: None,
             relaunching: false,
             options: options.clone(),
-            started: Instant::now(),
+            started: options.launched.unwrap_or_else(Instant::now),
+            logged: None,
+            frames_since_change: 0,
             ctx: cc.egui_ctx.clone(),
         };
         if let Some(file) = &options.recover {
@@ -472,53 +488,16 @@ impl EditorApp {
             "loading the scene",
             move || ctx.request_repaint(),
             move |cancelled| {
-                // A missing or broken source is reported and the rest of the session opens (the
-                // session keeps pointing at the file).
-                let mut warnings = Vec::new();
-                let hair = match load_hair_source(&session.hair) {
-                    Ok(h) => h,
-                    Err(e) => {
-                        warnings.push(format!("{e}; showing the default hairstyle instead"));
-                        load_hair_source(&Session::default().hair).map_err(|e| e.to_string())?
-                    }
-                };
-                let environment = match load_environment_source(&session.environment) {
-                    Ok((environment, w)) => {
-                        warnings.extend(w);
-                        environment
-                    }
-                    Err(e) => {
-                        warnings.push(format!("{e}; lighting with the built-in sky instead"));
-                        crate::render::scene::default_environment()
-                    }
-                };
-                warnings.extend(hair.warning.clone());
-                // A failure later still reports what was replaced on the way.
-                let failed = |e: String| match warnings.is_empty() {
-                    true => e,
-                    false => format!("{e} (also: {})", warnings.join("; ")),
-                };
-                let prepared = prepare(&session, &hair.hair).map_err(|e| failed(e.to_string()))?;
-                if cancelled.load(std::sync::atomic::Ordering::Relaxed) {
-                    return Err("superseded".into());
-                }
                 let gpu = gpu.ok_or("no GPU adapter")?;
-                let (lo, hi) = hair.hair.bounds();
-                let camera = session.camera.resolve(lo, hi, w as f32 / h.max(1) as f32);
-                let live = LiveScene::new(
-                    gpu,
-                    &luts,
-                    &session,
-                    hair,
-                    environment,
-                    prepared,
-                    &camera,
-                    w,
-                    h,
-                )
-                .map_err(|e| failed(e.to_string()))?;
+                let (driver, warnings) =
+                    crate::live::load::open(gpu, &luts, &session, (w, h), cancelled)?;
+                let pictures = Arc::new(super::env_preview::pictures(
+                    &driver.environment,
+                    driver.background_map().clone(),
+                ));
                 Ok(Loaded::Scene {
-                    live: Box::new(live),
+                    driver: Box::new(driver),
+                    pictures,
                     warnings,
                 })
             },
@@ -549,7 +528,12 @@ impl EditorApp {
                     fitted: Some(Box::new(environment.lights.clone())),
                 };
                 Ok(Loaded::Environment {
-                    pictures: Box::new(super::env_preview::pictures(&environment)),
+                    pictures: Box::new(super::env_preview::pictures(
+                        &environment,
+                        Arc::new(crate::render::background::BackgroundMap::from_environment(
+                            &environment,
+                        )),
+                    )),
                     environment: Box::new(environment),
                     source,
                 })
@@ -583,7 +567,7 @@ impl EditorApp {
             .live
             .as_ref()
             .map_or(crate::session::assemble::GENERATOR_SPACE, |l| {
-                l.normalization
+                l.lock().normalization
             });
         self.source_job = Some(Job::spawn(
             format!("loading {}", path.display()),
@@ -711,7 +695,8 @@ impl EditorApp {
         self.session.camera.distance = None;
         if let Some(live) = &self.live {
             // The session keeps "framed" (no target, no distance): it follows the hair.
-            let c = self.resolve_camera(live.bounds);
+            let bounds = live.lock().bounds;
+            let c = self.resolve_camera(bounds);
             self.camera = Some(c);
             self.session.camera.yaw = c.yaw;
             self.session.camera.pitch = c.pitch;
@@ -749,15 +734,35 @@ impl EditorApp {
             match result.and_then(|r| r) {
                 // A scene built for a device lost since is not installed.
                 Ok(Loaded::Scene { .. }) if self.gpu.is_none() => {}
-                Ok(Loaded::Scene { live, warnings }) => {
+                Ok(Loaded::Scene {
+                    driver,
+                    pictures,
+                    warnings,
+                }) => {
                     for w in warnings {
                         self.message(Level::Warning, w);
                     }
                     // The camera as it is now (the user may have navigated during the load); the
-                    // renderer takes it in its next sync.
-                    self.camera = Some(self.resolve_camera(live.bounds));
+                    // renderer takes it in its next sync, and the size of the viewport as it is.
+                    self.camera = Some(self.resolve_camera(driver.bounds));
                     self.drop_live();
-                    self.live = Some(*live);
+                    let mut driver = *driver;
+                    let (w, h) = self.render_size();
+                    if let Err(e) = driver.resize(w, h) {
+                        self.message(Level::Error, e.to_string());
+                    }
+                    driver.set_view(self.view);
+                    if let Some(camera) = self.camera
+                        && let Err(e) = driver.sync(&self.session, &camera)
+                    {
+                        self.message(Level::Error, e.to_string());
+                    }
+                    if self.first_scene {
+                        // The first scene's times count from the launch.
+                        self.first_scene = false;
+                        driver.count_from(self.started);
+                    }
+                    self.live = Some(LiveScene::new(driver, pictures, self.ctx.clone()));
                     self.failed = None;
                 }
                 Ok(_) => {}
@@ -791,7 +796,7 @@ impl EditorApp {
                     self.perform(Edit::Environment(Box::new(source.clone())), false);
                     if let Some(live) = &mut self.live
                         && self.loading.is_none()
-                        && live.hair_source == self.session.hair
+                        && live.lock().hair_source == self.session.hair
                     {
                         live.set_environment(*environment, *pictures, source, self.session.env_yaw);
                     }
@@ -803,7 +808,7 @@ impl EditorApp {
         }
         if let Some(job) = &mut self.export {
             self.ctx.request_repaint_after(REFINE_POLL);
-            if let Some(msg) = job.poll(&mut self.live) {
+            if let Some(msg) = job.poll(self.gpu.as_ref()) {
                 let (level, text) = msg;
                 self.message(level, text);
                 self.export = None;
@@ -839,7 +844,9 @@ impl EditorApp {
         )
     }
 
-    /// The viewport's per-frame work: rebuild, sync, refine, display.
+    /// The viewport's per-frame work: rebuild when the session needs another scene, tell the
+    /// driver what changed (size, session, camera, view, whether the brush picks) and kick its render
+    /// thread. Nothing here waits for the GPU: the thread refines and wakes the UI for new images.
     pub fn update_viewport(&mut self) {
         if self.gpu.is_none() {
             return;
@@ -848,7 +855,7 @@ impl EditorApp {
         let rebuild = self
             .live
             .as_ref()
-            .is_none_or(|l| l.needs_rebuild(&self.session));
+            .is_none_or(|l| l.lock().needs_rebuild(&self.session));
         if rebuild {
             let key = SceneKey::of(&self.session);
             let pending = self
@@ -859,8 +866,9 @@ impl EditorApp {
                 self.load_scene();
             }
             if self.live.as_ref().is_none_or(|l| {
-                l.hair_source != self.session.hair
-                    || l.environment_source != self.session.environment
+                let d = l.lock();
+                d.hair_source != self.session.hair
+                    || d.environment_source != self.session.environment
             }) {
                 return;
             }
@@ -869,47 +877,81 @@ impl EditorApp {
         if let Some(live) = &self.live
             && (self.session.camera.target.is_none() || self.session.camera.distance.is_none())
         {
-            self.camera = Some(self.resolve_camera(live.bounds));
+            let bounds = live.lock().bounds;
+            self.camera = Some(self.resolve_camera(bounds));
         }
         let (Some(live), Some(camera)) = (&mut self.live, self.camera) else {
             return;
         };
-        let mut result = Ok(());
+        let (result, paint_warning, errors, working) = {
+            let mut d = live.lock();
+            let result = d.resize(w, h).and_then(|_| d.sync(&self.session, &camera));
+            d.set_view(self.view);
+            d.set_picking(self.tool == super::brush_tool::Tool::Brush);
+            let working = d.working();
+            (result, d.paint_warning.take(), d.take_errors(), working)
+        };
+        live.kick();
         if let Some(er) = &self.egui_renderer {
-            let mut er = er.write();
-            result = live.resize(w, h, &mut er);
-            live.texture(&mut er);
+            live.texture(&mut er.write());
         }
-        let result = result
-            .and_then(|_| live.sync(&self.session, &camera))
-            .and_then(|_| live.step(self.view));
-        if self.tool == super::brush_tool::Tool::Brush {
-            live.update_picking();
+        self.refining = working;
+        if self.options.log_times {
+            self.log_times();
         }
-        let paint_warning = live.paint_warning.take();
-        self.refining = false;
-        match result {
-            Ok(p) => {
-                if !p.converged || live.tables_pending() {
-                    self.refining = true;
-                    // Poll for the unit in flight every 30 ms (not every vsync: on a software GPU,
-                    // egui's own frames share the CPU with the refinement).
-                    self.ctx.request_repaint_after(REFINE_POLL);
-                    self.painted_converged = false;
-                } else if !self.painted_converged {
-                    // One more frame to paint the converged image and status.
-                    self.painted_converged = true;
-                    self.ctx.request_repaint();
-                }
-            }
-            Err(e) => {
-                let text = e.to_string();
-                self.message(Level::Error, text);
-            }
+        if let Err(e) = result {
+            self.message(Level::Error, e.to_string());
+        }
+        for e in errors {
+            self.message(Level::Error, e);
         }
         if let Some(w) = paint_warning {
             self.message(Level::Warning, w);
         }
+    }
+
+    /// Prints the times of a change that has converged (once per change).
+    fn log_times(&mut self) {
+        let Some(live) = &self.live else {
+            return;
+        };
+        let (restarts, first, sharp, converged) = {
+            let d = live.lock();
+            let done = d.progress.is_some_and(|p| p.converged) && !d.tables_pending();
+            (
+                d.restarts(),
+                d.first_image_in(),
+                d.full_image_in,
+                d.converged_in.filter(|_| done),
+            )
+        };
+        self.frames_since_change += 1;
+        let Some(converged) = converged else {
+            return;
+        };
+        if self
+            .logged
+            .is_some_and(|(r, c)| r == restarts && c == converged)
+        {
+            return;
+        }
+        self.logged = Some((restarts, converged));
+        let costs = self.frame_costs.iter().rev().take(self.frames_since_change);
+        let mut costs: Vec<f32> = costs.copied().collect();
+        costs.sort_by(f32::total_cmp);
+        let p95 = costs
+            .get(((costs.len().max(1) - 1) as f32 * 0.95).round() as usize)
+            .copied()
+            .unwrap_or(0.0);
+        let s = |t: Option<Duration>| t.map_or(-1.0, |t| t.as_secs_f64());
+        eprintln!(
+            "times: first {:.3} s, sharp {:.3} s, converged {:.3} s; UI frames {}, cost p95 {p95:.1} ms",
+            s(first),
+            s(sharp),
+            converged.as_secs_f64(),
+            self.frames_since_change
+        );
+        self.frames_since_change = 0;
     }
 
     /// Keyboard shortcuts that act on the document.
@@ -947,17 +989,21 @@ impl EditorApp {
         }
     }
 
+    /// The end of a frame's work: its cost goes to the smoothed figure and the recent costs.
     fn frame_timing(&mut self) {
-        let now = Instant::now();
-        if let Some(last) = self.last_frame.filter(|_| self.refining) {
-            let ms = (now - last).as_secs_f32() * 1e3;
-            self.frame_ms = if self.frame_ms == 0.0 {
-                ms
-            } else {
-                0.9 * self.frame_ms + 0.1 * ms
-            };
+        let Some(t) = self.frame_started.take() else {
+            return;
+        };
+        let ms = t.elapsed().as_secs_f32() * 1e3;
+        self.frame_ms = if self.frame_ms == 0.0 {
+            ms
+        } else {
+            0.9 * self.frame_ms + 0.1 * ms
+        };
+        if self.frame_costs.len() == FRAME_COSTS_KEPT {
+            self.frame_costs.pop_front();
         }
-        self.last_frame = Some(now);
+        self.frame_costs.push_back(ms);
     }
 
     /// Navigation keys over the viewport.
@@ -1008,6 +1054,7 @@ impl EditorApp {
     /// How long ago the last refinement converged (tests and the status bar).
     pub fn converged(&self) -> Option<Duration> {
         self.live.as_ref().and_then(|l| {
+            let l = l.lock();
             l.progress
                 .filter(|p| p.converged && !l.tables_pending())
                 .and(l.converged_in)
@@ -1017,8 +1064,11 @@ impl EditorApp {
 
 const RECENT_FILE: &str = "recent.json";
 
-/// How often the UI wakes to poll refinement while it runs.
+/// How often the UI wakes to poll an export while it runs (its renderer is refined in UI frames).
 const REFINE_POLL: Duration = Duration::from_millis(30);
+
+/// UI frame costs kept for the status bar and measurements.
+const FRAME_COSTS_KEPT: usize = 256;
 
 /// The recent sessions list (missing or unreadable: empty).
 fn read_recent(dir: &Path) -> Vec<PathBuf> {
@@ -1043,7 +1093,7 @@ fn install_fonts(ctx: &egui::Context) {
 
 impl eframe::App for EditorApp {
     fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
-        self.frame_timing();
+        self.frame_started = Some(Instant::now());
         self.check_device();
         self.poll_jobs();
         self.dropped_files(ctx);
@@ -1058,6 +1108,7 @@ impl eframe::App for EditorApp {
         // image and the progress it produced.
         self.update_viewport();
         panels::show(self, ui);
+        self.frame_timing();
     }
 
     fn on_exit(&mut self) {

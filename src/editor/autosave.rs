@@ -5,7 +5,7 @@
 //! records the session file it belongs to. At start, files of processes that are no longer running are
 //! offered (the newest); a file of a live process belongs to another open editor and is left alone.
 
-use super::jobs::Job;
+use crate::live::jobs::Job;
 use crate::session::{Session, write_atomic};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -4,9 +4,10 @@
 //! one undo step holding the touched points' previous values.
 
 use super::app::{EditorApp, Level};
+use crate::live::{Dab, DabError};
+use crate::paint::PaintDelta;
 use crate::paint::brush::Stroke;
 use crate::paint::pick::dabs_along;
-use crate::paint::{PaintDelta, PaintLayer, SharedLayer};
 use crate::session::Edit;
 use std::time::Instant;
 
@@ -98,93 +99,51 @@ impl EditorApp {
         self.brush.radius_px * w as f32 / rect_w
     }
 
-    /// Dabs at `centres` (render pixels).
+    /// Dabs at `centres` (render pixels) through the live driver.
     fn dab_at(&mut self, centres: &[[f32; 2]], pressure: f32) {
         let t = Instant::now();
         let radius = self.brush_radius_render_px();
-        let Some(live) = &mut self.live else {
+        let (Some(live), Some(stroke)) = (&self.live, &mut self.stroke) else {
             return;
         };
-        // A hair change still loading: the scene on screen is not the session's.
-        if live.needs_rebuild(&self.session) {
-            return;
-        }
-        let Some(picker) = live.picker() else {
-            if let Some(s) = &mut self.stroke
-                && !s.waiting
-            {
-                s.waiting = true;
-                self.message(
-                    Level::Info,
-                    "the brush waits for the view's depth (a moment after the view changes)",
-                );
+        let result = live.lock().dab(
+            &mut self.session,
+            &mut stroke.stroke,
+            &self.brush,
+            centres,
+            radius,
+            pressure,
+        );
+        live.kick();
+        let n = match result {
+            Ok(Dab::Painted {
+                points,
+                created_layer,
+            }) => {
+                stroke.created_layer |= created_layer;
+                points
             }
-            return;
-        };
-        let under: Vec<Vec<crate::paint::brush::Touch>> = centres
-            .iter()
-            .map(|c| picker.dab(&self.brush, *c, radius, pressure))
-            .collect();
-        if under.iter().all(Vec::is_empty) {
-            return;
-        }
-        let hair = live.hair.clone();
-        let (points, strands) = (hair.point_count(), hair.strand_count());
-        // A paint file the session names but that was not read (it failed to load): painting would
-        // start an empty layer and the next save would replace the file.
-        if self.session.paint_layer.is_none()
-            && let Some(path) = self.session.paint.clone()
-        {
-            match PaintLayer::read(&path) {
-                Ok(l) => self.session.paint_layer = Some(SharedLayer::new(l)),
-                Err(e) => {
-                    self.end_stroke();
+            Ok(Dab::Waiting) => {
+                if !stroke.waiting {
+                    stroke.waiting = true;
                     self.message(
-                        Level::Error,
-                        format!("{e}: painting would replace it; Clear paint first to start anew"),
+                        Level::Info,
+                        "the brush waits for the view's depth (a moment after the view changes)",
                     );
-                    return;
                 }
+                return;
             }
-        }
-        let created = self.session.paint_layer.is_none();
-        let layer = self
-            .session
-            .paint_layer
-            .get_or_insert_with(|| SharedLayer::new(PaintLayer::empty(points, strands)));
-        if !layer.get().fits(points, strands) {
-            self.end_stroke();
-            self.message(
-                Level::Error,
-                "the paint layer was painted on another hair: clear it (brush panel) to paint this one",
-            );
-            return;
-        }
-        let Some(stroke) = &mut self.stroke else {
-            return;
+            Ok(Dab::SceneLoading | Dab::Missed) => return,
+            Err(e @ (DabError::UnreadablePaint(_) | DabError::OtherHair)) => {
+                self.end_stroke();
+                self.message(Level::Error, e.to_string());
+                return;
+            }
+            Err(e) => {
+                self.message(Level::Error, e.to_string());
+                0
+            }
         };
-        stroke.created_layer |= created;
-        let mut changed: Vec<u32> = Vec::new();
-        let points_mut = &mut layer.make_mut().points;
-        for u in &under {
-            changed.extend(stroke.stroke.dab(
-                &self.brush,
-                u,
-                points_mut,
-                &live.base_sigma_a,
-                |i| hair.strand_of_point(i),
-                crate::paint::brush::eumelanin_unit(),
-            ));
-        }
-        changed.sort_unstable();
-        changed.dedup();
-        let n = changed.len();
-        if n == 0 {
-            // New revision, same values: the renderer has them already.
-            live.note_paint(&self.session);
-        } else if let Err(e) = live.paint_points(&self.session, &changed) {
-            self.message(Level::Error, e.to_string());
-        }
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let st = &mut self.brush_stats;
         st.dabs += centres.len() as u64;
@@ -199,9 +158,10 @@ impl EditorApp {
         let Some(s) = self.stroke.take() else {
             return;
         };
-        if let Some(live) = &mut self.live {
+        if let Some(live) = &self.live {
             // The volume and grid may follow now, whatever the stroke left.
-            live.painting = false;
+            live.lock().end_painting();
+            live.kick();
         }
         let Some(layer) = &self.session.paint_layer else {
             return;
@@ -222,9 +182,11 @@ impl EditorApp {
                 self.autosave.changed();
             }
         }
-        if let Some(live) = &mut self.live
-            && let Err(e) = live.paint_finished(&self.session)
-        {
+        let finished = self
+            .live
+            .as_ref()
+            .map(|live| live.lock().paint_finished(&self.session));
+        if let Some(Err(e)) = finished {
             self.message(Level::Error, e.to_string());
         }
     }
@@ -243,10 +205,13 @@ impl EditorApp {
             self.message(Level::Error, "export: the scene is still loading");
             return;
         };
-        let (hair, sigma_a) = (live.hair.clone(), live.sigma_a.clone());
+        let (hair, sigma_a) = {
+            let d = live.lock();
+            (d.hair.clone(), d.sigma_a.clone())
+        };
         let scale = self.session.look.thickness_scale;
         let wake = self.egui_ctx();
-        self.hair_export = Some(super::jobs::Job::spawn(
+        self.hair_export = Some(crate::live::jobs::Job::spawn(
             "exporting the hair",
             move || wake.request_repaint(),
             move |_| {
@@ -264,10 +229,13 @@ impl EditorApp {
             return;
         };
         let PaintDelta { indices, .. } = delta.as_ref();
-        if let Some(live) = &mut self.live {
-            let r = live
-                .paint_points(&self.session, indices)
-                .and_then(|_| live.paint_finished(&self.session));
+        if let Some(live) = &self.live {
+            let r = {
+                let mut d = live.lock();
+                d.paint_points(&self.session, indices)
+                    .and_then(|_| d.paint_finished(&self.session))
+            };
+            live.kick();
             if let Err(e) = r {
                 self.message(Level::Error, e.to_string());
             }

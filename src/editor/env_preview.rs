@@ -75,8 +75,9 @@ pub struct EnvPictures {
     pub background: Arc<BackgroundMap>,
 }
 
-/// The two pictures of `env`, exposed so that the image's median luminance sits at 0.18.
-pub fn pictures(env: &Environment) -> EnvPictures {
+/// The two pictures of `env`, exposed so that the image's median luminance sits at 0.18, with the
+/// map the viewport shows behind the hair (made where the environment was loaded).
+pub fn pictures(env: &Environment, background: Arc<BackgroundMap>) -> EnvPictures {
     let (w, h) = (PREVIEW_WIDTH, PREVIEW_HEIGHT);
     let fit = env.lights.render(w, h);
     let image = env.image.as_ref().map(|i| resample(i, w, h));
@@ -90,7 +91,7 @@ pub fn pictures(env: &Environment) -> EnvPictures {
         image: image.map(|p| to_image(&p, scale)),
         fit: to_image(&fit.pixels, scale),
         relative_l2: env.lights.fit.as_ref().map(|f| f.relative_l2),
-        background: Arc::new(BackgroundMap::from_environment(env)),
+        background,
     }
 }
 

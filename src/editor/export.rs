@@ -4,8 +4,9 @@
 //! AOVs and the header `render` writes) and a PNG preview on a worker.
 
 use super::app::Level;
-use super::jobs::Job;
-use super::live::LiveScene;
+use crate::gpu::GpuContext;
+use crate::live::LiveDriver;
+use crate::live::jobs::Job;
 use crate::render::Renderer;
 use crate::render::background::Background;
 use crate::render::camera::Tile;
@@ -40,7 +41,7 @@ impl ExportJob {
     /// `tile`: at most this many pixels a side per tile (None: tiles only when the image needs them).
     #[allow(clippy::too_many_arguments)]
     pub fn start(
-        live: &LiveScene,
+        live: &LiveDriver,
         luts: &crate::scattering::lut::Luts,
         session: &Session,
         exr: PathBuf,
@@ -58,7 +59,7 @@ impl ExportJob {
         // The paint the viewport shows: a layer painted on another hair, or a file that cannot be
         // read, is left out as the viewport leaves it out.
         let mut session = session.clone();
-        let (layer, _) = crate::editor::live::paint_for(&session, &live.hair, &mut None);
+        let (layer, _) = crate::live::driver::paint_for(&session, &live.hair, &mut None);
         if layer.is_none() {
             session.paint = None;
         }
@@ -79,7 +80,7 @@ impl ExportJob {
 
     #[allow(clippy::too_many_arguments)]
     fn with_scene(
-        live: &LiveScene,
+        live: &LiveDriver,
         luts: &crate::scattering::lut::Luts,
         session: &Session,
         scene: Scene,
@@ -110,7 +111,7 @@ impl ExportJob {
             &scene.camera,
         )
         .map_err(|e| e.to_string())?;
-        renderer.set_unit_budget(crate::editor::live::unit_budget(&live.ctx));
+        renderer.set_unit_budget(crate::live::driver::unit_budget(&live.ctx));
         renderer.set_occluder(&live.ctx, scene.occluder.as_ref());
         renderer
             .set_camera_tile(&live.ctx, &scene.camera, tiles[0])
@@ -118,7 +119,7 @@ impl ExportJob {
         // The PNG shows the session's background: the live scene's map (made for its unturned lights),
         // turned by the session's yaw. The EXR keeps the hair alone with its alpha.
         if png.is_some() && session.render.background == Background::Environment {
-            let map = &live.environment_pictures.background;
+            let map = live.background_map();
             let yaw = map.yaw + session.env_yaw.to_radians() as f32;
             renderer.set_background(&live.ctx, Some(map), yaw);
         }
@@ -140,17 +141,16 @@ impl ExportJob {
     }
 
     /// One frame of the export; returns the final message when done.
-    pub fn poll(&mut self, live: &mut Option<LiveScene>) -> Option<(Level, String)> {
+    pub fn poll(&mut self, gpu: Option<&GpuContext>) -> Option<(Level, String)> {
         if let Some(job) = &mut self.writing {
             return job.poll().map(|r| match r.and_then(|r| r) {
                 Ok(m) => (Level::Info, m),
                 Err(e) => (Level::Error, e),
             });
         }
-        let Some(live) = live else {
-            return Some((Level::Error, "export: the scene went away".into()));
+        let Some(ctx) = gpu else {
+            return Some((Level::Error, "export: the GPU went away".into()));
         };
-        let ctx = &live.ctx;
         let n = self.tiles.len();
         let part = if let Some(r) = &self.reading {
             match r.poll(ctx)? {

@@ -1,6 +1,6 @@
 //! The editor (eframe + egui on wgpu): a session edited live in a window. The session model, scene
 //! assembly and renderer live in the library and serve the CLI too; this module holds the app state and
-//! frame loop ([`app`]), the live scene on egui's device ([`live`]), navigation, background jobs,
+//! frame loop ([`app`]), the live driver's image in egui ([`live`]), navigation, background jobs,
 //! autosave, export and one module per panel.
 
 pub mod app;
@@ -8,11 +8,9 @@ pub mod autosave;
 pub mod brush_tool;
 pub mod env_preview;
 pub mod export;
-pub mod jobs;
 pub mod live;
 pub mod navigation;
 pub mod panels;
-pub mod picking;
 
 pub use app::{EditorApp, EditorOptions};
 

@@ -1,4 +1,4 @@
-//! GPU access through wgpu: headless device creation shared by the CLI, tests and (later) the editor.
+//! GPU access through wgpu: device creation shared by the CLI, the tests and the editor.
 
 pub mod context;
 pub mod density_pyramid;

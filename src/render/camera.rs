@@ -1,4 +1,4 @@
-//! The orbit camera shared by the renderer, the reference mode and (later) the editor: a target, yaw and
+//! The orbit camera shared by the renderer, the reference mode and the editor: a target, yaw and
 //! pitch in degrees, a distance in centimetres and a vertical field of view. World space is +Y up.
 
 use bytemuck::{Pod, Zeroable};

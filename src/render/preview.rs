@@ -34,8 +34,8 @@ pub enum PreviewMode {
     Auto,
 }
 
-/// The longest shading time an automatic preview aims at, in one unit (the bound for the
-/// first preview after a change is 0.25 s on lavapipe; the rest is the unit in flight when the change
+/// The longest shading time an automatic preview aims at, in one unit (the first preview after a
+/// change should show within 0.25 s on lavapipe; the rest is the unit in flight when the change
 /// comes and the UI frame). On lavapipe this puts the default scene's divisor near Blender's 8-pixel
 /// start.
 pub const PREVIEW_TARGET: Duration = Duration::from_millis(150);

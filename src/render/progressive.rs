@@ -324,6 +324,10 @@ struct BandShape {
 /// Where progressive refinement stands (owned by the [`Renderer`]).
 pub struct Refinement {
     stage: Stage,
+    /// When the last unit finished, until the next is submitted; and the gaps between a unit's
+    /// completion and the next submission (what a driver of the refinement leaves idle).
+    last_done: Option<Instant>,
+    idle_gaps: Vec<Duration>,
     /// Shadow-grid entries built for the current volume, lights and tables.
     pub(super) grid_done: u32,
     /// The sweeps' samples built for the current pyramid (`MidplaneSamples`; a new light count or
@@ -441,6 +445,8 @@ impl Default for Refinement {
             pixel_cost: None,
             grid_last: 1,
             in_flight: None,
+            last_done: None,
+            idle_gaps: Vec::new(),
             stats: RefineStats::default(),
             started: Instant::now(),
             restarts: 0,
@@ -761,6 +767,9 @@ impl Refinement {
     }
 }
 
+/// Idle gaps kept until [`Renderer::take_idle_gaps`] (a frame has a few hundred units).
+pub const MAX_IDLE_GAPS: usize = 4096;
+
 /// What [`Renderer::refine`] reports.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Progress {
@@ -787,7 +796,7 @@ impl Renderer {
     /// Sizes units to `share` (0.1 to 1) of the budget, all but the preview's shading bands (which
     /// keep all of it, as the preview's target does): for a software GPU while a CPU job (the
     /// tables' build) takes part of its cores, which stretches units past their measured costs
-    /// ([`crate::editor::live::budget_share`]).
+    /// ([`crate::live::driver::budget_share`]).
     pub fn set_budget_share(&mut self, share: f64) {
         self.refinement.budget_share = share.clamp(0.1, 1.0);
     }
@@ -1024,6 +1033,7 @@ impl Renderer {
             f.repaint_end,
         );
         self.refinement.in_flight = None;
+        self.refinement.last_done = Some(t);
         let batch = match unit {
             WorkUnit::Shade { batch, .. } | WorkUnit::Repaint { batch, .. } => {
                 self.batch_shape(batch)
@@ -1092,6 +1102,8 @@ impl Renderer {
         }
         self.last_ran.clear(); // pass_times belongs to render_frame
         let Some(unit) = self.next_unit(&ctx.device) else {
+            // Nothing to do is not idling.
+            self.refinement.last_done = None;
             return Ok(self.progress(None, false, ready));
         };
         let mut enc = ctx
@@ -1101,6 +1113,12 @@ impl Renderer {
             });
         self.encode_unit(ctx, &mut enc, unit);
         ctx.queue.submit([enc.finish()]);
+        let r = &mut self.refinement;
+        if let Some(done) = r.last_done.take()
+            && r.idle_gaps.len() < MAX_IDLE_GAPS
+        {
+            r.idle_gaps.push(done.elapsed());
+        }
         self.request_row_segments();
         let done = Arc::new(Mutex::new(None));
         let flag = done.clone();
@@ -1139,6 +1157,13 @@ impl Renderer {
                     .map_err(|e| RenderError::Gpu(format!("waiting for the GPU: {e}")))?;
             }
         }
+    }
+
+    /// The gaps between a unit's completion and the next unit's submission since the last call
+    /// (at most [`MAX_IDLE_GAPS`] are kept): how long the driver of the refinement left the GPU
+    /// without work while work remained.
+    pub fn take_idle_gaps(&mut self) -> Vec<Duration> {
+        std::mem::take(&mut self.refinement.idle_gaps)
     }
 
     /// What refinement has measured since its last restart.

@@ -52,9 +52,9 @@ impl ResolvePass {
 
     /// Encodes the resolve of image rows `rows` (all of them after visibility or an exposure change;
     /// a band's after progressive refinement shaded it: at 720x480 on lavapipe a whole-image resolve
-    /// costs ~18 ms, which after every band was most of the refinement's time). With `background`,
-    /// the rows' background is looked up too (after visibility, a new camera or map; a shading band
-    /// leaves it as it is). With `normalise` (refinement under way), the hair's radiance is scaled by
+    /// costs ~18 ms, which after every band would be most of the refinement's time). With
+    /// `background`, the rows' background is looked up too (after visibility, a new camera or map;
+    /// a shading band leaves it as it is). With `normalise` (refinement under way), the hair's radiance is scaled by
     /// its alpha over the weight shaded so far, so a partly shaded image shows its final brightness.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(

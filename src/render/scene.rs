@@ -81,7 +81,7 @@ pub fn generated_hair(style: Style, strands: usize, points: usize, seed: u64) ->
         .unwrap_or_else(|e| unreachable!("fixed style parameters are valid: {e}"))
 }
 
-/// A benchmark scene of the renderer issue.
+/// A standard benchmark scene (`strandlight bench`, docs/benchmarks.md).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct StandardScene {
     pub name: &'static str,

@@ -10,8 +10,8 @@ pub const COMPONENTS: [&str; 5] = ["R", "TT", "TRT", "MS.global", "MS.local"];
 /// The occluder's -(triangle + 1) as an exact float (R32Uint cannot be multisampled without
 /// adapter-specific features; every integer up to 2^24 is exact in f32).
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-/// The most segments a hair may have (ids are u32 everywhere; this keeps the old bound of ids exact in
-/// f32, which the buffers' sizes reach first anyway).
+/// The most segments a hair may have (ids are u32 everywhere; this keeps ids exact in f32, a bound
+/// the buffers' sizes reach first anyway).
 pub const MAX_SEGMENTS: u32 = 1 << 24;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 

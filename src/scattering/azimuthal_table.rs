@@ -26,15 +26,16 @@
 //!
 //! Cells are kept in half precision ([`super::half_cells`]: 11 significant bits from 6e-8 to 64;
 //! the cells stay under 2.1: 0.83 for eta 1.55 round, 1.55-2.07 for eta 1.3-2 and eccentricities
-//! 0.5-2, measured 2026-12-02, and `tests/azimuthal_table.rs` bounds them by 8). The GPU's buffer
+//! 0.5-2, and `tests/azimuthal_table.rs` bounds them by 8). The GPU's buffer
 //! ([`AzimuthalTable::gpu`]) holds each cell as two half pairs in a vec2<u32>: a lookup loads half
-//! the words it did in f32; on lavapipe, whose loads cost per word, the shading pass took 16-21 %
-//! less time on S1 (single scattering alone on S0: 31 %). The CPU's cells are the same rounded
-//! values, so the WGSL twin (`shaders/azimuthal_table.wgsl`) and the lookups here read the same
-//! numbers; `tests/azimuthal_table.rs` measures the rounding with the rest (TT's median error
-//! against the exact integrals 2.6e-4 before, 3.0e-4 after; p95 6.5e-3 and 6.6e-3; TRT's p95 4.2e-3
-//! either way). A rule's node x = (w x) / w carries two roundings (~1e-3 relative), so e^(-s x)
-//! errs by ~1e-3 s relative: a few percent of a dark TRT's tiny value (s of 30 and more).
+//! the words it would in f32 (a software GPU's loads cost per word). The CPU's cells are the
+//! same rounded values, so the WGSL twin (`shaders/azimuthal_table.wgsl`) and the lookups here
+//! read the same numbers;
+//! `tests/azimuthal_table.rs` measures the rounding with the rest (it moves TT's median error
+//! against the exact integrals from 2.6e-4 in f32 to 3.0e-4, its p95 from 6.5e-3 to 6.6e-3, and
+//! leaves TRT's p95 at 4.2e-3). A rule's node x = (w x) / w carries two roundings (~1e-3
+//! relative), so e^(-s x) errs by ~1e-3 s relative: a few percent of a dark TRT's tiny value (s of
+//! 30 and more). See docs/fast-form.md.
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
 use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_prime};
@@ -50,10 +51,10 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 pub const TABLE_THETA_D: usize = 32;
 pub const THETA_D_MAX: f32 = 1.5;
 /// Samples of lambda', log-spaced over [LAMBDA_MIN, LAMBDA_MAX]: every lambda' the renderer meets (it
-/// clamps lambda' to [`LAMBDA_PRIME_MAX`]). Until 2026-11-30 the axis ended at 1.4 with 40 samples and
-/// Xu's circular-Gaussian fits took over from 0.7 (smoothstep blend): 54 keep the samples' spacing in
-/// ln lambda', and on lavapipe the fits, run by every SIMD group holding one wide light, had cost
-/// ~30 % of the shading pass.
+/// clamps lambda' to [`LAMBDA_PRIME_MAX`]), so that no light needs Xu's circular-Gaussian fits
+/// (on a software GPU every SIMD group holding one wide light would run them, ~30 % of the shading
+/// pass).
+/// 54 samples space the axis by about 0.14 in ln lambda'.
 pub const TABLE_LAMBDA: usize = 54;
 pub const LAMBDA_MIN: f32 = 0.005;
 pub const LAMBDA_MAX: f32 = LAMBDA_PRIME_MAX;
@@ -378,10 +379,8 @@ impl AzimuthalTable {
         + 3 * TABLE_THETA_D * TABLE_DPHI;
     pub const MAX_BYTES: u64 = ((Self::MAX_CELLS + GPU_HEADER_ENTRIES - 1) * 8) as u64;
 
-    /// Builds the table for the fiber's eta and eccentricity (on two cores of the CI-sized machine,
-    /// 2026-12-01: 0.75-0.85 s for a round fiber, 2.9-3.3 s for an elliptical one with its six TRT
-    /// indices; 1.1-1.2 s and 4.1-4.5 s before the inversions of the window's ends started from the
-    /// secant and stopped at a bracket of a few ulps).
+    /// Builds the table for the fiber's eta and eccentricity (on two cores of a CI-sized machine
+    /// about 0.8 s for a round fiber, 3 s for an elliptical one with its six TRT indices).
     pub fn build(eta: f32, eccentricity: f32) -> Self {
         Self::build_cells(eta, eccentricity, false)
     }

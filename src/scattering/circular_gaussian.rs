@@ -1,5 +1,5 @@
 //! Circular-Gaussian primitives of Xu et al. 2011's fast model, in f32 exactly as the WGSL twins
-//! will compute them (same names; MATH-NOTES "Gaussians: three different widths").
+//! compute them (same names; docs/hair-model.md, "Three Gaussian widths").
 //!
 //! - Circular Gaussian g^c(x; mu, lambda) = exp(2 (cos(x - mu) - 1) / lambda^2) = exp(kappa (cos(x - mu) - 1)),
 //!   kappa = 2 / lambda^2.

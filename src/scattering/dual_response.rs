@@ -18,11 +18,11 @@ use super::lut::wrap_angle_f32;
 use std::f32::consts::{PI, SQRT_2};
 
 /// `dual_quadrature_segments` of the WGSL: the dual terms' quadrature segments, half the
-/// single-scattering quadrature's and at least 2 (the renderer's 4 give 2: one inner node where three
-/// were; the poles are not evaluated, [`crate::scattering::fast_response::Quadrature`]). The dual terms are broad (the forward spread widens the light, the back lobe is
-/// wide), and against direct quadrature the global term's worst error went from 0.16 % to 1.0 %, the
-/// local one's (Xu's means over the light's width, most of it) from 7.2 % to 8.8 %
-/// (`tests/dual_terms.rs`).
+/// single-scattering quadrature's and at least 2 (the renderer's 4 give 2: one inner node; the
+/// poles are not evaluated, [`crate::scattering::fast_response::Quadrature`]). The dual terms are
+/// broad (the forward spread widens the light, the back lobe is wide): against direct quadrature
+/// the global term's worst error is 1.0 % (0.16 % with the full m), the local one's 8.8 % (7.2 %;
+/// most of it Xu's means over the light's width) (`tests/dual_terms.rs`).
 pub fn dual_quadrature_segments(m: u32) -> u32 {
     (m / 2).max(2)
 }

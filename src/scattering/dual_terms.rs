@@ -1,8 +1,8 @@
 //! Dual-scattering fiber terms (Zinke et al. 2008 Sec. 3; Xu et al. 2011 Eq. 32-33), sampled into 1D
 //! tables over the incident inclination theta and rebuilt on the CPU whenever hair parameters change.
 //!
-//! NORMALISATION (MATH-NOTES "Normalisation trap"). a_f and a_b are ENERGY FRACTIONS: for incident
-//! inclination theta, lobe t,
+//! NORMALISATION (docs/dual-scattering.md, "Normalisation: energy fractions"). a_f and a_b are
+//! ENERGY FRACTIONS: for incident inclination theta, lobe t,
 //!   a_{f,t}(theta) = L_t(theta) F_{f,t}(theta),   a_{b,t}(theta) = L_t(theta) F_{b,t}(theta),
 //!   L_t(theta) = (1/2) integral_{-pi/2}^{pi/2} M_t((theta + theta_o)/2) d theta_o
 //! (the longitudinal fraction: the published M_t integrates to 2 over theta_o, hence the 1/2; L_t = 1 unless the

@@ -392,7 +392,8 @@ pub fn trt_lobes(
 
 /// b integral g^c(x; 0, lambda') g^c(dphi - x; mu, lambda) dx in closed form: the product of two
 /// circular Gaussians is kappa_m cos(x - mu_m) with kappa_m e^(i mu_m) = kappa' + kappa e^(i (dphi - mu)),
-/// so the integral is 2 pi exp(kappa_m - kappa' - kappa) I0s(kappa_m) (MATH-NOTES).
+/// so the integral is 2 pi exp(kappa_m - kappa' - kappa) I0s(kappa_m) (docs/fast-form.md,
+/// "Circular Gaussians").
 pub fn circular_gaussian_convolution(kappa_prime: f32, dphi: f32, kappa: f32) -> f32 {
     let re = kappa_prime + kappa * dphi.cos();
     let im = kappa * dphi.sin();
@@ -433,8 +434,8 @@ mod tests {
     use crate::scattering::marschner::AzimuthalLobe;
     use crate::scattering::{CausticModel, HairParams, Lobe, ModelVariant};
 
-    /// The closed-form root of 2 asin(h/eta') = asin(h) against bisection of the same equation (the
-    /// way it was found before): g(h_c) > 0 at the caustic, g(1) < 0.
+    /// The closed-form root of 2 asin(h/eta') = asin(h) against bisection of the same equation:
+    /// g(h_c) > 0 at the caustic, g(1) < 0.
     #[test]
     fn trt_zero_root_solves_its_equation() {
         use crate::scattering::circular_gaussian::asin_precise;

@@ -2,10 +2,10 @@
 //!
 //! Why: the fits carry the right energy but not the right shape. N_TT has compact support and a flat
 //! top, N_TRT has one-sided 1/sqrt caustics; under a light narrower than the lobe the fitted Gaussian
-//! tails were off by factors of 2-20 (TT) and the caustic Gaussians by up to 3.7x (TRT) against the
-//! brute-force integral. Wide lights average the shape away; the fits were used for them (lambda' above
-//! 0.7, blended to 1.4) until the table covered every lambda': on a software GPU a SIMD group runs the
-//! fits whenever one of its points needs them, and they cost ~30 % of the shading pass.
+//! tails are off by factors of 2-20 (TT) and the caustic Gaussians by up to 3.7x (TRT) against the
+//! brute-force integral. Wide lights average the shape away, but the table serves them too: on a
+//! software GPU a SIMD group runs the fits whenever one of its points needs them, and they would
+//! cost ~30 % of the shading pass.
 //!
 //! How: with h = sin t, integral g^c(x; 0, lambda') N_p(dphi - x) dx = integral A_p(sin t)/2 g^c(dphi - Phi(t); 0, lambda') cos t dt,
 //! Phi(t) = 2 p asin(sin t / eta') - 2 t + p pi, summed over the pieces of t on which Phi is monotone
@@ -60,8 +60,8 @@ fn exit_azimuth_dt(p: u32, t: f32, eta_p: f32) -> f32 {
 /// lowest exit azimuth, `above` at its end of highest, Phi(below) <= target <= Phi(above). Safeguarded
 /// Newton from the secant between the ends (a bisection step wherever Newton would leave the bracket),
 /// until a step is under 1e-7 or the bracket is down to a few ulps of t: near |t| = pi/2 an ulp is
-/// 1.2e-7 and the steps alone need not settle (a quarter of the table's inversions then ran all 24
-/// iterations; from the piece's midpoint they took 15 on average, now 4).
+/// 1.2e-7 and the steps alone need not settle (a quarter of the table's inversions would run all
+/// 24 iterations; started from the piece's midpoint they take 15 on average, from the secant 4).
 pub fn invert_exit_azimuth(
     p: u32,
     eta_p: f32,

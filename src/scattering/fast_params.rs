@@ -20,7 +20,8 @@ pub struct FastHairParams {
     /// Eccentricity a (1 = circular).
     pub eccentricity: f32,
     /// Marschner's caustic width w_c, a standard deviation (radians). The circular Gaussians of the
-    /// TRT caustics get bandwidth sqrt(2) w_c (MATH-NOTES: bandwidth = sqrt(2) x std-dev). Read only by
+    /// TRT caustics get bandwidth sqrt(2) w_c (bandwidth = sqrt(2) x std-dev: docs/hair-model.md,
+    /// "Three Gaussian widths"). Read only by
     /// Xu's fits (`trt_lobes`): the response integrates the exact caustic from the azimuthal table.
     pub caustic_width: f32,
     /// Delta eta' of the smoothstep blend past eta' = 2 (Xu's fits only, as `caustic_width`).

@@ -71,7 +71,7 @@ pub fn quadrature_sample(s: u32, m: u32, mu: f32, lambda: f32) -> f32 {
 /// linearly on every segment. Here segments are taken in pairs and f is interpolated by the parabola
 /// through each pair's three samples (the paper's suggested "higher order polynomial"); a last unpaired
 /// segment (m odd) stays linear. f contains cos^2(theta_i), which vanishes quadratically at the ends
-/// +-pi/2: near the poles the linear rule was off by up to 12% from m = 200. f must vanish at the ends
+/// +-pi/2: near the poles the linear rule is off by up to 12% from m = 200. f must vanish at the ends
 /// (every integrand carries the longitudinal factor's clamped cos(theta_i)): it is evaluated at the
 /// m - 1 inner samples only.
 pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) -> Rgb32) -> Rgb32 {
@@ -88,7 +88,7 @@ pub fn linear_quadrature(m: u32, mu: f32, lambda: f32, mut f: impl FnMut(f32) ->
 /// `quadrature_node` and `quadrature_end`): nodes s = 0..=m are fed in order; each even node closes the pair of segments
 /// before it with their parabola, a last odd node (m odd) its linear segment. The shaders call their
 /// integrands from one place per quadrature this way (each call site is inlined: three per
-/// quadrature took lavapipe seconds to compile).
+/// quadrature take lavapipe seconds to compile).
 #[derive(Clone, Copy, Debug)]
 pub struct Quadrature {
     pub mu: f32,
@@ -431,7 +431,7 @@ pub const NEGLIGIBLE_LN_WEIGHT: f32 = -14.0;
 
 /// Newton's search for the weight's peak stops after a step below this (radians). It converges
 /// quadratically: the peak left is within ~1e-6 lambda* of the converged one (the 24000 light-lobe pairs
-/// of `bench-fast`, against a 1e-6 stop; 1.6 steps on average where that took 2.2).
+/// of `bench-fast`, against a 1e-6 stop; 1.6 steps on average where that stop takes 2.2).
 pub const PEAK_STEP_TOLERANCE: f32 = 1e-3;
 
 /// Finds theta* by Newton's method on

@@ -1,4 +1,5 @@
-//! The fiber frame and angle conventions (Marschner et al. 2003, Sec. 2; MATH-NOTES "Frame and angles").
+//! The fiber frame and angle conventions (Marschner et al. 2003, Sec. 2; docs/hair-model.md,
+//! "Frame and angles").
 //!
 //! This is the one definition used everywhere in strandlight:
 //! - `u` is the fiber tangent, pointing from root to tip; `v` and `w` span the normal plane.

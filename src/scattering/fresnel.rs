@@ -1,7 +1,7 @@
 //! Fresnel reflectance for the hair model (Marschner et al. 2003, Appendix B; Xu et al. 2011 Sec. 4.1).
 
 /// Bravais effective index for the perpendicular polarisation, eta'(theta_d)
-/// = sqrt(eta^2 - sin^2 theta_d) / cos theta_d (Marschner 2003 Eq. 3; MATH-NOTES).
+/// = sqrt(eta^2 - sin^2 theta_d) / cos theta_d (Marschner 2003 Eq. 3; docs/hair-model.md).
 pub fn bravais_perpendicular(eta: f64, theta_d: f64) -> f64 {
     let s = theta_d.sin();
     (eta * eta - s * s).max(0.0).sqrt() / theta_d.cos()

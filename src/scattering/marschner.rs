@@ -8,7 +8,7 @@
 //! = (1/2) sum_p integral A_p dh, the energy the three lobes carry (~0.95-1 for sigma_a = 0).
 //!
 //! This is the reference every fast path is tested against. Angles follow
-//! [`crate::scattering::frame`]. Symbols are the paper's; MATH-NOTES restates them.
+//! [`crate::scattering::frame`]. Symbols are the paper's; docs/hair-model.md restates them.
 
 use super::frame::{FiberAngles, HalfAngles, wrap_angle};
 use super::fresnel::{

@@ -1,4 +1,4 @@
-//! Hair scattering maths: the exact Marschner model (reference) and, later, the fast forms.
+//! Hair scattering maths: the exact Marschner model (reference) and the fast forms.
 
 pub mod azimuthal_table;
 pub mod circular_gaussian;

@@ -1,7 +1,8 @@
 //! Marschner hair parameters (Marschner et al. 2003, Table 1) and named presets.
 //!
 //! Angles are stored in radians. `sigma_a` is the absorption coefficient per unit fiber RADIUS
-//! (the chord through a unit circle has length 2 cos(gamma_t), MATH-NOTES), per RGB channel.
+//! (the chord through a unit circle has length 2 cos(gamma_t): docs/hair-model.md), per RGB
+//! channel.
 //! The lobe shifts and widths of TT and TRT default to Marschner's couplings
 //! (alpha_TT = -alpha_R/2, alpha_TRT = -3 alpha_R/2, beta_TT = beta_R/2, beta_TRT = 2 beta_R);
 //! each can be overridden.
@@ -74,7 +75,8 @@ pub enum LongitudinalModel {
     Normalized,
     /// Marschner 2003 / Xu 2011 Eq. 7 as published: M_p(theta_h) a unit-area Gaussian in theta_h and
     /// S = sum_p M_p N_p / cos^2(theta_d). It integrates to ~2 over theta_i: lossless hair in a white
-    /// furnace renders at ~1.3-2.3 (MATH-NOTES, "normalisation trap"). Kept for comparison with the papers.
+    /// furnace renders at ~1.3-2.3 (docs/hair-model.md, "Energy"). Kept for comparison with the
+    /// papers.
     Published,
 }
 

@@ -12,9 +12,9 @@ use std::f64::consts::PI;
 /// Relative accuracy of the reference integrals.
 pub const REFERENCE_REL_TOL: f64 = 1e-9;
 
-/// Energy fraction one fiber scatters into lobe p: (1/2) integral_{-1}^{1} A_p(h) dh (MATH-NOTES,
-/// "Normalisation trap"). By the change of variables phi = phi(p, h) this equals integral N_p dphi
-/// for the bare root sum.
+/// Energy fraction one fiber scatters into lobe p: (1/2) integral_{-1}^{1} A_p(h) dh
+/// (docs/hair-model.md, "Energy"). By the change of variables phi = phi(p, h) this equals
+/// integral N_p dphi for the bare root sum.
 pub fn scatter_fraction(
     params: &HairParams,
     variant: ModelVariant,
@@ -75,8 +75,8 @@ pub fn azimuthal_energy(
 /// scattered fraction (1/2) integral A_p dh, averaged over the theta_d the lobe covers; the three lobes
 /// together reach 1 minus what p >= 3 would carry. Published: M_p is a unit-area Gaussian in
 /// theta_h = (theta_i + theta_o)/2, so it integrates to 2 over theta_i and E is close to 2 x the scattered
-/// fraction for narrow lobes (MATH-NOTES). The published S is symmetric, so this equals the integral over
-/// theta_o at fixed theta_i.
+/// fraction for narrow lobes (docs/hair-model.md, "Energy"). The published S is symmetric, so this
+/// equals the integral over theta_o at fixed theta_i.
 pub fn directional_albedo(
     params: &HairParams,
     variant: ModelVariant,

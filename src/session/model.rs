@@ -187,6 +187,15 @@ impl Look {
     }
 
     /// Checks every value, naming the offending one.
+    /// A preset's melanin and lobe parameters over this look (the editor's preset buttons): the
+    /// fibre's other settings stay, a root-to-tip gradient goes.
+    pub fn apply_preset(&mut self, preset: Preset) {
+        let p = Look::from_preset(preset);
+        self.params = p.params;
+        self.root = p.root;
+        self.tip = None;
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         self.params.validate()?;
         for (name, a) in [("root", Some(self.root)), ("tip", self.tip)] {

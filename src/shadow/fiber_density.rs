@@ -1,5 +1,5 @@
 //! The fiber-density volume of self-shadowing (after Bertails et al. 2005), physically scaled: the
-//! CPU twin of the GPU compute pass the renderer will run whenever geometry changes.
+//! CPU twin of the GPU compute pass the renderer runs whenever geometry changes.
 //!
 //! Per voxel: the fiber length density rho_L (cm of fiber per cm^3), the length-weighted orientation
 //! tensor T = <u u^T> (trace 1), the length-weighted mean absorption sigma_a and fiber diameter D.

@@ -3,7 +3,7 @@
 //! light-space sweeps ([`super::sweep`]; when geometry, absorption, lights or the forward table change)
 //! and read trilinearly by the shading pass, instead of once per shaded sample and light. A camera
 //! move recomputes nothing. Twin of `shaders/shadow_grid.wgsl` and `shadow_grid_build.wgsl`.
-//! [`srbf_forward`] is the cone march the sweeps replaced, kept as their reference.
+//! [`srbf_forward`] is the cone march, the sweeps' reference (docs/shadows.md).
 
 use super::cone::{DensityPyramid, srbf_cones};
 use super::fiber_density::{FiberDensity, VolumeGrid};
@@ -30,8 +30,8 @@ pub struct GridShadow {
 
 /// forward_scattering over the cones of `srbf_transmittance`, each cone marched with its own width, so
 /// the direct fraction is `srbf_transmittance` itself; sigma_f^2 is averaged per channel over the
-/// forward-scattered light, weights w (T_f - direct). The cone march the grid's sweeps replaced, kept
-/// as their reference (tests).
+/// forward-scattered light, weights w (T_f - direct). The cone march: the reference the grid's
+/// sweeps are tested against.
 pub fn srbf_forward(
     pyramid: &DensityPyramid,
     volume: &FiberDensity,

@@ -1,6 +1,6 @@
 //! The sweeps' samples as the GPU stores them (`grid_samples` in `shaders/shadow_grid_build.wgsl`,
-//! three `vec2<u32>` a sample, 24 B where three f32 vec4 took 48): the sweeps read four of them at
-//! every point of every sweep, and their bytes were the largest part of the grid's reads.
+//! three `vec2<u32>` a sample, 24 B where three f32 vec4 would take 48): the sweeps read four of
+//! them at every point of every sweep, and their bytes are the largest part of the grid's reads.
 //!
 //! | word | holds | as |
 //! |---|---|---|

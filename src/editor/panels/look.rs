@@ -175,10 +175,7 @@ fn preset_row(ui: &mut egui::Ui, look: &mut Look) -> Changed {
                 .on_hover_text("Melanin concentrations and Marschner's mid-range lobe parameters")
                 .clicked()
             {
-                let preset = Look::from_preset(p);
-                look.params = preset.params;
-                look.root = preset.root;
-                look.tip = None;
+                look.apply_preset(p);
                 c.changed = true;
             }
         }

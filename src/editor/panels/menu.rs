@@ -192,15 +192,16 @@ pub fn start_export_tiled(app: &mut EditorApp, exr: std::path::PathBuf, tile: Op
         return;
     };
     let png = Some(ExportJob::preview_path(&exr));
-    match ExportJob::start(
-        live,
+    let started = ExportJob::start(
+        &live.lock(),
         app.luts(),
         &app.session,
         exr,
         png,
         app.egui_ctx(),
         tile,
-    ) {
+    );
+    match started {
         Ok(job) => app.export = Some(job),
         Err(e) => app.message(Level::Error, format!("export: {e}")),
     }

@@ -48,12 +48,13 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
     generator(app, ui);
     head(app, ui);
     if let Some(live) = &app.live {
-        let (lo, hi) = live.hair.bounds();
+        let hair = live.lock().hair.clone();
+        let (lo, hi) = hair.bounds();
         let size = hi - lo;
         ui.weak(format!(
             "{} strands, {} points, {:.1} × {:.1} × {:.1} cm",
-            live.hair.strand_count(),
-            live.hair.point_count(),
+            hair.strand_count(),
+            hair.point_count(),
             size.x,
             size.y,
             size.z
@@ -84,7 +85,7 @@ fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         let own = match (
             &app.session.hair,
-            app.live.as_ref().map(|l| l.hair_mesh.is_some()),
+            app.live.as_ref().map(|l| l.lock().hair_mesh.is_some()),
         ) {
             (HairSource::Generated { .. }, _) => "the generated head",
             (_, Some(true)) => "the hair file's mesh",
@@ -272,16 +273,18 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
         app.perform(Edit::EnvYaw(yaw), c.gesture);
     }
     if let Some(live) = &app.live {
-        let env = &live.environment;
-        let pictures = &live.environment_pictures;
+        let (count, name) = {
+            let d = live.lock();
+            (
+                d.environment.lights.lights.len(),
+                d.environment.name.clone(),
+            )
+        };
+        let pictures = live.environment_pictures.clone();
         if app.env_preview.as_ref().map(|p| &p.key) != Some(&pictures.key) {
-            app.env_preview = Some(crate::editor::env_preview::upload(ui.ctx(), pictures));
+            app.env_preview = Some(crate::editor::env_preview::upload(ui.ctx(), &pictures));
         }
-        ui.weak(format!(
-            "{} SRBF lights · {}",
-            env.lights.lights.len(),
-            env.name
-        ));
+        ui.weak(format!("{count} SRBF lights · {name}"));
     }
     if let Some(p) = &app.env_preview {
         let w = ui.available_width().min(250.0);

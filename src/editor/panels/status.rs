@@ -11,56 +11,71 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
         };
         ui.separator();
         if let Some(live) = &app.live {
+            let s = {
+                let d = live.lock();
+                Snapshot {
+                    strands: d.hair.strand_count(),
+                    points: d.hair.point_count(),
+                    lights: d.renderer.light_count(),
+                    size: (d.display.width, d.display.height),
+                    progress: d.progress,
+                    final_image: !d.tables_pending(),
+                    first: d.first_image_in(),
+                    sharp: d.full_image_in,
+                    converged: d.converged_in,
+                }
+            };
             ui.label(format!(
                 "{} strands · {} points · {} lights",
-                live.hair.strand_count(),
-                live.hair.point_count(),
-                live.renderer.light_count()
+                s.strands, s.points, s.lights
             ));
             ui.separator();
-            let (w, h) = (live.display.width, live.display.height);
-            match (live.progress, live.converged_in) {
-                (Some(p), Some(t)) if p.converged && !live.tables_pending() => {
+            let (w, h) = s.size;
+            ui.label(format!("{w}×{h} ({:.0} %)", 100.0 * app.view.scale))
+                .on_hover_text(
+                    "The render size and its share of the viewport's pixels (View → resolution)",
+                );
+            let secs = |t: Option<std::time::Duration>| {
+                t.map_or("–".to_string(), |t| format!("{:.1} s", t.as_secs_f64()))
+            };
+            let times = format!(
+                "first {} · sharp {} · converged {}",
+                secs(s.first),
+                secs(s.sharp),
+                secs(s.converged.filter(|_| s.final_image))
+            );
+            let hover = "Wall-clock time since the last change (since the launch for the first \
+                         scene): the first image (a preview at reduced resolution), the sharp \
+                         full-resolution image (every light at the front fragment of each pixel) \
+                         and the converged image";
+            match s.progress {
+                Some(p) if p.converged && s.final_image => {
                     let passes: Vec<String> = UNIT_PASSES
                         .iter()
                         .zip(p.stats.pass_time)
                         .filter(|(_, d)| !d.is_zero())
                         .map(|(n, d)| format!("{n} {:.0}", d.as_secs_f64() * 1e3))
                         .collect();
-                    ui.label(format!(
-                        "{w}×{h} converged in {:.1} s · {} units, longest {:.0} ms",
-                        t.as_secs_f64(),
+                    ui.label(times).on_hover_text(format!(
+                        "{hover}. {} units, the longest {:.0} ms; time per pass (ms, submission \
+                         to completion of its units): {}",
                         p.stats.units,
-                        p.stats.longest.as_secs_f64() * 1e3
-                    ))
-                    .on_hover_text(format!(
-                        "Time per pass (ms, submission to completion of its units): {}",
+                        p.stats.longest.as_secs_f64() * 1e3,
                         passes.join(", ")
                     ));
-                    ui.weak(format!("ms: {}", passes.join(" · ")));
                 }
-                (Some(p), _) => {
+                Some(p) => {
                     ui.add(
                         egui::ProgressBar::new(p.fraction)
                             .desired_width(120.0)
-                            .text(format!("refining {w}×{h}")),
+                            .text("refining"),
                     );
-                    let times: Vec<String> =
-                        [("preview", live.preview_in), ("full", live.full_image_in)]
-                            .into_iter()
-                            .filter_map(|(n, t)| t.map(|t| format!("{n} {:.2} s", t.as_secs_f64())))
-                            .collect();
-                    if !times.is_empty() {
-                        ui.weak(times.join(" · ")).on_hover_text(
-                            "Since the last change: the reduced-resolution preview, and the full \
-                             image with every light at the front fragment of each pixel",
-                        );
-                    }
+                    ui.weak(times).on_hover_text(hover);
                 }
-                _ => {}
+                None => {
+                    ui.weak(times).on_hover_text(hover);
+                }
             }
-        } else if app.loading.is_some() {
-            ui.spinner();
         }
         if let Some(job) = &app.loading {
             ui.separator();
@@ -86,7 +101,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
         if app.frame_ms > 0.0 {
             ui.separator();
             ui.weak(format!("UI {:.1} ms", app.frame_ms))
-                .on_hover_text("Time between UI frames while the viewport refines");
+                .on_hover_text("The UI's own work per frame (the render thread refines apart)");
         }
         if let Some(m) = app.messages.last() {
             ui.separator();
@@ -98,4 +113,17 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             ui.add(egui::Label::new(egui::RichText::new(&m.text).color(colour)).truncate());
         }
     });
+}
+
+/// What the status bar shows of the live driver, read under its lock at once.
+struct Snapshot {
+    strands: usize,
+    points: usize,
+    lights: u32,
+    size: (u32, u32),
+    progress: Option<crate::render::progressive::Progress>,
+    final_image: bool,
+    first: Option<std::time::Duration>,
+    sharp: Option<std::time::Duration>,
+    converged: Option<std::time::Duration>,
 }

@@ -21,7 +21,7 @@ pub fn show(app: &mut EditorApp, ui: &mut egui::Ui) {
     app.viewport_px = px;
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 0.0, egui::Color32::from_rgb(41, 41, 43));
-    match app.live.as_ref().and_then(|l| l.texture) {
+    match app.live.as_ref().and_then(|l| l.texture_id()) {
         Some(id) => {
             painter.image(
                 id,

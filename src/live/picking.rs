@@ -2,8 +2,8 @@
 //! renderer has drawn the current view's visibility, the points projected for that view on a worker
 //! ([`Picker`]), and a dab's absorption written to the renderer for only the points it changed.
 
+use super::driver::{LiveDriver, LiveError};
 use super::jobs::Job;
-use super::live::{LiveError, LiveScene};
 use crate::gpu::context::PendingRead;
 use crate::paint::brush::effective;
 use crate::paint::pick::{Picker, ViewDepth};
@@ -21,7 +21,19 @@ pub struct Picking {
     picker: Option<Arc<Picker>>,
 }
 
-impl LiveScene {
+impl Picking {
+    /// The view depth is on its way back.
+    pub fn reading(&self) -> bool {
+        self.reading.is_some()
+    }
+}
+
+impl LiveDriver {
+    /// The brush wants a picker and the current view has none yet.
+    pub(super) fn picking_pending(&self) -> bool {
+        self.picker().is_none()
+    }
+
     /// Once a frame while the brush is active: when the renderer has the current view's depth and
     /// the picker is for another view, reads the depth back and builds a picker from it.
     pub fn update_picking(&mut self) {
@@ -107,6 +119,11 @@ impl LiveScene {
             self.restarted();
         }
         Ok(())
+    }
+
+    /// A stroke ended (the volume and grid may follow whatever it left).
+    pub fn end_painting(&mut self) {
+        self.painting = false;
     }
 
     /// The stroke ended. Nothing more to send: the volume and shadow grid follow the dabs by
