@@ -172,6 +172,43 @@ fn click(h: &mut Harness<'static, EditorApp>, label: &str) {
 }
 
 #[test]
+fn refinement_proceeds_without_ui_frames_and_converges() {
+    let dir = tmp("no-frames");
+    let mut h = harness(small_session(), &dir.join("state"), false);
+    // UI frames until the loaded scene is installed (a frame takes the load job's result), and
+    // one more that tells the driver the viewport's size and camera.
+    let t = Instant::now();
+    while h.state().live.is_none() {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+        assert!(t.elapsed() < Duration::from_secs(300), "the scene loads");
+    }
+    h.step();
+    // From here no UI frame runs: the render thread alone refines the image.
+    let frames = h.state().frame_costs.len();
+    let live = h.state().live.as_ref().expect("a scene");
+    assert!(
+        live.handle().wait_idle(Duration::from_secs(300)),
+        "the viewport converged without UI frames"
+    );
+    let (units, shown) = {
+        let d = live.lock();
+        let p = d.progress.expect("progress");
+        assert!(p.converged && d.converged_in.is_some() && !d.tables_pending());
+        (
+            p.stats.units,
+            d.first_image_in().is_some() && d.full_image_in.is_some(),
+        )
+    };
+    assert_eq!(h.state().frame_costs.len(), frames, "no UI frame ran");
+    println!("converged in {units} units with no UI frame");
+    assert!(shown && units > 1);
+    // The next frame shows it converged.
+    h.step();
+    assert!(h.state().converged().is_some());
+}
+
+#[test]
 fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
     let dir = tmp("equal");
     let mut h = harness(small_session(), &dir, false);
