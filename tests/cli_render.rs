@@ -1,4 +1,4 @@
-//! `strandlight render` and `strandlight bench` end to end (lavapipe in CI).
+//! `strandlight render` end to end (lavapipe in CI).
 
 mod common;
 

@@ -239,8 +239,8 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
         difference(&with_draft, &b)
     );
     // Measured 1.1e-3 against 9.6e-3: most of it the forward and dual tables, the old eta's until
-    // the tables come (a draft that carried the new eta's, built in twice the time, measured
-    // 1.6e-4 against 9.4e-3).
+    // the tables come (a draft carrying the new eta's forward and dual tables too would take
+    // twice as long to build, for 1.6e-4 against 9.4e-3).
     assert!(
         draft_error > 0.0 && draft_error < 0.2 * difference(&b, &c),
         "the draft's image ({draft_error}) is far closer to the table's than the old eta's"
@@ -1180,7 +1180,7 @@ fn a_coarse_preview_of_dense_hair_draws_a_quarter_of_the_strands_four_times_as_w
 /// The preview's divisor changed after the frame's plan had begun (the automatic divisor adapts to
 /// the first preview's time, after it): once the image converges the plan draws the preview's
 /// visibility at the new divisor, so that the next change's preview only shades (on lavapipe the
-/// redraw was 140 ms of S1's first edit's 300 ms preview). The image is the same; the preview the
+/// redraw takes ~140 ms of S1's first edit's 300 ms preview). The image is the same; the preview the
 /// next change shows is the one a preview drawn then would show.
 #[test]
 fn a_converged_plan_draws_the_next_previews_visibility() {

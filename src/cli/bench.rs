@@ -24,7 +24,7 @@ pub struct BenchArgs {
     /// Scenes to run (S0, S1, S2, S3).
     #[arg(long, value_delimiter = ',', default_value = "S0,S1,S2,S3")]
     pub scenes: Vec<String>,
-    /// Timed frames per scene (the issue asks for at least 20; software adapters may need fewer).
+    /// Timed frames per scene (20 give stable medians on a GPU; software adapters may need fewer).
     #[arg(long, default_value_t = 20)]
     pub frames: usize,
     /// Untimed frames first.

@@ -158,7 +158,10 @@ pub struct EditorApp {
     /// Work remains for the viewport (the render thread is refining).
     pub refining: bool,
     /// When this frame's work started.
-    frame_started: Option<Instant>,
+    pub(super) frame_started: Option<Instant>,
+    /// A dab not yet seen on screen: when its frame began, and the driver's restart it made
+    /// (`--log-times` reports its latency).
+    pub(super) pending_dab: Option<(Instant, u64)>,
     /// The first scene is still to come (its times count from the launch).
     first_scene: bool,
     /// Set by wgpu when the device is lost (reason and message).
@@ -273,6 +276,7 @@ impl EditorApp {
             frame_costs: Default::default(),
             refining: false,
             frame_started: None,
+            pending_dab: None,
             first_scene: true,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
@@ -318,6 +322,9 @@ impl EditorApp {
                     }
                     wake.request_repaint();
                 }));
+        }
+        if let Some(g) = &app.gpu {
+            app.view = ViewSettings::for_adapter(g.adapter.get_info().device_type);
         }
         app.load_scene();
         app
@@ -917,6 +924,16 @@ impl EditorApp {
         };
         let (restarts, first, sharp, converged) = {
             let d = live.lock();
+            if let Some((t, r)) = self.pending_dab
+                && d.restarts() >= r
+                && d.first_image_in().is_some()
+            {
+                self.pending_dab = None;
+                eprintln!(
+                    "dab: shown {:.1} ms after the frame that took it",
+                    t.elapsed().as_secs_f64() * 1e3
+                );
+            }
             let done = d.progress.is_some_and(|p| p.converged) && !d.tables_pending();
             (
                 d.restarts(),

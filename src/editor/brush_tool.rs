@@ -106,15 +106,24 @@ impl EditorApp {
         let (Some(live), Some(stroke)) = (&self.live, &mut self.stroke) else {
             return;
         };
-        let result = live.lock().dab(
-            &mut self.session,
-            &mut stroke.stroke,
-            &self.brush,
-            centres,
-            radius,
-            pressure,
-        );
+        let (result, restarts) = {
+            let mut d = live.lock();
+            let r = d.dab(
+                &mut self.session,
+                &mut stroke.stroke,
+                &self.brush,
+                centres,
+                radius,
+                pressure,
+            );
+            (r, d.restarts())
+        };
         live.kick();
+        if let Ok(Dab::Painted { points: 1.., .. }) = result
+            && self.pending_dab.is_none()
+        {
+            self.pending_dab = Some((self.frame_started.unwrap_or(t), restarts));
+        }
         let n = match result {
             Ok(Dab::Painted {
                 points,

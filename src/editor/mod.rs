@@ -18,7 +18,7 @@ use crate::gpu::GpuContext;
 use std::sync::Arc;
 
 /// eframe's wgpu setup asking for what the renderer needs: the adapter's own limits and the optional
-/// features (eframe requests only defaults unless told; GPU-NOTES).
+/// features (eframe requests only defaults unless told; docs/gpu.md).
 pub fn wgpu_setup() -> egui_wgpu::WgpuSetup {
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     setup.instance_descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();

@@ -48,15 +48,37 @@ pub struct ViewSettings {
 }
 
 impl Default for ViewSettings {
+    /// Every pixel of the viewport rendered (a hardware GPU's default).
     fn default() -> Self {
         Self {
             transform: ViewTransform::Filmic,
             exposure: 0.0,
-            scale: 0.5,
+            scale: 1.0,
             solo: Solo::Beauty,
         }
     }
 }
+
+impl ViewSettings {
+    /// The default view for an adapter: the viewport at full resolution, but half of it on a
+    /// software GPU, where the default scene at the default window's full viewport (654x734)
+    /// converges in 8-9 s in the editor (the refinement alone 6.6 s, `render --session` 4.8 s) and at
+    /// half resolution in about 6 s (4.6 s and 3.7 s): a first look at every change within a few
+    /// seconds matters more there than the last pixel; the resolution buttons raise it.
+    pub fn for_adapter(device_type: wgpu::DeviceType) -> Self {
+        Self {
+            scale: if device_type == wgpu::DeviceType::Cpu {
+                SOFTWARE_VIEW_SCALE
+            } else {
+                1.0
+            },
+            ..Self::default()
+        }
+    }
+}
+
+/// The default render scale on a software GPU ([`ViewSettings::for_adapter`]).
+pub const SOFTWARE_VIEW_SCALE: f32 = 0.5;
 
 /// The viewport's background (display-encoded grey).
 pub const BACKGROUND: [f32; 3] = [0.16, 0.16, 0.17];
@@ -122,8 +144,8 @@ pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_
 /// The share of the unit budget the refinement's units after the preview get while tables are
 /// wanted or built on a worker (`building`): on a software GPU the build takes its cores, and units
 /// sized to the whole budget from costs measured without it ran 1.5 times as long (S1's eta edits,
-/// whose azimuthal table takes 1.3-1.6 s: units of up to 56-63 ms at 35 ms, lavapipe, 2-core Zen 3
-/// VM). A hardware GPU keeps the whole budget ([`Renderer::set_budget_share`]).
+/// whose azimuthal table takes 1.3-1.6 s: units of up to 56-63 ms at 35 ms, lavapipe, two
+/// cores). A hardware GPU keeps the whole budget ([`Renderer::set_budget_share`]).
 pub fn budget_share(ctx: &GpuContext, building: bool) -> f64 {
     if building && ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
         SOFTWARE_SHARE_WHILE_BUILDING

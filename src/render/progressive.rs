@@ -36,20 +36,20 @@ use crate::gpu::GpuContext;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-/// The default longest submission (the bound on lavapipe is 50 ms; the budget leaves room for
-/// the estimate's error).
+/// The default longest submission (units should stay under 50 ms, what a UI sharing the queue waits
+/// behind at most; the budget leaves room for the estimate's error).
 pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
 
 /// First guesses, before a unit of the kind has been measured: conservative (lavapipe on two cores
 /// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a
 /// 16-light batch at 720 pixels).
 const GUESS_GRID_ENTRY_S: f64 = 10e-3;
-/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: 350-500 ns on a
-/// 2-core Zen 3 VM; when the guess was 50 ns S1's 343k samples went in one 110-140 ms unit).
+/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: 350-500 ns; a guess
+/// of 50 ns would put S1's 343k samples in one 110-140 ms unit).
 const GUESS_GRID_SAMPLE_S: f64 = 500e-9;
 const GUESS_SHADE_ROW_S: f64 = 40e-3;
-/// A voxel resolved (lavapipe, two cores: 100-180 ns, 400-580 ns on a 2-core Zen 3 VM, where the
-/// guess of 400 ns made S1's first resolve unit of 87.5k voxels take 51 ms at 35 ms units).
+/// A voxel resolved (lavapipe, two cores: 100-580 ns depending on the machine; a guess of 400 ns can
+/// make S1's first resolve unit of 87.5k voxels take 51 ms at 35 ms units).
 const GUESS_VOXEL_S: f64 = 600e-9;
 /// The fewest voxels a resolve unit and rows a backdrop unit hold (a unit's fixed cost, which a tiny
 /// budget cannot hold, would otherwise shrink them to one of each).
@@ -57,8 +57,8 @@ const MIN_RESOLVE_VOXELS: u32 = 16_384;
 const MIN_BACKDROP_ROWS: u32 = 8;
 /// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
 const GUESS_SEGMENT_S: f64 = 1e-6;
-/// A segment drawn into the K-buffer (lavapipe, two cores: S0's preview drew 30000 segments in one
-/// 406 ms unit, the shader's compilation included, when this guess was the ribbons' 1 us).
+/// A segment drawn into the K-buffer (lavapipe, two cores: with a guess of 1 us, S0's preview drew
+/// 30000 segments in one 406 ms unit, the shader's compilation included).
 const GUESS_VISIBILITY_SEGMENT_S: f64 = 8e-6;
 /// A visible segment under one light, shaded by segment (lavapipe, two cores: 2.7 us on S1).
 const GUESS_SEGMENT_LIGHT_S: f64 = 10e-6;
@@ -1536,7 +1536,7 @@ impl Renderer {
                 let r = &mut self.refinement;
                 let guess = GUESS_PIXEL_S * self.settings.width as f64;
                 // At most twice the last, from a few workgroups' rows (rows with hair cost more than
-                // the background's, and the cost per row measured in one sitting can double in the
+                // the background's, and the cost per row measured in one unit can double in the
                 // next when a table worker shares the cores).
                 if row == 0 {
                     r.backdrop_last = 2 * MIN_BACKDROP_ROWS;

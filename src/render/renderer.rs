@@ -1,4 +1,4 @@
-//! The renderer the CLI, the benchmarks and (later) the editor drive: GPU resources for one hairstyle,
+//! The renderer the CLI, the benchmarks and the live driver drive: GPU resources for one hairstyle,
 //! updated in place when parameters, absorption, lights or the camera change, and `render_frame`,
 //! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
 //! the per-light shadow grid when they or the lights changed, visibility, shading batches, resolve).
@@ -285,9 +285,10 @@ pub struct RenderSettings {
     /// weighted by the light's transmittance at its ends and midpoint; multiple scattering once per
     /// pair of consecutive segments of a strand with the same absorption, at the point they share:
     /// `shade::ShadingHair::ms_key`) instead of every kept fragment at its own point (false): ~8x
-    /// fewer responses at full resolution (S1 on lavapipe: 8.9 s a frame against 101 s, one sitting). On by default; its cost
-    /// against per-fragment shading is 0.42 % relative RMSE (`tests/render.rs`), and on the blond clump
-    /// of `tests/ms_reference.rs` it stays as close to ray shooting (9.0 % against 9.7 %). Each light's
+    /// fewer responses at full resolution (S1 on lavapipe: 8.9 s a frame against 101 s per
+    /// fragment). On by default; its cost against per-fragment shading is bounded by
+    /// `tests/render.rs`, and on the blond clump of `tests/ms_reference.rs` it stays at least as close
+    /// to ray shooting (docs/testing.md gives the measured figures). Each light's
     /// response reads the absorption at each of the segment's ends where they differ (the midpoint's
     /// between them), so paint keeps its gradient along the segment; a pair whose points' absorption
     /// differs gets a multiple-scattering sample per segment.

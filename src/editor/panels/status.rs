@@ -33,7 +33,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             let (w, h) = s.size;
             ui.label(format!("{w}×{h} ({:.0} %)", 100.0 * app.view.scale))
                 .on_hover_text(
-                    "The render size and its share of the viewport's pixels (View → resolution)",
+                    "The render size and its share of the viewport's pixels (the resolution buttons by the view transform)",
                 );
             let secs = |t: Option<std::time::Duration>| {
                 t.map_or("–".to_string(), |t| format!("{:.1} s", t.as_secs_f64()))
