@@ -1,4 +1,5 @@
-//! Every parser fed 10^5 mutated versions of a valid file: errors are fine, panics are not.
+//! Every parser fed 10^5 mutated versions of a valid file (which must itself parse): errors are
+//! fine, panics are not.
 
 mod common;
 
@@ -45,6 +46,11 @@ fn mutate(valid: &[u8], m: &Mutation) -> Vec<u8> {
 }
 
 fn fuzz(name: &str, valid: Vec<u8>, parse: impl Fn(&[u8]) -> bool) {
+    // The seed itself must parse: a parser that rejected everything would otherwise pass.
+    assert!(
+        parse(&valid),
+        "{name}: the unmutated seed file does not parse"
+    );
     // A fixed seed keeps CI reproducible; set PROPTEST_RNG_SEED to explore other mutations.
     let seed = std::env::var("PROPTEST_RNG_SEED")
         .ok()

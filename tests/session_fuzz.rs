@@ -19,6 +19,9 @@ fn mutated_sessions_never_panic() {
         beta_n: 0.3,
     });
     let text = valid.to_json();
+    // The seed itself must parse: a parser that rejected everything would otherwise pass.
+    let back = Session::from_json(&text, Path::new("seed.slsession")).expect("the seed parses");
+    assert_eq!(back, valid);
     let bytes = text.as_bytes().to_vec();
     let mut runner = TestRunner::new(Config {
         cases: CASES,
@@ -56,6 +59,68 @@ fn mutated_sessions_never_panic() {
         .expect("no panic, errors name the file");
     println!(
         "{CASES} mutated sessions: {} still parsed and validated",
+        parsed.get()
+    );
+}
+
+#[test]
+fn mutated_recovery_files_never_panic() {
+    let session: serde_json::Value =
+        serde_json::from_str(&Session::default().to_json()).expect("a session's JSON");
+    let seed = serde_json::json!({
+        "session_path": "/nowhere/look.slsession",
+        "session": session,
+    })
+    .to_string();
+    let dir =
+        std::env::temp_dir().join(format!("strandlight-recovery-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let file = dir.join("recovery-1.slsession");
+    let read = |bytes: &[u8]| {
+        std::fs::write(&file, bytes).expect("written");
+        strandlight::editor::autosave::read_recovery(&file)
+    };
+    // The seed itself must read back: a reader that rejected everything would otherwise pass.
+    let (path, s, warning) = read(seed.as_bytes()).expect("the unmutated recovery file reads");
+    assert_eq!(path, Path::new("/nowhere/look.slsession"));
+    assert_eq!(s, Session::default());
+    assert!(warning.is_none());
+    let cases = CASES / 4;
+    let mut runner = TestRunner::new(Config {
+        cases,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let parsed = std::cell::Cell::new(0u32);
+    runner
+        .run(
+            &(
+                prop::collection::vec((any::<usize>(), any::<u8>()), 0..6),
+                prop::option::of(any::<usize>()),
+            ),
+            |(edits, cut)| {
+                let mut b = seed.as_bytes().to_vec();
+                for (pos, v) in edits {
+                    let n = b.len();
+                    b[pos % n] = b"0123456789-.e,:{}[]\"tfn "[v as usize % 24];
+                }
+                if let Some(c) = cut {
+                    b.truncate(c % (b.len() + 1));
+                }
+                match read(&b) {
+                    Ok((_, s, _)) => {
+                        parsed.set(parsed.get() + 1);
+                        prop_assert!(s.validate().is_ok());
+                    }
+                    Err(e) => prop_assert!(e.contains("recovery-1.slsession"), "{e}"),
+                }
+                Ok(())
+            },
+        )
+        .expect("no panic, errors name the file");
+    let _ = std::fs::remove_dir_all(&dir);
+    println!(
+        "{cases} mutated recovery files: {} still read and validated",
         parsed.get()
     );
 }
