@@ -883,8 +883,31 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
     );
     println!("tiled (40 px) against untiled export: max {d:.2e}, mean {mean:.2e} of the peak");
     assert!(mean < 1e-4, "{d} {mean}");
+}
 
-    // The README's screenshot, made here.
+/// The default scene as a user first sees it, in the default window: it converges, the status bar
+/// shows its times and scale, and the screenshot is the README's (docs/editor.png).
+#[test]
+fn the_default_scene_in_the_default_window() {
+    let dir = tmp("default-scene");
+    std::fs::create_dir_all(&dir).expect("state dir");
+    let options = EditorOptions {
+        session: Some(Session::default()),
+        state_dir: Some(dir),
+        ..Default::default()
+    };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .wgpu_setup(strandlight::editor::wgpu_setup())
+        .build_eframe(move |cc| EditorApp::new(cc, options));
+    let software = h.state().gpu.as_ref().expect("a GPU").summary.device_type == "Cpu";
+    assert_eq!(h.state().view.scale, if software { 0.5 } else { 1.0 });
+    converge(&mut h);
+    // The status bar's times of the launch (each query panics when no label matches).
+    h.get_by_label_contains("first ");
+    h.get_by_label_contains("sharp ");
+    h.get_by_label_contains("converged ");
+    h.get_by_label_contains(if software { "(50 %)" } else { "(100 %)" });
     let shot = h.render().expect("a screenshot");
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("editor.png");
     shot.save(&out).expect("saved");
