@@ -10,6 +10,7 @@ fn no_point_inside_the_head_and_lengths_in_range() {
         Style::Curly,
         Style::Bob,
         Style::Ponytail,
+        Style::SidePart,
     ] {
         let mut p = StyleParams::new(style, 3000, 40, 11);
         p.frizz = 0.3;

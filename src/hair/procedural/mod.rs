@@ -27,6 +27,10 @@ pub enum Style {
     Curly,
     Bob,
     Ponytail,
+    /// Chin to shoulder length, parted on the right (+X): combed from the parting down over the
+    /// scalp, the longer side swept across the crown and the forehead in a side fringe, so the scalp
+    /// is hidden from the front and the sides.
+    SidePart,
 }
 
 impl Style {
@@ -38,6 +42,7 @@ impl Style {
             Style::Curly => (25.0, 35.0),
             Style::Bob => (14.0, 20.0),
             Style::Ponytail => (40.0, 50.0),
+            Style::SidePart => (18.0, 25.0),
         }
     }
 }
@@ -175,9 +180,13 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
     let outward = (root - head.centre).with_y(0.0).normalize_or(normal);
     let front = ((root.z - head.centre.z) / head.radii.z).max(0.0);
     let aside = Vec3::X * (root.x - head.centre.x).signum();
-    let mut base =
-        (0.5 * normal + outward + 0.5 * down + (Vec3::Y * 1.5 - Vec3::Z * 2.5 + aside) * front)
-            .normalize_or(down);
+    let mut base = match params.style {
+        Style::SidePart => parted_start(head, root, normal),
+        _ => {
+            (0.5 * normal + outward + 0.5 * down + (Vec3::Y * 1.5 - Vec3::Z * 2.5 + aside) * front)
+                .normalize_or(down)
+        }
+    };
     let mut side = orthogonal(base);
     let mut frizz_tilt = Vec3::ZERO;
     let mut pts = Vec::with_capacity(n);
@@ -199,10 +208,20 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                 (down + 0.3 * (column - p)).normalize_or(down)
             }
             _ => {
-                // Combed back while in front of the ears, above the chin: the face stays clear.
-                let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0)
-                    * (p.y > head.centre.y - 0.6 * head.radii.y) as u8 as f32;
-                (base + 0.35 * ds * down - Vec3::Z * (0.6 * ds * ahead)).normalize_or(down)
+                // Combed back while in front of the ears, above the chin: the face stays clear
+                // (the side part's fringe only below the brow, so it sweeps across the forehead).
+                let brow = head.centre.y + 0.15 * head.radii.y;
+                let clear = match params.style {
+                    Style::SidePart => p.y < brow,
+                    _ => p.y > head.centre.y - 0.6 * head.radii.y,
+                };
+                let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0) * clear as u8 as f32;
+                let back = if params.style == Style::SidePart {
+                    1.5
+                } else {
+                    0.6
+                };
+                (base + 0.35 * ds * down - Vec3::Z * (back * ds * ahead)).normalize_or(down)
             }
         };
         // Parallel transport of the side vector keeps curls from twisting.
@@ -227,6 +246,13 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                 let curl = ((t - 0.7) / 0.3).clamp(0.0, 1.0);
                 dir = (base + 1.2 * curl * inward).normalize_or(base);
             }
+            Style::SidePart => {
+                // A loose wave for body, only towards the tips (the crown stays sleek).
+                let tilt = 0.3
+                    * ((t - 0.4) / 0.3).clamp(0.0, 1.0)
+                    * (std::f32::consts::TAU * s / (1.5 * wave_length) + phase).sin();
+                dir = base * tilt.cos() + side * tilt.sin();
+            }
             Style::StraightLong | Style::Ponytail => {}
         }
         if params.frizz > 0.0 {
@@ -238,6 +264,36 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
         pts.push(p);
     }
     pts
+}
+
+/// The parting of [`Style::SidePart`]: x over the head's half width (right of centre, as seen facing
+/// the head).
+const PARTING_X: f32 = 0.3;
+
+/// The first direction of a [`Style::SidePart`] strand rooted at `root` (scalp normal `normal`):
+/// along the scalp, away from the parting, turning to straight back behind the crown; the front of
+/// the longer side sweeps across the forehead (the fringe). A slight lift off the scalp gives the
+/// crown some volume.
+fn parted_start(head: &Head, root: Vec3, normal: Vec3) -> Vec3 {
+    let q = (root - head.centre) / head.radii;
+    let long_side = q.x <= PARTING_X;
+    let away = if long_side { -Vec3::X } else { Vec3::X };
+    // Behind the crown the parting ends: hair there falls back and down.
+    let behind = ((-q.z + 0.1) / 0.5).clamp(0.0, 1.0);
+    let front = (q.z / 0.8).clamp(0.0, 1.0);
+    let fringe = if long_side { fringe_weight(q) } else { 0.0 };
+    let comb = away * (1.0 - behind)
+        + Vec3::NEG_Z * ((0.25 + 0.35 * front) * (1.0 - fringe) + behind)
+        + Vec3::Z * (0.4 * fringe)
+        + Vec3::NEG_Y * 0.4;
+    let along = (comb - normal * comb.dot(normal)).normalize_or(Vec3::NEG_Y);
+    (along + 0.15 * normal).normalize_or(Vec3::NEG_Y)
+}
+
+/// How much a root of the longer side (at `q`, scaled by the head's radii) belongs to the fringe:
+/// 1 along the front hairline, 0 from a third of the way up to the crown.
+fn fringe_weight(q: Vec3) -> f32 {
+    ((q.z - 0.25) / 0.3).clamp(0.0, 1.0)
 }
 
 /// One step of length `ds` from `p` along `dir`, sliding over the head if it would enter it.
