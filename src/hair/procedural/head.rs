@@ -125,7 +125,8 @@ impl Head {
     /// The skull as a closed triangle mesh (outward winding, counter-clockwise seen from outside):
     /// latitude rings from the crown down, `2 rings` vertices each, carved by the face's relief. With
     /// a neck, the rings stop at the first one below the equator wholly inside the neck's circle, a
-    /// flat annulus joins it to a cylinder that runs down to two half-heights below the centre, and a
+    /// flat annulus joins it to a neck (widening a little) that runs down to 1.75 half-heights below the centre (~10 cm
+    /// below the jaw), and a
     /// disc closes it.
     pub fn mesh(&self, rings: usize, neck: bool) -> TriangleMesh {
         use std::f32::consts::{PI, TAU};
@@ -178,12 +179,12 @@ impl Head {
                 .iter()
                 .map(|v| v.y)
                 .fold(f32::MAX, f32::min);
-            let bottom = self.centre.y - 2.0 * self.radii.y;
+            let bottom = self.centre.y - 1.75 * self.radii.y;
             let base = positions.len();
-            for y in [y0, bottom] {
+            // Widening a little towards the shoulders.
+            for (y, r) in [(y0, neck_r), (bottom, 1.1 * neck_r)] {
                 for j in 0..n {
-                    positions
-                        .push(self.centre + around(j) * neck_r + Vec3::Y * (y - self.centre.y));
+                    positions.push(self.centre + around(j) * r + Vec3::Y * (y - self.centre.y));
                 }
             }
             band(&mut triangles, top, base);
