@@ -317,7 +317,7 @@ mod tests {
     fn presets_are_spelled_as_on_the_command_line() {
         let text = Session::default()
             .to_json()
-            .replace("\"style\": \"wavy\"", "\"style\": \"bob\"");
+            .replace("\"style\": \"side-part\"", "\"style\": \"bob\"");
         let s = Session::from_json(&text, Path::new("x")).unwrap();
         assert!(matches!(
             s.hair,

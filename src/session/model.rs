@@ -425,24 +425,56 @@ impl OccluderOptions {
 }
 
 impl Default for Session {
-    /// The editor's first scene: a wavy style of 10000 strands on the generated head under the sunny
-    /// sky. With fibres of their true width fewer strands look thin (3000 showed the scalp); the
-    /// K-buffer's shading costs the same (lavapipe: 30.4 s for both at 330x370 by `render`).
+    /// The editor's first scene: a side-parted, shoulder-length style with a fringe, 14000 strands
+    /// on the generated head under the sunny sky, framed as a portrait.
+    /// - Each strand stands for a few hairs (the fibres are drawn 3.5 times their width): 14000
+    ///   strands of true width let the scalp show through, and 50000 would cost 3.5 times the
+    ///   shading.
+    /// - A darker skin and an exposure a stop down: the face keeps its modelling under the key
+    ///   light.
+    /// - A 20-degree field of view (a portrait lens) after framing at 30: the hair fills most of a
+    ///   portrait viewport's height.
+    /// - The sky turned so that the sun is a key light above and beside the camera (unturned it sits
+    ///   behind the head, lighting only a rim): the primary highlight runs across the crown in the
+    ///   three-quarter view and the face is modelled from its side.
     fn default() -> Self {
         Self {
             version: SESSION_VERSION,
-            hair: HairSource::generated(Style::Wavy, 10000, 16, 1),
+            hair: HairSource::generated(Style::SidePart, 14000, 16, 1),
             environment: EnvironmentSource::Builtin,
-            env_yaw: 0.0,
-            look: Look::default(),
-            camera: ViewCamera::default(),
-            render: RenderOptions::default(),
+            env_yaw: DEFAULT_ENV_YAW,
+            look: Look {
+                thickness_scale: 3.5,
+                ..Look::default()
+            },
+            camera: ViewCamera {
+                fov_y: 20.0,
+                ..ViewCamera::default()
+            },
+            render: RenderOptions {
+                exposure: DEFAULT_EXPOSURE,
+                ..RenderOptions::default()
+            },
             paint: None,
             paint_layer: None,
-            occluder: OccluderOptions::default(),
+            occluder: OccluderOptions {
+                albedo: DEFAULT_SKIN_ALBEDO,
+                ..OccluderOptions::default()
+            },
         }
     }
 }
+
+/// The default scene's skin (linear RGB): a little darker than the renderer's, so that the face
+/// keeps its modelling under the key light.
+pub const DEFAULT_SKIN_ALBEDO: [f32; 3] = [0.42, 0.26, 0.19];
+
+/// The default scene's exposure, stops: the sun as a key light beside the camera would blow the
+/// skin out at the renderer's default.
+pub const DEFAULT_EXPOSURE: f32 = -1.0;
+
+/// The default scene's turn of the built-in sky, degrees (see [`Session::default`]).
+pub const DEFAULT_ENV_YAW: f64 = -110.0;
 
 impl Session {
     /// The look's parameters as the renderer takes them, with sigma_a from the root absorption.

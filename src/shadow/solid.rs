@@ -96,7 +96,11 @@ mod tests {
 
     #[test]
     fn a_head_fills_its_volume_and_nothing_else() {
-        let head = Head::default();
+        // The plain ellipsoid (no face), whose volume is known exactly.
+        let head = Head {
+            face: false,
+            ..Head::default()
+        };
         let mesh = head.mesh(24, false);
         let grid = VolumeGrid {
             origin: Vec3::splat(-12.0),

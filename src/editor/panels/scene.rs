@@ -11,12 +11,13 @@ use crate::render::frame::{srgb_decode, srgb_encode};
 use crate::render::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
 
-const STYLES: [(Style, &str); 5] = [
+const STYLES: [(Style, &str); 6] = [
     (Style::StraightLong, "straight long"),
     (Style::Wavy, "wavy"),
     (Style::Curly, "curly"),
     (Style::Bob, "bob"),
     (Style::Ponytail, "ponytail"),
+    (Style::SidePart, "side part"),
 ];
 
 pub fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {

@@ -27,6 +27,11 @@ pub enum Style {
     Curly,
     Bob,
     Ponytail,
+    /// Chin to shoulder length, parted on the right (+X): combed from the parting down over the
+    /// scalp, with a fringe over the forehead that ends just above the brows (no strand falls in
+    /// front of the face: each is cut where it would), so the scalp is hidden from the front and
+    /// the sides.
+    SidePart,
 }
 
 impl Style {
@@ -38,6 +43,7 @@ impl Style {
             Style::Curly => (25.0, 35.0),
             Style::Bob => (14.0, 20.0),
             Style::Ponytail => (40.0, 50.0),
+            Style::SidePart => (18.0, 25.0),
         }
     }
 }
@@ -175,9 +181,13 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
     let outward = (root - head.centre).with_y(0.0).normalize_or(normal);
     let front = ((root.z - head.centre.z) / head.radii.z).max(0.0);
     let aside = Vec3::X * (root.x - head.centre.x).signum();
-    let mut base =
-        (0.5 * normal + outward + 0.5 * down + (Vec3::Y * 1.5 - Vec3::Z * 2.5 + aside) * front)
-            .normalize_or(down);
+    let mut base = match params.style {
+        Style::SidePart => parted_start(head, root, normal),
+        _ => {
+            (0.5 * normal + outward + 0.5 * down + (Vec3::Y * 1.5 - Vec3::Z * 2.5 + aside) * front)
+                .normalize_or(down)
+        }
+    };
     let mut side = orthogonal(base);
     let mut frizz_tilt = Vec3::ZERO;
     let mut pts = Vec::with_capacity(n);
@@ -199,10 +209,20 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                 (down + 0.3 * (column - p)).normalize_or(down)
             }
             _ => {
-                // Combed back while in front of the ears, above the chin: the face stays clear.
-                let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0)
-                    * (p.y > head.centre.y - 0.6 * head.radii.y) as u8 as f32;
-                (base + 0.35 * ds * down - Vec3::Z * (0.6 * ds * ahead)).normalize_or(down)
+                // Combed back while in front of the ears, above the chin: the face stays clear
+                // (the side part's fringe only below the brow, so it sweeps across the forehead).
+                let brow = head.centre.y + 0.15 * head.radii.y;
+                let clear = match params.style {
+                    Style::SidePart => p.y < brow,
+                    _ => p.y > head.centre.y - 0.6 * head.radii.y,
+                };
+                let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0) * clear as u8 as f32;
+                let back = if params.style == Style::SidePart {
+                    0.6
+                } else {
+                    0.6
+                };
+                (base + 0.35 * ds * down - Vec3::Z * (back * ds * ahead)).normalize_or(down)
             }
         };
         // Parallel transport of the side vector keeps curls from twisting.
@@ -227,6 +247,13 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                 let curl = ((t - 0.7) / 0.3).clamp(0.0, 1.0);
                 dir = (base + 1.2 * curl * inward).normalize_or(base);
             }
+            Style::SidePart => {
+                // A loose wave for body, only towards the tips (the crown stays sleek).
+                let tilt = 0.3
+                    * ((t - 0.4) / 0.3).clamp(0.0, 1.0)
+                    * (std::f32::consts::TAU * s / (1.5 * wave_length) + phase).sin();
+                dir = base * tilt.cos() + side * tilt.sin();
+            }
             Style::StraightLong | Style::Ponytail => {}
         }
         if params.frizz > 0.0 {
@@ -238,6 +265,82 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
         pts.push(p);
     }
     pts
+}
+
+/// The parting of [`Style::SidePart`]: x over the head's half width (right of centre, as seen facing
+/// the head).
+const PARTING_X: f32 = 0.3;
+
+/// The first direction of a [`Style::SidePart`] strand rooted at `root` (scalp normal `normal`):
+/// along the scalp, away from the parting, turning to straight back behind the crown; the front of
+/// the longer side sweeps across the forehead (the fringe). A slight lift off the scalp gives the
+/// crown some volume.
+fn parted_start(head: &Head, root: Vec3, normal: Vec3) -> Vec3 {
+    let q = (root - head.centre) / head.radii;
+    // Away from the parting, the strands along it combed back over it (no line of bare scalp).
+    let away = Vec3::X * ((q.x - PARTING_X) / 0.2).clamp(-1.0, 1.0);
+    // Behind the crown the parting ends: hair there falls back and down.
+    let behind = ((-q.z + 0.1) / 0.5).clamp(0.0, 1.0);
+    let front = (q.z / 0.8).clamp(0.0, 1.0);
+    let fringe = fringe_weight(q);
+    let comb =
+        (away * (1.0 - behind) + Vec3::NEG_Z * (0.25 * (1.0 - front) + behind) + Vec3::NEG_Y * 0.4)
+            * (1.0 - fringe)
+            + (Vec3::Z + Vec3::NEG_Y * 0.6 + Vec3::X * (0.35 * q.x)) * fringe;
+    let along = (comb - normal * comb.dot(normal)).normalize_or(Vec3::NEG_Y);
+    (along + 0.15 * normal).normalize_or(Vec3::NEG_Y)
+}
+
+/// How much a root (at `q`, scaled by the head's radii) belongs to the fringe (the bangs): 1 over
+/// the front of the scalp between the temples, 0 from half way up to the crown and at the sides.
+fn fringe_weight(q: Vec3) -> f32 {
+    let ahead = ((q.z - 0.35) / 0.25).clamp(0.0, 1.0);
+    let between = ((0.9 - q.x.abs()) / 0.3).clamp(0.0, 1.0);
+    ahead * between
+}
+
+/// The height (over the head's centre, in half heights) above which [`Style::SidePart`]'s strands
+/// end where they would fall in front of the face: just above the brows.
+const FRINGE_CUT: f32 = 0.18;
+
+/// Whether `p` lies in front of the face below the fringe's cut: no strand of
+/// [`Style::SidePart`] enters it.
+fn before_face(head: &Head, p: Vec3, cut: f32) -> bool {
+    let q = (p - head.centre) / head.radii;
+    q.y < cut && q.z > 0.4 && q.x.abs() < 0.8
+}
+
+/// Cuts a strand where it first enters the space in front of the face (the fringe ends above the
+/// brows, no strand crosses the eyes), resampled to the same number of points of equal spacing.
+/// The cut height varies a little per strand (a soft, uneven fringe line).
+fn trim_fringe(head: &Head, pts: Vec<Vec3>, jitter: f32) -> Vec<Vec3> {
+    let cut = FRINGE_CUT + 0.03 * jitter;
+    let Some(k) = pts.iter().position(|&p| before_face(head, p, cut)) else {
+        return pts;
+    };
+    if k == 0 {
+        return pts;
+    }
+    let arc: Vec<f32> = std::iter::once(0.0)
+        .chain(pts.windows(2).scan(0.0, |a, w| {
+            *a += w[0].distance(w[1]);
+            Some(*a)
+        }))
+        .collect();
+    let length = arc[k - 1].max(0.5 * arc[k]).max(1e-3);
+    let n = pts.len();
+    let mut j = 0;
+    (0..n)
+        .map(|i| {
+            let s = length * i as f32 / (n - 1) as f32;
+            while j + 2 < n && arc[j + 1] < s {
+                j += 1;
+            }
+            let span = (arc[j + 1] - arc[j]).max(1e-6);
+            let p = pts[j].lerp(pts[j + 1], ((s - arc[j]) / span).clamp(0.0, 1.0));
+            head.push_out(p, MARGIN)
+        })
+        .collect()
 }
 
 /// One step of length `ds` from `p` along `dir`, sliding over the head if it would enter it.
@@ -302,6 +405,10 @@ pub fn generate(params: &StyleParams) -> Result<Hair, String> {
                 let prev = out[k - 1];
                 let dir = (pts[k] - prev).normalize_or(Vec3::NEG_Y);
                 out.push(step_outside(&params.head, prev, dir, ds));
+            }
+            if params.style == Style::SidePart {
+                let jitter = 2.0 * uniform(&mut rng_for(params.seed, s, 2)) - 1.0;
+                out = trim_fringe(&params.head, out, jitter);
             }
             RawStrand {
                 points: out,
