@@ -242,7 +242,12 @@ fn lights_alone_show_their_reconstruction_behind_the_hair() {
             height: 48,
             ..Default::default()
         },
-        ..Default::default()
+        ..strandlight::session::Session::neutral(strandlight::session::HairSource::generated(
+            strandlight::hair::procedural::Style::Bob,
+            300,
+            8,
+            1,
+        ))
     };
     let scene = strandlight::session::Scene::assemble(&session).expect("the scene");
     let camera = scene.camera;

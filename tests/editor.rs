@@ -24,10 +24,7 @@ fn tmp(name: &str) -> PathBuf {
 
 /// A bob of 400 strands with a coarse volume and shadow grid.
 fn small_session() -> Session {
-    let mut s = Session {
-        hair: HairSource::generated(Style::Bob, 400, 8, 3),
-        ..Default::default()
-    };
+    let mut s = Session::neutral(HairSource::generated(Style::Bob, 400, 8, 3));
     s.render.volume_resolution = 48;
     s.render.shadow_grid_resolution = 16;
     s

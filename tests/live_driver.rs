@@ -28,10 +28,7 @@ fn context() -> GpuContext {
 
 /// A 400-strand bob on the generated head with a coarse volume and shadow grid.
 fn small_session() -> Session {
-    let mut s = Session {
-        hair: HairSource::generated(Style::Bob, 400, 10, 3),
-        ..Default::default()
-    };
+    let mut s = Session::neutral(HairSource::generated(Style::Bob, 400, 10, 3));
     s.render.volume_resolution = 48;
     s.render.shadow_grid_resolution = 16;
     s

@@ -17,7 +17,7 @@ use strandlight::render::table_cache;
 use strandlight::render::{Camera, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
-use strandlight::session::{HairSource, Look, Session, ViewCamera};
+use strandlight::session::{HairSource, Look, Session};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -328,13 +328,10 @@ fn scene_session(scene: &StandardScene, args: &BenchArgs) -> Session {
     } else {
         Style::StraightLong
     };
+    // The standard scenes keep the renderer's own settings, not the first scene's art direction.
     let mut session = Session {
-        hair: HairSource::generated(style, scene.strands, scene.points, 1),
         look: Look::from_preset(Preset::Brown),
-        // The standard scenes keep their own view: the unturned sky, the framing camera.
-        env_yaw: 0.0,
-        camera: ViewCamera::default(),
-        ..Session::default()
+        ..Session::neutral(HairSource::generated(style, scene.strands, scene.points, 1))
     };
     session.render.width = scene.width;
     session.render.height = scene.height;

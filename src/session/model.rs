@@ -465,6 +465,24 @@ impl Default for Session {
     }
 }
 
+impl Session {
+    /// A session of `hair` with the renderer's own settings (the default look, the unturned sky, the
+    /// framing camera, the renderer's skin and exposure): the first scene's art direction
+    /// ([`Session::default`]) left out, for benchmarks and tests that compare against scenes made
+    /// without a session.
+    pub fn neutral(hair: HairSource) -> Self {
+        Self {
+            hair,
+            env_yaw: 0.0,
+            look: Look::default(),
+            camera: ViewCamera::default(),
+            render: RenderOptions::default(),
+            occluder: OccluderOptions::default(),
+            ..Self::default()
+        }
+    }
+}
+
 /// The default scene's skin (linear RGB): a little darker than the renderer's, so that the face
 /// keeps its modelling under the key light.
 pub const DEFAULT_SKIN_ALBEDO: [f32; 3] = [0.42, 0.26, 0.19];
