@@ -8,6 +8,44 @@ use strandlight::session::Session;
 
 const CASES: u32 = 20_000;
 
+/// Feeds `cases` mutations of the JSON text `seed` to `check` (true: it parsed); no panic may occur.
+/// The edits are mostly digits and JSON punctuation: they reach the values, not just the syntax.
+fn fuzz_json(
+    seed: &str,
+    cases: u32,
+    check: impl Fn(&str) -> Result<bool, proptest::test_runner::TestCaseError>,
+) -> u32 {
+    let mut runner = TestRunner::new(Config {
+        cases,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let parsed = std::cell::Cell::new(0u32);
+    runner
+        .run(
+            &(
+                prop::collection::vec((any::<usize>(), any::<u8>()), 0..6),
+                prop::option::of(any::<usize>()),
+            ),
+            |(edits, cut)| {
+                let mut b = seed.as_bytes().to_vec();
+                for (pos, v) in edits {
+                    let n = b.len();
+                    b[pos % n] = b"0123456789-.e,:{}[]\"tfn "[v as usize % 24];
+                }
+                if let Some(c) = cut {
+                    b.truncate(c % (b.len() + 1));
+                }
+                if check(&String::from_utf8_lossy(&b))? {
+                    parsed.set(parsed.get() + 1);
+                }
+                Ok(())
+            },
+        )
+        .expect("no panic, errors name the file");
+    parsed.get()
+}
+
 #[test]
 fn mutated_sessions_never_panic() {
     let mut valid = Session {
@@ -22,45 +60,19 @@ fn mutated_sessions_never_panic() {
     // The seed itself must parse: a parser that rejected everything would otherwise pass.
     let back = Session::from_json(&text, Path::new("seed.slsession")).expect("the seed parses");
     assert_eq!(back, valid);
-    let bytes = text.as_bytes().to_vec();
-    let mut runner = TestRunner::new(Config {
-        cases: CASES,
-        failure_persistence: None,
-        ..Config::default()
+    let parsed = fuzz_json(&text, CASES, |text| {
+        match Session::from_json(text, Path::new("fuzzed.slsession")) {
+            Ok(s) => {
+                prop_assert!(s.validate().is_ok());
+                Ok(true)
+            }
+            Err(e) => {
+                prop_assert!(e.to_string().contains("fuzzed.slsession"));
+                Ok(false)
+            }
+        }
     });
-    let parsed = std::cell::Cell::new(0u32);
-    runner
-        .run(
-            &(
-                prop::collection::vec((any::<usize>(), any::<u8>()), 0..6),
-                prop::option::of(any::<usize>()),
-            ),
-            |(edits, cut)| {
-                let mut b = bytes.clone();
-                for (pos, v) in edits {
-                    let n = b.len();
-                    // Mostly digits and JSON punctuation: they reach the values, not just the syntax.
-                    b[pos % n] = b"0123456789-.e,:{}[]\"tfn "[v as usize % 24];
-                }
-                if let Some(c) = cut {
-                    b.truncate(c % (b.len() + 1));
-                }
-                let text = String::from_utf8_lossy(&b);
-                match Session::from_json(&text, Path::new("fuzzed.slsession")) {
-                    Ok(s) => {
-                        parsed.set(parsed.get() + 1);
-                        prop_assert!(s.validate().is_ok());
-                    }
-                    Err(e) => prop_assert!(e.to_string().contains("fuzzed.slsession")),
-                }
-                Ok(())
-            },
-        )
-        .expect("no panic, errors name the file");
-    println!(
-        "{CASES} mutated sessions: {} still parsed and validated",
-        parsed.get()
-    );
+    println!("{CASES} mutated sessions: {parsed} still parsed and validated");
 }
 
 #[test]
@@ -86,41 +98,16 @@ fn mutated_recovery_files_never_panic() {
     assert_eq!(s, Session::default());
     assert!(warning.is_none());
     let cases = CASES / 4;
-    let mut runner = TestRunner::new(Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
+    let parsed = fuzz_json(&seed, cases, |text| match read(text.as_bytes()) {
+        Ok((_, s, _)) => {
+            prop_assert!(s.validate().is_ok());
+            Ok(true)
+        }
+        Err(e) => {
+            prop_assert!(e.contains("recovery-1.slsession"), "{e}");
+            Ok(false)
+        }
     });
-    let parsed = std::cell::Cell::new(0u32);
-    runner
-        .run(
-            &(
-                prop::collection::vec((any::<usize>(), any::<u8>()), 0..6),
-                prop::option::of(any::<usize>()),
-            ),
-            |(edits, cut)| {
-                let mut b = seed.as_bytes().to_vec();
-                for (pos, v) in edits {
-                    let n = b.len();
-                    b[pos % n] = b"0123456789-.e,:{}[]\"tfn "[v as usize % 24];
-                }
-                if let Some(c) = cut {
-                    b.truncate(c % (b.len() + 1));
-                }
-                match read(&b) {
-                    Ok((_, s, _)) => {
-                        parsed.set(parsed.get() + 1);
-                        prop_assert!(s.validate().is_ok());
-                    }
-                    Err(e) => prop_assert!(e.contains("recovery-1.slsession"), "{e}"),
-                }
-                Ok(())
-            },
-        )
-        .expect("no panic, errors name the file");
     let _ = std::fs::remove_dir_all(&dir);
-    println!(
-        "{cases} mutated recovery files: {} still read and validated",
-        parsed.get()
-    );
+    println!("{cases} mutated recovery files: {parsed} still read and validated");
 }
