@@ -217,12 +217,7 @@ fn grow(params: &StyleParams, strand: usize) -> Vec<Vec3> {
                     _ => p.y > head.centre.y - 0.6 * head.radii.y,
                 };
                 let ahead = ((p.z - head.centre.z) / head.radii.z).max(0.0) * clear as u8 as f32;
-                let back = if params.style == Style::SidePart {
-                    0.6
-                } else {
-                    0.6
-                };
-                (base + 0.35 * ds * down - Vec3::Z * (back * ds * ahead)).normalize_or(down)
+                (base + 0.35 * ds * down - Vec3::Z * (0.6 * ds * ahead)).normalize_or(down)
             }
         };
         // Parallel transport of the side vector keeps curls from twisting.
