@@ -160,13 +160,13 @@ pub struct EditorApp {
     /// included.
     pub frame_intervals: std::collections::VecDeque<f32>,
     last_frame_start: Option<Instant>,
-    /// Work remains for the viewport (the render thread is refining).
-    pub refining: bool,
     /// When this frame's work started.
     pub(super) frame_started: Option<Instant>,
     /// A dab not yet seen on screen: when its frame began, and the driver's restart it made
     /// (`--log-times` reports its latency).
     pub(super) pending_dab: Option<(Instant, u64)>,
+    /// The viewport's render thread was found not running (reported once).
+    render_thread_lost: bool,
     /// The first scene is still to come (its times count from the launch).
     first_scene: bool,
     /// Set by wgpu when the device is lost (reason and message).
@@ -281,10 +281,10 @@ impl EditorApp {
             frame_costs: Default::default(),
             frame_intervals: Default::default(),
             last_frame_start: None,
-            refining: false,
             frame_started: None,
             pending_dab: None,
             first_scene: true,
+            render_thread_lost: false,
             device_lost: Arc::new(std::sync::Mutex::new(None)),
             gpu_error: Arc::new(std::sync::Mutex::new(None)),
             gpu_error_shown: false,
@@ -777,6 +777,7 @@ impl EditorApp {
                         driver.count_from(self.started);
                     }
                     self.live = Some(LiveScene::new(driver, pictures, self.ctx.clone()));
+                    self.render_thread_lost = false;
                     self.failed = None;
                 }
                 Ok(_) => {}
@@ -897,21 +898,29 @@ impl EditorApp {
         let (Some(live), Some(camera)) = (&mut self.live, self.camera) else {
             return;
         };
-        let (result, paint_warning, errors, working) = {
+        let (result, paint_warning, errors) = {
             let mut d = live.lock();
             let result = d.resize(w, h).and_then(|_| d.sync(&self.session, &camera));
             d.set_view(self.view);
             d.set_picking(self.tool == super::brush_tool::Tool::Brush);
-            let working = d.working();
-            (result, d.paint_warning.take(), d.take_errors(), working)
+            (result, d.paint_warning.take(), d.take_errors())
         };
         live.kick();
+        let lost = !live.handle().running();
         if let Some(er) = &self.egui_renderer {
             live.texture(&mut er.write());
         }
-        self.refining = working;
         if self.options.log_times {
             self.log_times();
+        }
+        if lost && !self.render_thread_lost {
+            // No thread could be started for it: nothing refines the image any more.
+            self.render_thread_lost = true;
+            self.message(
+                Level::Error,
+                "the viewport's render thread is not running: the image no longer refines; \
+                 reopen the session",
+            );
         }
         if let Err(e) = result {
             self.message(Level::Error, e.to_string());

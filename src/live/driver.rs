@@ -297,8 +297,11 @@ pub struct LiveDriver {
     wanted_view: ViewSettings,
     /// Keep a picker for the current view (the brush is the active tool).
     picking_wanted: bool,
-    /// Errors of steps taken on the render thread, for the UI to report.
+    /// Errors of steps taken on the render thread, for the UI to report; a step failed, and no
+    /// change has come since; the paint warning was announced to the UI.
     errors: Vec<String>,
+    failed: bool,
+    warning_announced: bool,
     /// Display passes submitted (each is an image the UI has not drawn yet), and the restart of
     /// the last one.
     shown_count: u64,
@@ -428,6 +431,8 @@ impl LiveDriver {
             wanted_view: ViewSettings::default(),
             picking_wanted: false,
             errors: Vec::new(),
+            failed: false,
+            warning_announced: false,
             shown_count: 0,
             shown_restart: 0,
             tables: None,
@@ -685,8 +690,10 @@ impl LiveDriver {
         self.applied.paint = paint_key(session);
     }
 
-    /// A change the image does not show yet: times are measured from here.
+    /// A change the image does not show yet: times are measured from here (and a failed step is
+    /// tried again).
     pub(super) fn restarted(&mut self) {
+        self.failed = false;
         self.refine_started = Instant::now();
         self.showing_anew();
     }
@@ -947,6 +954,10 @@ impl LiveDriver {
 
     /// Whether anything is left to do: refinement, tables, the picker.
     pub fn working(&self) -> bool {
+        !self.failed && self.work_left()
+    }
+
+    fn work_left(&self) -> bool {
         !self.progress.is_some_and(|p| p.converged)
             || self.tables_pending()
             || self.view != Some(self.wanted_view)
@@ -957,7 +968,12 @@ impl LiveDriver {
     /// picker's read-back and build while the brush wants one. Errors are kept for the UI
     /// ([`LiveDriver::take_errors`]).
     pub fn pump_step(&mut self) -> StepOutcome {
+        // A step that failed is not retried until something changes (it would fail again).
+        if self.failed {
+            return StepOutcome::idle();
+        }
         let (shown, restarts) = (self.shown_count, self.restarts);
+        let fraction = self.progress.map(|p| p.fraction);
         let result = self.step(self.wanted_view);
         if self.picking_wanted {
             self.update_picking();
@@ -966,7 +982,7 @@ impl LiveDriver {
             Ok(p) => p,
             Err(e) => {
                 self.errors.push(e.to_string());
-                // Not retried until something changes (a failing step would fail again).
+                self.failed = true;
                 return StepOutcome {
                     news: true,
                     urgent: true,
@@ -974,21 +990,34 @@ impl LiveDriver {
                 };
             }
         };
-        let news = self.shown_count != shown;
+        let shown_new = self.shown_count != shown;
         // The first image of a change, and the converged one, are drawn at once.
-        let urgent = news
+        let urgent = shown_new
             && (self.shown_restart != restarts || self.restarts != restarts || progress.converged);
-        if news {
+        if shown_new {
             self.shown_restart = self.restarts;
         }
+        // A warning for the UI is news once; the progress bar's advance is news too (paced).
+        let warning = self.paint_warning.is_some() && !self.warning_announced;
+        self.warning_announced = self.paint_warning.is_some();
+        let advanced = self.progress.map(|p| p.fraction) != fraction;
         StepOutcome {
             gpu_busy: progress.busy
                 || progress.submitted.is_some()
                 || (self.picking_wanted && self.picking.reading()),
             working: self.working(),
-            news: news || self.paint_warning.is_some(),
-            urgent: urgent || self.paint_warning.is_some(),
+            news: shown_new || warning || advanced,
+            urgent: urgent || warning,
         }
+    }
+
+    /// A step panicked on the render thread: reported, and no step is taken until something
+    /// changes (the driver may be half-way through that step; a change restarts the refinement).
+    pub fn step_panicked(&mut self, why: &str) {
+        self.errors.push(format!(
+            "the viewport's refinement stopped: {why}; change something to restart it"
+        ));
+        self.failed = true;
     }
 
     /// Whether tables are still being built or not yet handed to the renderer, or a deferred

@@ -66,7 +66,8 @@ impl LiveHandle {
     /// The driver, for the caller's changes and reads. Hold it briefly: the render thread takes it
     /// between units.
     pub fn lock(&self) -> MutexGuard<'_, LiveDriver> {
-        // A panic on the render thread leaves the driver as its last complete step left it.
+        // A panic in a step is caught on the render thread (`LiveDriver::step_panicked`): the
+        // lock is poisoned only by a panic elsewhere, which leaves the driver as that step did.
         self.shared.driver.lock().unwrap_or_else(|e| e.into_inner())
     }
 
@@ -152,10 +153,27 @@ fn run(shared: &Shared) {
         }
         let (outcome, device) = {
             let mut d = shared.driver.lock().unwrap_or_else(|e| e.into_inner());
-            (d.pump_step(), d.ctx.device.clone())
+            // A panic in a step (a bug, or no thread to be had for a job) is reported, not lost
+            // with the thread: the driver stops stepping until something changes.
+            let step = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| d.pump_step()));
+            let outcome = step.unwrap_or_else(|panic| {
+                let why = panic
+                    .downcast_ref::<String>()
+                    .map(String::as_str)
+                    .or_else(|| panic.downcast_ref::<&str>().copied())
+                    .unwrap_or("unknown");
+                d.step_panicked(why);
+                StepOutcome {
+                    news: true,
+                    urgent: true,
+                    ..StepOutcome::idle()
+                }
+            });
+            (outcome, d.ctx.device.clone())
         };
-        // The UI is woken without the driver's lock held (its frame takes that lock).
-        owed |= outcome.news;
+        // The UI is woken without the driver's lock held (its frame takes that lock), also when
+        // the work ends without a new image (a table build that died, a picker built).
+        owed |= outcome.news || (working && !outcome.working);
         let due = last_wake.is_none_or(|t| t.elapsed() >= shared.wake_interval);
         if owed && (outcome.urgent || due || !outcome.working) {
             owed = false;
