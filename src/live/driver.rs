@@ -61,10 +61,10 @@ impl Default for ViewSettings {
 
 impl ViewSettings {
     /// The default view for an adapter: the viewport at full resolution, but half of it on a
-    /// software GPU, where the default scene at the default window's full viewport (654x734)
-    /// converges in 8-9 s in the editor (the refinement alone 6.6 s, `render --session` 4.8 s) and at
-    /// half resolution in about 6 s (4.6 s and 3.7 s): a first look at every change within a few
-    /// seconds matters more there than the last pixel; the resolution buttons raise it.
+    /// software GPU, where the live driver alone took 6.6 s to converge a 10000-strand scene at the
+    /// default window's full viewport (654x734; `render --session` 4.8 s) and 4.6 s at half of it
+    /// (3.7 s), before the editor's own frames: a first look at every change within a few seconds
+    /// matters more there than the last pixel; the resolution buttons raise it.
     pub fn for_adapter(device_type: wgpu::DeviceType) -> Self {
         Self {
             scale: if device_type == wgpu::DeviceType::Cpu {
