@@ -110,6 +110,16 @@ fn converge(h: &mut Harness<'static, EditorApp>) {
     }
 }
 
+/// When the viewport's current refinement started (the last change).
+fn refine_started(h: &Harness<'static, EditorApp>) -> Instant {
+    h.state()
+        .live
+        .as_ref()
+        .expect("a scene")
+        .lock()
+        .refine_started
+}
+
 /// The viewport's converged image, read back from the renderer.
 fn image(h: &Harness<'static, EditorApp>) -> Frame {
     let live = h.state().live.as_ref().expect("a live scene").lock();
@@ -375,13 +385,7 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     // Raising sigma_a (the dark-brown preset) darkens the hair; blond lightens it. The new absorption
     // is shaded before the volume and shadow grid are rebuilt for it (single scattering reads only the
     // grid's transmittance, which absorption does not change).
-    let started = h
-        .state()
-        .live
-        .as_ref()
-        .expect("a scene")
-        .lock()
-        .refine_started;
+    let started = refine_started(&h);
     click(&mut h, "dark brown");
     let rebuilt = rebuilds_before_first_image(&mut h, started, "dark brown");
     assert_eq!(rebuilt, 0, "the first image waited for the volume");
@@ -451,13 +455,7 @@ fn a_narrower_highlight_is_sharper() {
         v[(v.len() * 999) / 1000]
     };
     let wide = r_peak(&image(&h));
-    let before = h
-        .state()
-        .live
-        .as_ref()
-        .expect("a scene")
-        .lock()
-        .refine_started;
+    let before = refine_started(&h);
     slider(&h, "β_R width").set_value_accesskit(3.0);
     // The new look shows before the shadow grid is rebuilt for the new tables (with dual scattering
     // their forward terms need it): the first image is shaded with the grid already built, and the
