@@ -9,10 +9,7 @@ use crate::render::scene::Environment;
 use crate::session::EnvironmentSource;
 use std::sync::{Arc, MutexGuard};
 
-pub use crate::live::driver::{
-    BACKGROUND, PaintFileCache, ViewSettings, budget_share, paint_for, painted, prepare,
-    unit_budget,
-};
+pub use crate::live::driver::ViewSettings;
 
 pub struct LiveScene {
     handle: LiveHandle,

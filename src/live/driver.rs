@@ -921,11 +921,6 @@ impl LiveDriver {
         self.wanted_view = view;
     }
 
-    /// The view asked for.
-    pub fn view(&self) -> ViewSettings {
-        self.wanted_view
-    }
-
     /// Keep a picker for the current view (while the brush is the active tool).
     pub fn set_picking(&mut self, wanted: bool) {
         self.picking_wanted = wanted;

@@ -7,7 +7,7 @@
 //! paced by frames ran one per ~130 ms whatever their own cost (a 5 s frame took over a minute).
 
 use super::driver::{LiveDriver, StepOutcome};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -68,18 +68,15 @@ impl LiveHandle {
     pub fn lock(&self) -> MutexGuard<'_, LiveDriver> {
         // A panic in a step is caught on the render thread (`LiveDriver::step_panicked`): the
         // lock is poisoned only by a panic elsewhere, which leaves the driver as that step did.
-        self.shared.driver.lock().unwrap_or_else(|e| e.into_inner())
+        self.shared
+            .driver
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Tells the render thread that something may have changed (it looks at once).
     pub fn kick(&self) {
-        let mut c = self
-            .shared
-            .control
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        c.kicked = true;
-        self.shared.kick.notify_one();
+        self.shared.signal(|c| c.kicked = true);
     }
 
     /// Whether the render thread is running (it stops only when dropped, or if it panicked).
@@ -119,19 +116,20 @@ impl LiveHandle {
 
 impl Drop for LiveHandle {
     fn drop(&mut self) {
-        {
-            let mut c = self
-                .shared
-                .control
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            c.stop = true;
-            self.shared.kick.notify_one();
-        }
+        self.shared.signal(|c| c.stop = true);
         // Bounded: the thread waits on the GPU at most GPU_WAIT at a time.
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+    }
+}
+
+impl Shared {
+    /// Changes the thread's controls and wakes it to read them.
+    fn signal(&self, change: impl FnOnce(&mut Control)) {
+        let mut c = self.control.lock().unwrap_or_else(PoisonError::into_inner);
+        change(&mut c);
+        self.kick.notify_one();
     }
 }
 
@@ -142,9 +140,12 @@ fn run(shared: &Shared) {
     let mut last_wake: Option<Instant> = None;
     loop {
         {
-            let mut c = shared.control.lock().unwrap_or_else(|e| e.into_inner());
+            let mut c = shared
+                .control
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner);
             while !c.stop && !c.kicked && !working {
-                c = shared.kick.wait(c).unwrap_or_else(|e| e.into_inner());
+                c = shared.kick.wait(c).unwrap_or_else(PoisonError::into_inner);
             }
             if c.stop {
                 return;
@@ -152,7 +153,7 @@ fn run(shared: &Shared) {
             c.kicked = false;
         }
         let (outcome, device) = {
-            let mut d = shared.driver.lock().unwrap_or_else(|e| e.into_inner());
+            let mut d = shared.driver.lock().unwrap_or_else(PoisonError::into_inner);
             // A panic in a step (a bug, or no thread to be had for a job) is reported, not lost
             // with the thread: the driver stops stepping until something changes.
             let step = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| d.pump_step()));
@@ -188,7 +189,10 @@ fn run(shared: &Shared) {
                 timeout: Some(GPU_WAIT),
             });
         } else if working {
-            let c = shared.control.lock().unwrap_or_else(|e| e.into_inner());
+            let c = shared
+                .control
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner);
             if !c.kicked && !c.stop {
                 let _ = shared.kick.wait_timeout(c, IDLE_TICK);
             }

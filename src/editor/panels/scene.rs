@@ -49,16 +49,15 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
     generator(app, ui);
     head(app, ui);
     if let Some(live) = &app.live {
-        let hair = live.lock().hair.clone();
-        let (lo, hi) = hair.bounds();
+        // The driver's bounds, found once per hair (not every frame over every point).
+        let (strands, points, (lo, hi)) = {
+            let d = live.lock();
+            (d.hair.strand_count(), d.hair.point_count(), d.bounds)
+        };
         let size = hi - lo;
         ui.weak(format!(
-            "{} strands, {} points, {:.1} × {:.1} × {:.1} cm",
-            hair.strand_count(),
-            hair.point_count(),
-            size.x,
-            size.y,
-            size.z
+            "{strands} strands, {points} points, {:.1} × {:.1} × {:.1} cm",
+            size.x, size.y, size.z
         ));
     }
 }
