@@ -249,11 +249,13 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<(EnvMap, Sanitised), EnvE
         .first()
         .ok_or_else(|| EnvError::format(path, "OpenEXR file has no layers"))?;
     let compression = header.compression;
-    if matches!(compression, Compression::DWAA(_) | Compression::DWAB(_)) {
+    // The exr crate decodes every compression but the HTJ2K ones; name them rather than let a
+    // generic "unimplemented" message through.
+    if matches!(compression, Compression::HTJ2K32 | Compression::HTJ2K256) {
         return Err(EnvError::format(
             path,
             format!(
-                "uses {compression:?} compression, which the exr crate cannot decode; re-save it with ZIP, PIZ or no compression"
+                "uses {compression:?} (high-throughput JPEG 2000) compression, which strandlight cannot decode; re-save it with ZIP, PIZ, DWAA or no compression"
             ),
         ));
     }

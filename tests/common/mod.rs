@@ -381,3 +381,29 @@ pub fn temp_file(what: &str, name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).expect("temp dir");
     d.join(name)
 }
+
+/// A `python3` command that can import `module` (a test-time checker such as `pxr` from
+/// `usd-core` or `OpenEXR`), or None with a printed reason. Where `STRANDLIGHT_REQUIRE_CHECKERS` is
+/// set (CI installs the checkers), a missing module is a failure rather than a skip; a missing
+/// Python is always a skip.
+pub fn python_with(module: &str) -> Option<std::process::Command> {
+    let probe = std::process::Command::new("python3")
+        .args(["-c", &format!("import {module}")])
+        .output();
+    match probe {
+        Err(e) => {
+            println!("skipped: python3 is not available ({e})");
+            None
+        }
+        Ok(out) if !out.status.success() => {
+            let why = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                std::env::var_os("STRANDLIGHT_REQUIRE_CHECKERS").is_none(),
+                "the Python checker `{module}` is required here but cannot be imported: {why}"
+            );
+            println!("skipped: Python cannot import `{module}` (pip install it to run this check)");
+            None
+        }
+        Ok(_) => Some(std::process::Command::new("python3")),
+    }
+}
