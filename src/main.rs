@@ -20,7 +20,21 @@ fn one_line(e: &anyhow::Error) -> String {
     line
 }
 
+/// A command piped into `head` or `less` ends quietly when the reader closes the pipe, as Unix
+/// tools do: Rust ignores SIGPIPE by default, which turns the next `println!` into a panic.
+#[cfg(unix)]
+fn end_quietly_on_closed_pipe() {
+    // SAFETY: restoring a signal's default disposition at start-up, before any thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn end_quietly_on_closed_pipe() {}
+
 fn main() {
+    end_quietly_on_closed_pipe();
     let cli = cli::Cli::parse();
     if let Err(e) = cli::run(cli) {
         eprintln!("error: {}", one_line(&e));

@@ -385,3 +385,20 @@ fn render_reference_takes_an_optional_mode() {
         assert!(help.contains(want), "help lacks {want}");
     }
 }
+
+#[test]
+fn a_closed_pipe_ends_a_command_quietly() {
+    // `strandlight bsdf … | head -0`: the reader is gone before the first line is written.
+    let mut child = strandlight()
+        .args(["bsdf", "--theta-i", "10", "--theta-o", "-5", "--phi-o", "160"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("status {:?}, stderr {stderr:?}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_ne!(out.status.code(), Some(101), "a panic's exit code");
+}
