@@ -390,7 +390,15 @@ fn render_reference_takes_an_optional_mode() {
 fn a_closed_pipe_ends_a_command_quietly() {
     // `strandlight bsdf … | head -0`: the reader is gone before the first line is written.
     let mut child = strandlight()
-        .args(["bsdf", "--theta-i", "10", "--theta-o", "-5", "--phi-o", "160"])
+        .args([
+            "bsdf",
+            "--theta-i",
+            "10",
+            "--theta-o",
+            "-5",
+            "--phi-o",
+            "160",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

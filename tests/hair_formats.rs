@@ -302,3 +302,297 @@ fn bad_input_names_the_file_and_the_problem() {
         .to_string();
     assert!(e.contains("/nonexistent/h.hair"), "{e}");
 }
+
+/// The distance from `p` to the nearest point of `line`.
+fn nearest(line: &[Vec3], p: Vec3) -> f32 {
+    line.iter().map(|q| q.distance(p)).fold(f32::MAX, f32::min)
+}
+
+#[test]
+fn usd_grooms_from_blender_and_pixars_library_match_their_source() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    let source = load_hair(
+        &data.join("hair/tressfx_ponytail.hair"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let src = &source.file.hair;
+    let (slo, shi) = src.bounds();
+    // Blender: cubic Catmull-Rom, pinned, Z up, metres, under two Xforms, color4f colours.
+    // usd-core: Unreal's groom convention, linear, Y up, centimetres.
+    for (file, colour, first_colour) in [
+        (
+            "hair/usd/ponytail_blender.usdc",
+            "primvars:color",
+            [0.05, 0.03, 0.02],
+        ),
+        (
+            "hair/usd/ponytail_usdcore.usda",
+            "primvars:groom_color",
+            [0.06, 0.035, 0.02],
+        ),
+    ] {
+        let start = std::time::Instant::now();
+        let l = load_hair(&data.join(file), &LoadOptions::default()).unwrap();
+        let seconds = start.elapsed().as_secs_f64();
+        let h = &l.file.hair;
+        let curves = l.file.curves.as_ref().unwrap();
+        assert_eq!(h.strand_count(), src.strand_count(), "{file}");
+        assert_eq!(curves.declared, (4933, 78928), "{file}");
+        assert_eq!(l.normalization.up_source, "declared by the file");
+        let (lo, hi) = h.bounds();
+        let overshoot = (slo - lo).max(hi - shi).max_element();
+        let inside = (lo - slo).max(shi - hi).max_element();
+        // Every source point lies on its strand's polyline: both bases interpolate.
+        let mut worst = 0f32;
+        for s in 0..src.strand_count() {
+            for p in src.strand(s) {
+                worst = worst.max(nearest(h.strand(s), *p));
+            }
+        }
+        println!(
+            "{file}: {} strands, {} points in {seconds:.2} s; bounds overshoot {overshoot:.4} cm, \
+             fall short {inside:.5} cm; source points off the polyline by {worst:.5} cm at most",
+            h.strand_count(),
+            h.point_count()
+        );
+        assert!(
+            overshoot <= 0.05,
+            "{file}: the curve overshoots by {overshoot} cm"
+        );
+        assert!(inside <= 1e-3, "{file}: bounds fall short by {inside} cm");
+        assert!(worst <= 1e-3, "{file}: a source point is {worst} cm away");
+        // Widths are 0.2 mm in both files (Blender's in metres).
+        for (s, p) in [(0, 0), (100, 5)] {
+            let t = h.thickness_at(s, h.strand_range(s).start + p);
+            assert!((t - 0.02).abs() < 1e-5, "{file}: width {t}");
+        }
+        assert_eq!(curves.colour.as_deref(), Some(colour));
+        let c = h.colour.as_ref().unwrap()[0];
+        for k in 0..3 {
+            assert!(
+                (c[k] - first_colour[k]).abs() < 1e-4,
+                "{file}: colour {c:?}"
+            );
+        }
+    }
+}
+
+/// Writes `text` as `name` in a temporary folder and loads it.
+fn load_usda(name: &str, text: &str) -> Result<strandlight::hair::LoadedHair, String> {
+    let path = common::temp_file("usd", name);
+    std::fs::write(&path, text).unwrap();
+    load_hair(&path, &LoadOptions::default()).map_err(|e| e.to_string())
+}
+
+fn usda(body: &str) -> String {
+    format!("#usda 1.0\n(\n    upAxis = \"Y\"\n    metersPerUnit = 0.01\n)\n\n{body}\n")
+}
+
+const FOUR: &str = "[(0, 0, 0), (0, -1, 0), (0, -2, 1), (0, -3, 3)]";
+
+#[test]
+fn usd_curves_transforms_bases_guides_time_and_primvars() {
+    // A parent Xform moves and scales its curves; a guide prim and an invisible one are skipped.
+    let text = usda(&format!(
+        r#"def Xform "groom" (
+)
+{{
+    double3 xformOp:translate = (10, 0, 0)
+    float3 xformOp:scale = (2, 2, 2)
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+
+    def BasisCurves "hair"
+    {{
+        uniform token type = "linear"
+        int[] curveVertexCounts = [4]
+        point3f[] points = {FOUR}
+        float[] widths = [0.01] (interpolation = "constant")
+        color3f[] primvars:displayColor = [(1, 0, 0), (0, 0, 1)] (interpolation = "vertex")
+        int[] primvars:displayColor:indices = [0, 0, 1, 1]
+    }}
+    def BasisCurves "guides" (
+        apiSchemas = ["GroomAPI"]
+    )
+    {{
+        uniform token type = "linear"
+        int[] curveVertexCounts = [2]
+        point3f[] points = [(0, 0, 0), (0, 9, 0)]
+        int primvars:groom_guide = 1 (interpolation = "constant")
+    }}
+    def BasisCurves "proxy"
+    {{
+        uniform token purpose = "guide"
+        uniform token type = "linear"
+        int[] curveVertexCounts = [2]
+        point3f[] points = [(0, 0, 0), (0, 9, 0)]
+    }}
+    def BasisCurves "hidden"
+    {{
+        token visibility = "invisible"
+        uniform token type = "linear"
+        int[] curveVertexCounts = [2]
+        point3f[] points = [(0, 0, 0), (0, 9, 0)]
+    }}
+    def Xform "reset"
+    {{
+        uniform token[] xformOpOrder = ["!resetXformStack!"]
+        def BasisCurves "alone"
+        {{
+            uniform token type = "linear"
+            int[] curveVertexCounts = [2]
+            point3f[] points = [(0, 0, 0), (0, -5, 0)]
+        }}
+    }}
+}}"#
+    ));
+    let l = load_usda("transforms.usda", &text).unwrap();
+    let h = &l.file.hair;
+    let curves = l.file.curves.as_ref().unwrap();
+    println!("read {:?}, skipped {:?}", curves.batches, curves.skipped);
+    assert_eq!(h.strand_count(), 2);
+    assert_eq!(curves.skipped.len(), 3, "{:?}", curves.skipped);
+    assert_eq!(h.strand(0)[3], Vec3::new(10.0, -6.0, 6.0));
+    assert_eq!(h.strand(1)[1], Vec3::new(0.0, -5.0, 0.0), "reset stack");
+    assert!((h.thickness_at(0, 0) - 0.02).abs() < 1e-7, "width scaled");
+    let c = h.colour.as_ref().unwrap();
+    assert_eq!((c[0], c[3]), ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), "indexed");
+
+    // Cubic bases: B-spline pinned reaches its end points; Bézier has 4 + 3k points; varying
+    // widths take one value per segment end.
+    let text = usda(&format!(
+        r#"def BasisCurves "b"
+{{
+    uniform token type = "cubic"
+    uniform token basis = "bspline"
+    uniform token wrap = "pinned"
+    int[] curveVertexCounts = [4]
+    point3f[] points = {FOUR}
+    float[] widths = [0.01, 0.02, 0.03, 0.04] (interpolation = "varying")
+}}
+def BasisCurves "z"
+{{
+    uniform token type = "cubic"
+    uniform token basis = "bezier"
+    int[] curveVertexCounts = [4]
+    point3f[] points = {FOUR}
+}}"#
+    ));
+    let l = load_usda("bases.usda", &text).unwrap();
+    let h = &l.file.hair;
+    let b = h.strand(0);
+    assert!(b[0].distance(Vec3::ZERO) < 1e-6);
+    assert!(b.last().unwrap().distance(Vec3::new(0.0, -3.0, 3.0)) < 1e-5);
+    assert!((h.thickness_at(0, h.strand_range(0).end - 1) - 0.04).abs() < 1e-6);
+    let z = h.strand(1);
+    assert!(z.last().unwrap().distance(Vec3::new(0.0, -3.0, 3.0)) < 1e-5);
+    assert!(z.len() > 2, "a bent Bézier is sampled between its ends");
+
+    // Time samples: the earliest by default, another when asked for.
+    let text = usda(
+        r#"def BasisCurves "t"
+{
+    uniform token type = "linear"
+    int[] curveVertexCounts = [2]
+    point3f[] points.timeSamples = {
+        1: [(0, 0, 0), (0, -1, 0)],
+        5: [(0, 0, 0), (0, -7, 0)],
+    }
+}"#,
+    );
+    let l = load_usda("time.usda", &text).unwrap();
+    assert_eq!(l.file.hair.strand(0)[1].y, -1.0);
+    assert_eq!(l.file.curves.as_ref().unwrap().time, Some(1.0));
+    let path = common::temp_file("usd", "time.usda");
+    let mut options = LoadOptions::default();
+    options.curves.time = Some(5.0);
+    let l = load_hair(&path, &options).unwrap();
+    assert_eq!(l.file.hair.strand(0)[1].y, -7.0);
+    // A picked prim; a prim that is not there.
+    options.curves.prim = Some("/t".into());
+    assert_eq!(
+        load_hair(&path, &options).unwrap().file.hair.strand_count(),
+        1
+    );
+    options.curves.prim = Some("/nothing".into());
+    let e = load_hair(&path, &options).err().unwrap().to_string();
+    assert!(e.contains("/nothing"), "{e}");
+}
+
+#[test]
+fn bad_usd_curves_are_clear_errors() {
+    let curves = |body: &str| usda(&format!("def BasisCurves \"c\"\n{{\n{body}\n}}"));
+    let cases = [
+        ("empty prim", curves(""), "no curveVertexCounts"),
+        (
+            "counts disagree",
+            curves(
+                "uniform token type = \"linear\"\nint[] curveVertexCounts = [3]\npoint3f[] points = [(0,0,0), (0,1,0)]",
+            ),
+            "add up to 3",
+        ),
+        (
+            "huge count",
+            curves(
+                "uniform token type = \"linear\"\nint[] curveVertexCounts = [2147483647]\npoint3f[] points = [(0,0,0), (0,1,0)]",
+            ),
+            "add up to 2147483647",
+        ),
+        (
+            "negative count",
+            curves("int[] curveVertexCounts = [-2]\npoint3f[] points = [(0,0,0), (0,1,0)]"),
+            "negative",
+        ),
+        (
+            "not finite",
+            curves(&format!(
+                "uniform token type = \"linear\"\nint[] curveVertexCounts = [2]\npoint3f[] points = [(0,0,0), (0,{},0)]",
+                "inf"
+            )),
+            "not finite",
+        ),
+        (
+            "widths of the wrong length",
+            curves(&format!(
+                "uniform token type = \"linear\"\nint[] curveVertexCounts = [4]\npoint3f[] points = {FOUR}\nfloat[] widths = [1, 2, 3] (interpolation = \"vertex\")"
+            )),
+            "widths has 3 values",
+        ),
+        (
+            "unknown basis",
+            curves(&format!(
+                "uniform token basis = \"hermite\"\nint[] curveVertexCounts = [4]\npoint3f[] points = {FOUR}"
+            )),
+            "unknown basis",
+        ),
+        (
+            "Bézier of 5 points",
+            curves(
+                "int[] curveVertexCounts = [5]\npoint3f[] points = [(0,0,0),(0,1,0),(0,2,0),(0,3,0),(0,4,0)]",
+            ),
+            "4 + 3k",
+        ),
+        ("no curves", usda("def Xform \"x\" {}"), "no BasisCurves"),
+        ("not USD", "#usda 1.0\ndef Curves (((".to_string(), "USD"),
+        (
+            "missing reference",
+            usda("def Xform \"x\" (\n    references = @./no_such_file.usda@\n)\n{}"),
+            "no_such_file",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let file = format!("bad_{}.usda", name.replace(' ', "_"));
+        let e = load_usda(&file, &text)
+            .err()
+            .unwrap_or_else(|| panic!("{name} accepted"));
+        println!("{name}: {e}");
+        assert!(e.contains(&file) && e.contains(needle), "{name}: {e}");
+    }
+    let e = load_hair(Path::new("/nonexistent/g.usdc"), &LoadOptions::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("g.usdc"), "{e}");
+}

@@ -11,6 +11,7 @@ use strandlight::hair::gltf_io::read_gltf;
 use strandlight::hair::mesh::read_obj;
 use strandlight::hair::procedural::{Style, StyleParams, generate};
 use strandlight::hair::tressfx::read_tressfx;
+use strandlight::hair::usd::{CurveSelection, read_usd, write_usda};
 
 const CASES: u32 = 100_000;
 
@@ -46,6 +47,10 @@ fn mutate(valid: &[u8], m: &Mutation) -> Vec<u8> {
 }
 
 fn fuzz(name: &str, valid: Vec<u8>, parse: impl Fn(&[u8]) -> bool) {
+    fuzz_n(name, valid, CASES, parse)
+}
+
+fn fuzz_n(name: &str, valid: Vec<u8>, cases: u32, parse: impl Fn(&[u8]) -> bool) {
     // The seed itself must parse: a parser that rejected everything would otherwise pass.
     assert!(
         parse(&valid),
@@ -57,7 +62,7 @@ fn fuzz(name: &str, valid: Vec<u8>, parse: impl Fn(&[u8]) -> bool) {
         .and_then(|s| s.parse().ok())
         .unwrap_or(0x5EED_u64);
     let mut runner = TestRunner::new(Config {
-        cases: CASES,
+        cases,
         failure_persistence: None,
         rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
         ..Config::default()
@@ -73,7 +78,7 @@ fn fuzz(name: &str, valid: Vec<u8>, parse: impl Fn(&[u8]) -> bool) {
         })
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     println!(
-        "{name}: {CASES} mutated inputs, {} still parsed, none panicked",
+        "{name}: {cases} mutated inputs, {} still parsed, none panicked",
         accepted.get()
     );
 }
@@ -108,4 +113,38 @@ fn obj_parser_survives_mutations() {
     fuzz("OBJ", common::OBJ.as_bytes().to_vec(), |b| {
         read_obj(b, Path::new("f.obj")).is_ok()
     });
+}
+
+/// The USD reader opens files by path (references resolve beside them): each mutation is written
+/// to a temporary file, so fewer cases run than for the in-memory parsers.
+fn fuzz_usd(name: &str, ext: &str, valid: Vec<u8>, cases: u32) {
+    let path = common::temp_file("usd-fuzz", &format!("f.{ext}"));
+    let failed_inside = std::cell::Cell::new(0u32);
+    fuzz_n(name, valid, cases, |b| {
+        std::fs::write(&path, b).unwrap();
+        let r = read_usd(&path, &CurveSelection::default());
+        if let Err(e) = &r
+            && (e.contains("USD reader failed") || e.contains("USD reader crashed"))
+        {
+            failed_inside.set(failed_inside.get() + 1);
+        }
+        r.is_ok()
+    });
+    println!(
+        "{name}: the USD crate panicked or aborted on {} inputs (isolated, reported as errors)",
+        failed_inside.get()
+    );
+}
+
+#[test]
+fn usd_reader_survives_mutations() {
+    let hair = generate(&StyleParams::new(Style::Wavy, 3, 5, 1)).unwrap();
+    let text = write_usda(&hair, None, "fuzz");
+    // The same layer as a binary crate file, written by the USD crate.
+    let data = openusd::usda::parse(&text).unwrap();
+    let crate_path = common::temp_file("usd-fuzz", "seed.usdc");
+    openusd::usdc::CrateWriter::write_to_file(&data, crate_path.to_str().unwrap()).unwrap();
+    let crate_bytes = std::fs::read(&crate_path).unwrap();
+    fuzz_usd("USD text", "usda", text.into_bytes(), 1_500);
+    fuzz_usd("USD crate", "usdc", crate_bytes, 1_500);
 }

@@ -4,19 +4,21 @@ use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
+use strandlight::hair::curve_file::CurveFile;
 use strandlight::hair::load::{ArraysPresent, LoadOptions, load_hair};
 use strandlight::hair::normalize::{Normalization, Units, UpAxis};
+use strandlight::hair::usd::CurveSelection;
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// A .hair (cyHair), .tfx (TressFX 3/4), .gltf or .glb file.
+    /// A .hair (cyHair), .tfx (TressFX 3/4), .gltf, .glb or USD (.usd, .usda, .usdc, .usdz) file.
     pub file: PathBuf,
     #[command(flatten)]
     pub space: SpaceArgs,
 }
 
-/// Overrides of the detected orientation and units.
-#[derive(Args, Debug, Clone, Copy)]
+/// Overrides of the detected or declared orientation and units, and which curves to read.
+#[derive(Args, Debug, Clone)]
 pub struct SpaceArgs {
     /// Up axis of the file (detected when absent).
     #[arg(long, value_enum)]
@@ -27,6 +29,12 @@ pub struct SpaceArgs {
     /// Extra scale after unit conversion.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
+    /// USD: the prim whose curves are read (default: the stage's default prim).
+    #[arg(long)]
+    pub prim: Option<String>,
+    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    #[arg(long)]
+    pub time: Option<f64>,
 }
 
 impl SpaceArgs {
@@ -35,6 +43,10 @@ impl SpaceArgs {
             up: self.up,
             units: self.units,
             scale: self.scale,
+            curves: CurveSelection {
+                prim: self.prim.clone(),
+                time: self.time,
+            },
         }
     }
 }
@@ -81,11 +93,18 @@ struct Info {
     thickness_cm: Stats,
     arrays: ArraysPresent,
     occluder_triangles: usize,
+    /// What a USD or Alembic file declared: the curve batches read and skipped, the colour
+    /// primvar, the time read.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    curves: Option<CurveFile>,
+    load_seconds: f64,
 }
 
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
-    let loaded =
+    let start = std::time::Instant::now();
+    let mut loaded =
         load_hair(&args.file, &args.space.options()).context("could not read hair file")?;
+    let load_seconds = start.elapsed().as_secs_f64();
     let h = &loaded.file.hair;
     let (lo, hi) = h.bounds();
     let info = Info {
@@ -112,21 +131,27 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
         ),
         arrays: loaded.file.arrays,
         occluder_triangles: loaded.file.mesh.as_ref().map_or(0, |m| m.triangles.len()),
+        curves: loaded.file.curves.take(),
+        load_seconds,
     };
     println!("{}", serde_json::to_string_pretty(&info)?);
+    let n = &info.normalization;
+    let units = match n.declared_cm_per_unit {
+        Some(cm) => format!("{cm} cm per unit (declared by the file)"),
+        None if n.units_detected => format!("{:?} (detected)", n.units),
+        None => format!("{:?} (given)", n.units),
+    };
     eprintln!(
-        "{}: {} strands, {} points; up {} ({}), units {:?} ({})",
+        "{}: {} strands, {} points in {:.2} s; up {} ({}), units {units}",
         info.file,
         info.strands,
         info.points,
-        serde_json::to_string(&info.normalization.up)?.trim_matches('"'),
-        info.normalization.up_source,
-        info.normalization.units,
-        if info.normalization.units_detected {
-            "detected"
-        } else {
-            "given"
-        },
+        info.load_seconds,
+        serde_json::to_string(&n.up)?.trim_matches('"'),
+        n.up_source,
     );
+    for skipped in info.curves.iter().flat_map(|c| &c.skipped) {
+        eprintln!("skipped {skipped}");
+    }
     Ok(())
 }

@@ -13,7 +13,9 @@ pub enum HairError {
     /// The file's contents are not what its format requires.
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },
-    #[error("{path}: unsupported file type (expected .hair, .tfx, .gltf, .glb or .obj)")]
+    #[error(
+        "{path}: unsupported file type (expected .hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz or .obj)"
+    )]
     UnknownType { path: PathBuf },
 }
 

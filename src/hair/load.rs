@@ -1,22 +1,26 @@
 //! Loading any supported hair or mesh file into world space (cm, +Y up).
 
+use super::curve_file::CurveFile;
 use super::error::HairError;
 use super::gltf_io::read_gltf;
 use super::mesh::{TriangleMesh, read_obj};
 use super::model::{CleanReport, Hair, Thickness};
 use super::normalize::{Normalization, Units, UpAxis, detect_units, detect_up};
 use super::tressfx::read_tressfx;
+use super::usd::{CurveSelection, read_usd};
 use glam::Vec3;
 use serde::Serialize;
 use std::path::Path;
 
-/// User overrides of the detected orientation and units.
-#[derive(Clone, Copy, Debug)]
+/// User overrides of the detected or declared orientation and units, and which curves of a
+/// production file (USD, Alembic) to read.
+#[derive(Clone, Debug)]
 pub struct LoadOptions {
     pub up: Option<UpAxis>,
     pub units: Option<Units>,
     /// Extra scale after unit conversion.
     pub scale: f32,
+    pub curves: CurveSelection,
 }
 
 impl Default for LoadOptions {
@@ -25,6 +29,7 @@ impl Default for LoadOptions {
             up: None,
             units: None,
             scale: 1.0,
+            curves: CurveSelection::default(),
         }
     }
 }
@@ -60,6 +65,8 @@ fn extension(path: &Path) -> String {
 
 /// A hair file as read.
 pub struct RawHairFile {
+    /// What a production curves file (USD, Alembic) declared and held beyond the strands.
+    pub curves: Option<CurveFile>,
     pub hair: Hair,
     /// Occluder triangles found in the same file (glTF).
     pub mesh: Option<TriangleMesh>,
@@ -70,10 +77,21 @@ pub struct RawHairFile {
     pub clean: CleanReport,
 }
 
-/// Reads a hair file (.hair, .tfx, .gltf, .glb) without normalising it.
-pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
+/// Reads a hair file (.hair, .tfx, .gltf, .glb, USD) without normalising it.
+pub fn read_hair_raw(path: &Path, curves: &CurveSelection) -> Result<RawHairFile, HairError> {
+    let ext = extension(path);
+    if matches!(ext.as_str(), "usd" | "usda" | "usdc" | "usdz") {
+        if !path.is_file() {
+            return Err(HairError::io(
+                path,
+                std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+            ));
+        }
+        let file = read_usd(path, curves).map_err(|e| HairError::format(path, e))?;
+        return from_curve_file(path, "USD", file);
+    }
     let bytes = read_file(path)?;
-    match extension(path).as_str() {
+    match ext.as_str() {
         "hair" => {
             let (hair, h, clean) = read_cyhair(&bytes, path)?;
             use super::cyhair::{
@@ -87,6 +105,7 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
                 strand_uvs: false,
             };
             Ok(RawHairFile {
+                curves: None,
                 hair,
                 mesh: None,
                 format: "cyHair",
@@ -108,6 +127,7 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
             };
             let n = info.strands as u64;
             Ok(RawHairFile {
+                curves: None,
                 hair,
                 mesh: None,
                 format: fmt,
@@ -138,6 +158,7 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
             }
             let mesh = (!content.mesh.triangles.is_empty()).then_some(content.mesh);
             Ok(RawHairFile {
+                curves: None,
                 hair,
                 mesh,
                 format: "glTF",
@@ -150,9 +171,40 @@ pub fn read_hair_raw(path: &Path) -> Result<RawHairFile, HairError> {
     }
 }
 
+/// The strands of a production curves file, cleaned.
+fn from_curve_file(
+    path: &Path,
+    format: &'static str,
+    mut file: CurveFile,
+) -> Result<RawHairFile, HairError> {
+    let strands = std::mem::take(&mut file.strands);
+    let (hair, clean) = Hair::from_strands(strands, super::model::DEFAULT_FIBER_DIAMETER);
+    if hair.strand_count() == 0 {
+        return Err(HairError::format(
+            path,
+            "no curve has two or more distinct points",
+        ));
+    }
+    Ok(RawHairFile {
+        hair,
+        mesh: None,
+        format,
+        declared: file.declared,
+        arrays: ArraysPresent {
+            thickness: file.widths,
+            colour: file.colour.is_some(),
+            ..Default::default()
+        },
+        clean,
+        curves: Some(file),
+    })
+}
+
 /// Reads a hair file and brings it into world space (cm, +Y up), detecting what is not given.
 pub fn load_hair(path: &Path, options: &LoadOptions) -> Result<LoadedHair, HairError> {
-    let mut file = read_hair_raw(path)?;
+    let mut file = read_hair_raw(path, &options.curves)?;
+    let declared_up = file.curves.as_ref().and_then(|c| c.up);
+    let declared_cm = file.curves.as_ref().and_then(|c| c.cm_per_unit);
     let RawHairFile {
         hair,
         mesh,
@@ -176,17 +228,19 @@ pub fn load_hair(path: &Path, options: &LoadOptions) -> Result<LoadedHair, HairE
         ));
     }
     let normalization = Normalization {
-        up: options.up.unwrap_or_else(|| match format {
+        up: options.up.or(declared_up).unwrap_or_else(|| match format {
             "cyHair" => detect_up(&roots, &tips, source_bounds),
             _ => UpAxis::PosY,
         }),
-        up_source: match (options.up, format) {
-            (Some(_), _) => "given",
-            (None, "cyHair") => "detected",
-            (None, _) => "format convention",
+        up_source: match (options.up, declared_up, format) {
+            (Some(_), _, _) => "given",
+            (None, Some(_), _) => "declared by the file",
+            (None, None, "cyHair") => "detected",
+            (None, None, _) => "format convention",
         },
         units: options.units.unwrap_or_else(|| detect_units(extent)),
-        units_detected: options.units.is_none(),
+        units_detected: options.units.is_none() && declared_cm.is_none(),
+        declared_cm_per_unit: declared_cm.filter(|_| options.units.is_none()),
         scale: options.scale,
     };
     let k = normalization.length_factor();

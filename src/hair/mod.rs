@@ -2,6 +2,8 @@
 //! space (centimetres, +Y up), and procedural hairstyles.
 
 pub mod bytes;
+pub mod curve_file;
+pub mod curves;
 pub mod cyhair;
 pub mod error;
 pub mod gltf_io;
@@ -13,7 +15,7 @@ pub mod procedural;
 pub mod tressfx;
 pub mod usd;
 
-pub use error::HairError;
+pub use error::{HairError, MAX_POINTS};
 pub use load::{LoadOptions, LoadedHair, load_hair, load_mesh};
 pub use mesh::TriangleMesh;
 pub use model::{Hair, RawStrand, Thickness};

@@ -117,17 +117,22 @@ pub struct Normalization {
     pub up_source: &'static str,
     pub units: Units,
     pub units_detected: bool,
+    /// Centimetres per unit as the file declares them (USD `metersPerUnit`); where set, they
+    /// replace `units`.
+    pub declared_cm_per_unit: Option<f32>,
     /// Extra user scale applied after the unit conversion.
     pub scale: f32,
 }
 
 impl Normalization {
     pub fn apply(&self, p: Vec3) -> Vec3 {
-        self.up.to_y_up(p) * (self.units.to_cm() * self.scale)
+        self.up.to_y_up(p) * self.length_factor()
     }
 
     pub fn length_factor(&self) -> f32 {
-        self.units.to_cm() * self.scale
+        self.declared_cm_per_unit
+            .unwrap_or_else(|| self.units.to_cm())
+            * self.scale
     }
 }
 

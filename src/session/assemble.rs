@@ -49,6 +49,7 @@ pub const GENERATOR_SPACE: Normalization = Normalization {
     up_source: "generator",
     units: crate::hair::normalize::Units::Centimetres,
     units_detected: false,
+    declared_cm_per_unit: None,
     scale: 1.0,
 };
 

@@ -3,7 +3,7 @@
 //! (linear RGB), in centimetres (`metersPerUnit = 0.01`), +Y up. Blender and Unreal read USD curves;
 //! the colours carry the painted dye to them.
 
-use super::Hair;
+use crate::hair::Hair;
 use std::fmt::Write;
 
 /// The `.usda` text of `hair` with one linear RGB colour per point (`colours`; None: no colour).
