@@ -210,3 +210,37 @@ fn a_tiled_render_equals_the_untiled_one() {
         "{max} {mean} {off}"
     );
 }
+
+/// The grooms Blender and Pixar's library wrote render, the hair covering part of the frame.
+#[test]
+fn usd_grooms_render() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    for (file, prim) in [
+        ("hair/usd/ponytail_blender.usdc", None),
+        ("hair/usd/ponytail_usdcore.usda", Some("/Groom/hair")),
+    ] {
+        let exr = tmp(&format!("{}.exr", file.replace('/', "_")));
+        let mut c = strandlight();
+        c.args(["render", "--hair"])
+            .arg(data.join(file))
+            .args(["--width", "48", "--height", "48", "-o"])
+            .arg(&exr);
+        if let Some(p) = prim {
+            c.args(["--hair-prim", p]);
+        }
+        let out = c.output().expect("runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{file}: {stderr}");
+        // The ponytail is 4933 guide strands of 0.2 mm: thin, so coverage is partial.
+        let alpha = &common::read_exr_channels(&exr, &["A"])[0];
+        let touched = alpha.iter().filter(|a| **a > 0.02).count() as f64 / alpha.len() as f64;
+        let mean = alpha.iter().sum::<f32>() / alpha.len() as f32;
+        println!(
+            "{file}: hair in {:.0} % of the pixels, mean coverage {mean:.3}",
+            100.0 * touched
+        );
+        assert!(touched > 0.05 && mean > 0.01, "{file}: the groom is not in the frame");
+    }
+}

@@ -44,6 +44,7 @@ fn hair_of(fibers: &[(Vec3, Vec3)], diameter: f32) -> Hair {
             thickness: None,
             transparency: None,
             colour: None,
+            sigma_a: None,
         })
         .collect();
     Hair::from_strands(strands, diameter).0

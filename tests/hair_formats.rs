@@ -596,3 +596,87 @@ fn bad_usd_curves_are_clear_errors() {
         .to_string();
     assert!(e.contains("g.usdc"), "{e}");
 }
+
+#[test]
+fn a_painted_groom_round_trips_through_usd_and_pixars_library_reads_it() {
+    use strandlight::scattering::Preset;
+    use strandlight::session::Look;
+    use strandlight::session::export_hair::write_painted_hair;
+    let hair = generate(&StyleParams::new(Style::Wavy, 40, 9, 3)).unwrap();
+    let sigma_a: Vec<[f32; 3]> = (0..hair.point_count())
+        .map(|i| [0.1 + i as f32 * 0.01, 0.5, 2.0 - i as f32 * 0.003])
+        .collect();
+    let mut look = Look::from_preset(Preset::Blond);
+    look.d_f = 0.55;
+    look.params.eta = 1.6;
+    let out = common::temp_file("usd-export", "painted.usda");
+    write_painted_hair(&hair, &sigma_a, &look, &out).unwrap();
+    let back = load_hair(&out, &LoadOptions::default()).unwrap();
+    let h = &back.file.hair;
+    assert_eq!(h.strand_offsets, hair.strand_offsets);
+    assert_eq!(h.positions, hair.positions, "points");
+    for s in 0..hair.strand_count() {
+        for i in hair.strand_range(s) {
+            assert_eq!(h.thickness_at(s, i), hair.thickness_at(s, i), "widths");
+        }
+    }
+    assert_eq!(h.sigma_a.as_deref(), Some(&sigma_a[..]), "absorption");
+    let json = back.file.curves.as_ref().unwrap().look.as_deref().unwrap();
+    assert_eq!(serde_json::from_str::<Look>(json).unwrap(), look, "look");
+    println!(
+        "{} strands, {} points: points, widths, absorption and look came back exactly",
+        h.strand_count(),
+        h.point_count()
+    );
+    // Pixar's library reads what Unreal's groom importer looks for, and Blender's colour.
+    let Some(mut python) = common::python_with("pxr") else {
+        return;
+    };
+    let script = r#"
+import sys
+from pxr import Usd, UsdGeom
+stage = Usd.Stage.Open(sys.argv[1])
+prim = stage.GetPrimAtPath("/Groom/hair")
+curves = UsdGeom.BasisCurves(prim)
+pv = UsdGeom.PrimvarsAPI(prim)
+def primvar(name):
+    p = pv.GetPrimvar(name)
+    return str(p.GetTypeName()), p.GetInterpolation(), len(p.Get())
+# GroomAPI is Unreal's schema, unknown to usd-core's registry: read the authored list.
+print("schemas", list(prim.GetMetadata("apiSchemas").GetAddedOrExplicitItems()))
+print("type", prim.GetTypeName(), curves.GetTypeAttr().Get(), curves.GetWrapAttr().Get())
+print("up", UsdGeom.GetStageUpAxis(stage), "mpu", UsdGeom.GetStageMetersPerUnit(stage))
+print("curves", len(curves.GetCurveVertexCountsAttr().Get()), "points", len(curves.GetPointsAttr().Get()))
+print("widths", curves.GetWidthsInterpolation(), len(curves.GetWidthsAttr().Get()))
+for name in ["groom_color", "displayColor", "groom_roughness", "groom_id", "strandlight:sigma_a"]:
+    print(name, *primvar(name))
+print("eta", prim.GetAttribute("strandlight:eta").Get())
+"#;
+    let result = python.args(["-c", script]).arg(&out).output().unwrap();
+    let text = String::from_utf8_lossy(&result.stdout);
+    println!(
+        "usd-core:\n{text}{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(result.status.success());
+    let n = hair.point_count();
+    let s = hair.strand_count();
+    for line in [
+        "schemas ['GroomAPI']".to_string(),
+        "type BasisCurves linear nonperiodic".into(),
+        "up Y mpu 0.01".into(),
+        format!("curves {s} points {n}"),
+        format!("widths vertex {n}"),
+        format!("groom_color float3[] vertex {n}"),
+        format!("displayColor color3f[] vertex {n}"),
+        format!("groom_roughness float[] vertex {n}"),
+        format!("groom_id int[] uniform {s}"),
+        format!("strandlight:sigma_a float3[] vertex {n}"),
+        "eta 1.6".into(),
+    ] {
+        assert!(
+            text.lines().any(|l| l == line),
+            "missing `{line}` in\n{text}"
+        );
+    }
+}

@@ -10,9 +10,15 @@ use strandlight::session::{EnvironmentSource, HairSource, Session};
 pub struct EditArgs {
     /// A session file (.slsession) to open.
     pub session: Option<PathBuf>,
-    /// Hair file (.hair, .tfx, .gltf, .glb) instead of the generated default.
+    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz) instead of the generated default.
     #[arg(long, conflicts_with = "session")]
     pub hair: Option<PathBuf>,
+    /// USD: the prim whose curves are the hair (default: the stage's default prim).
+    #[arg(long, requires = "hair")]
+    pub hair_prim: Option<String>,
+    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    #[arg(long, requires = "hair")]
+    pub hair_time: Option<f64>,
     /// Environment (.hdr, .exr, .srbf.json) instead of the built-in sunny sky.
     #[arg(long, conflicts_with = "session")]
     pub env: Option<PathBuf>,
@@ -34,7 +40,12 @@ pub fn run_editor(args: EditArgs, launched: std::time::Instant) -> anyhow::Resul
     let mut session = Session::default();
     if let Some(path) = args.hair {
         let blake3 = strandlight::session::assemble::file_blake3(&path).ok();
-        session.hair = HairSource::File { path, blake3 };
+        session.hair = HairSource::File {
+            path,
+            blake3,
+            prim: args.hair_prim,
+            time: args.hair_time,
+        };
     }
     if let Some(path) = args.env {
         session.environment = EnvironmentSource::File {

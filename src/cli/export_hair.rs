@@ -15,7 +15,9 @@ pub struct ExportHairArgs {
     /// A paint layer (.slpaint) instead of the session's.
     #[arg(long)]
     pub paint: Option<PathBuf>,
-    /// Output: .usda (USD BasisCurves with widths and displayColor) or .hair (cyHair with colours).
+    /// Output: .usda (a USD groom in Unreal's convention, which Blender reads too: widths, groom_color,
+    /// displayColor, groom_roughness, and the look and absorption to come back exactly) or .hair
+    /// (cyHair with colours).
     #[arg(short, long)]
     pub output: PathBuf,
 }

@@ -30,9 +30,15 @@ pub struct RenderArgs {
     /// come from it, and the scene flags below are ignored (outputs, --reference and --software apply).
     #[arg(long)]
     pub session: Option<PathBuf>,
-    /// Hair file (.hair, .tfx, .gltf, .glb); default: a generated wavy hairstyle (10k strands).
+    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz); default: a generated wavy hairstyle (10k strands).
     #[arg(long)]
     pub hair: Option<PathBuf>,
+    /// USD: the prim whose curves are the hair (default: the stage's default prim).
+    #[arg(long, requires = "hair")]
+    pub hair_prim: Option<String>,
+    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    #[arg(long, requires = "hair")]
+    pub hair_time: Option<f64>,
     /// Style of the generated hair (when no --hair is given).
     #[arg(long, value_enum, conflicts_with = "hair")]
     pub style: Option<Style>,
@@ -233,6 +239,8 @@ fn session_from_args(args: &RenderArgs) -> anyhow::Result<Session> {
             Some(path) => HairSource::File {
                 path: path.clone(),
                 blake3: None,
+                prim: args.hair_prim.clone(),
+                time: args.hair_time,
             },
             None => HairSource::generated(
                 args.style.unwrap_or(Style::Wavy),

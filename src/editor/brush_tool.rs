@@ -218,7 +218,8 @@ impl EditorApp {
             let d = live.lock();
             (d.hair.clone(), d.sigma_a.clone())
         };
-        let scale = self.session.look.thickness_scale;
+        let look = self.session.look;
+        let scale = look.thickness_scale;
         let wake = self.egui_ctx();
         self.hair_export = Some(crate::live::jobs::Job::spawn(
             "exporting the hair",
@@ -226,7 +227,7 @@ impl EditorApp {
             move |_| {
                 let mut h = (*hair).clone();
                 h.transform(|p| p, scale);
-                crate::session::export_hair::write_painted_hair(&h, &sigma_a, &out)
+                crate::session::export_hair::write_painted_hair(&h, &sigma_a, &look, &out)
                     .map(|_| format!("exported {}", out.display()))
             },
         ));

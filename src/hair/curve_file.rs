@@ -27,6 +27,8 @@ pub struct CurveFile {
     pub colour: Option<String>,
     /// The time the values were read at, where any was sampled over time.
     pub time: Option<f64>,
+    /// strandlight's look, where the file is strandlight's own export (JSON of `session::Look`).
+    pub look: Option<String>,
 }
 
 /// A primvar of one batch: its interpolation and values (already expanded from any indices).
@@ -44,6 +46,8 @@ pub struct CurveBatch<'a> {
     pub points: &'a [Vec3],
     pub widths: Option<Primvar<'a, f32>>,
     pub colour: Option<Primvar<'a, Vec3>>,
+    /// strandlight's per-vertex absorption (its own export).
+    pub sigma_a: Option<Primvar<'a, Vec3>>,
 }
 
 impl CurveBatch<'_> {
@@ -118,18 +122,19 @@ impl CurveBatch<'_> {
                 let r = slice(w.interpolation);
                 primvar_at(&self.kind, w.interpolation, &w.values[r], &samples)
             });
-            let colour = self.colour.as_ref().map(|p| {
+            let rgb = |p: &Primvar<Vec3>| {
                 let r = slice(p.interpolation);
                 primvar_at(&self.kind, p.interpolation, &p.values[r], &samples)
                     .into_iter()
                     .map(|v| v.max(Vec3::ZERO).to_array())
                     .collect()
-            });
+            };
             out.strands.push(RawStrand {
                 points,
                 thickness: thickness.map(|t| t.into_iter().map(|w| w.max(0.0)).collect()),
-                colour,
+                colour: self.colour.as_ref().map(rgb),
                 transparency: None,
+                sigma_a: self.sigma_a.as_ref().map(rgb),
             });
             ctrl += n;
             vary += v;

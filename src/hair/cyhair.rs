@@ -154,6 +154,7 @@ pub fn read_cyhair(
             thickness: thickness.as_ref().map(|t| t[range.clone()].to_vec()),
             colour: colours.as_ref().map(|t| t[range.clone()].to_vec()),
             transparency: transparency.as_ref().map(|t| t[range.clone()].to_vec()),
+            sigma_a: None,
         });
         start = range.end;
     }

@@ -21,6 +21,8 @@ pub struct RawStrand {
     pub thickness: Option<Vec<f32>>,
     pub colour: Option<Vec<[f32; 3]>>,
     pub transparency: Option<Vec<f32>>,
+    /// Absorption per point, where the file carries strandlight's own (its USD export).
+    pub sigma_a: Option<Vec<[f32; 3]>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +37,8 @@ pub struct Hair {
     pub colour: Option<Vec<[f32; 3]>>,
     /// Optional per-point transparency (cyHair).
     pub transparency: Option<Vec<f32>>,
+    /// Optional per-point absorption a file carried (strandlight's USD export).
+    pub sigma_a: Option<Vec<[f32; 3]>>,
 }
 
 /// What cleaning removed, for reporting.
@@ -61,6 +65,8 @@ impl Hair {
         let any_thickness = strands.iter().any(|s| s.thickness.is_some());
         let any_colour = strands.iter().any(|s| s.colour.is_some());
         let any_transparency = strands.iter().any(|s| s.transparency.is_some());
+        let any_sigma_a = strands.iter().any(|s| s.sigma_a.is_some());
+        let mut sigma_a = Vec::new();
         let mut thickness = Vec::new();
         let mut colour = Vec::new();
         let mut transparency = Vec::new();
@@ -89,6 +95,9 @@ impl Hair {
                 if any_transparency {
                     transparency.push(s.transparency.as_ref().map_or(0.0, |t| t[k]));
                 }
+                if any_sigma_a {
+                    sigma_a.push(s.sigma_a.as_ref().map_or([0.0; 3], |a| a[k]));
+                }
             }
             offsets.push(positions.len() as u32);
             ids.push(id as u32);
@@ -104,6 +113,7 @@ impl Hair {
             },
             colour: any_colour.then_some(colour),
             transparency: any_transparency.then_some(transparency),
+            sigma_a: any_sigma_a.then_some(sigma_a),
         };
         (hair, report)
     }
@@ -283,6 +293,12 @@ impl Hair {
                     raw.transparency
                         .get_or_insert_with(Vec::new)
                         .push(lerp(t[r.start + seg], t[r.start + seg + 1]));
+                }
+                if let Some(c) = &self.sigma_a {
+                    let (a, b) = (c[r.start + seg], c[r.start + seg + 1]);
+                    raw.sigma_a
+                        .get_or_insert_with(Vec::new)
+                        .push(std::array::from_fn(|i| lerp(a[i], b[i])));
                 }
             }
             strands.push(raw);

@@ -90,8 +90,20 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 normalization: GENERATOR_SPACE,
             }
         }
-        HairSource::File { path, blake3 } => {
-            let loaded = load_hair(path, &LoadOptions::default())?;
+        HairSource::File {
+            path,
+            blake3,
+            prim,
+            time,
+        } => {
+            let options = LoadOptions {
+                curves: crate::hair::usd::CurveSelection {
+                    prim: prim.clone(),
+                    time: *time,
+                },
+                ..LoadOptions::default()
+            };
+            let loaded = load_hair(path, &options)?;
             LoadedHairSource {
                 hair: loaded.file.hair,
                 name: path.display().to_string(),

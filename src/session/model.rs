@@ -40,6 +40,12 @@ pub enum HairSource {
         path: PathBuf,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         blake3: Option<String>,
+        /// A USD stage's prim whose curves are the hair (None: the default prim).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        prim: Option<String>,
+        /// The time code time-sampled curves are read at (None: the earliest sample).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        time: Option<f64>,
     },
 }
 

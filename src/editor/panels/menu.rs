@@ -41,7 +41,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             }
             if ui
                 .button("Export painted hair…")
-                .on_hover_text("The hair with its dye as USD curves (.usda, displayColor) or cyHair colours (.hair)")
+                .on_hover_text("The groom with its dye and look as USD (.usda, for Unreal and Blender) or cyHair colours (.hair)")
                 .clicked()
             {
                 hair_export_dialog(app);
@@ -121,7 +121,10 @@ pub fn save_as_dialog(app: &mut EditorApp) {
 
 pub fn hair_dialog(app: &mut EditorApp) {
     if let Some(p) = rfd::FileDialog::new()
-        .add_filter("hair", &["hair", "tfx", "gltf", "glb"])
+        .add_filter(
+            "hair",
+            &["hair", "tfx", "gltf", "glb", "usd", "usda", "usdc", "usdz"],
+        )
         .pick_file()
     {
         app.open_hair(p);

@@ -29,6 +29,10 @@ pub struct CurveSelection {
     pub time: Option<f64>,
 }
 
+/// strandlight's own per-vertex absorption and look (its export, `write.rs`).
+const SIGMA_A_PRIMVAR: &str = "primvars:strandlight:sigma_a";
+const LOOK_ATTRIBUTE: &str = "strandlight:look";
+
 /// The colour primvars read, most specific first.
 const COLOUR_PRIMVARS: [&str; 3] = ["groom_color", "displayColor", "color"];
 
@@ -69,8 +73,16 @@ pub fn read_usd(path: &Path, selection: &CurveSelection) -> Result<CurveFile, St
                 interpolation: *i,
                 values: v,
             }),
+            sigma_a: b.sigma_a.as_ref().map(|(i, v)| Primvar {
+                name: SIGMA_A_PRIMVAR,
+                interpolation: *i,
+                values: v,
+            }),
         }
         .append_to(&mut out)?;
+        if out.look.is_none() {
+            out.look.clone_from(&b.look);
+        }
     }
     Ok(out)
 }
@@ -94,6 +106,8 @@ struct PrimCurves {
     points: Vec<Vec3>,
     widths: Option<(Interpolation, Vec<f32>)>,
     colour: Option<(String, Interpolation, Vec<Vec3>)>,
+    sigma_a: Option<(Interpolation, Vec<Vec3>)>,
+    look: Option<String>,
 }
 
 fn read_stage(root: &str, selection: &CurveSelection) -> Result<StageCurves, String> {
@@ -266,6 +280,11 @@ fn read_curves(
             break;
         }
     }
+    let sigma_a = read_primvar(prim, SIGMA_A_PRIMVAR, time, Interpolation::Vertex, vec3s)?;
+    let look = match value(&prim.attribute(LOOK_ATTRIBUTE), None)? {
+        Some(Value::String(s)) => Some(s),
+        _ => None,
+    };
     Ok(PrimCurves {
         name,
         kind,
@@ -273,6 +292,8 @@ fn read_curves(
         points,
         widths,
         colour,
+        sigma_a,
+        look,
     })
 }
 
@@ -485,6 +506,15 @@ impl Wire for PrimCurves {
                 put_pods(c, out);
             }
         }
+        match &self.sigma_a {
+            None => 0u8.put(out),
+            Some((i, v)) => {
+                1u8.put(out);
+                put_index(&INTERPOLATIONS, i, out);
+                put_pods(v, out);
+            }
+        }
+        self.look.put(out);
     }
     fn get(input: &mut &[u8]) -> Option<Self> {
         let name = String::get(input)?;
@@ -508,6 +538,11 @@ impl Wire for PrimCurves {
             )),
             _ => return None,
         };
+        let sigma_a = match u8::get(input)? {
+            0 => None,
+            1 => Some((get_index(&INTERPOLATIONS, input)?, get_pods(input)?)),
+            _ => return None,
+        };
         Some(Self {
             name,
             kind,
@@ -515,6 +550,8 @@ impl Wire for PrimCurves {
             points,
             widths,
             colour,
+            sigma_a,
+            look: Wire::get(input)?,
         })
     }
 }
