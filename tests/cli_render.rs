@@ -241,6 +241,9 @@ fn usd_grooms_render() {
             "{file}: hair in {:.0} % of the pixels, mean coverage {mean:.3}",
             100.0 * touched
         );
-        assert!(touched > 0.05 && mean > 0.01, "{file}: the groom is not in the frame");
+        assert!(
+            touched > 0.05 && mean > 0.01,
+            "{file}: the groom is not in the frame"
+        );
     }
 }

@@ -309,7 +309,7 @@ fn nearest(line: &[Vec3], p: Vec3) -> f32 {
 }
 
 #[test]
-fn usd_grooms_from_blender_and_pixars_library_match_their_source() {
+fn usd_and_alembic_grooms_from_blender_and_pixars_library_match_their_source() {
     let Some(data) = common::shared_data() else {
         return;
     };
@@ -320,19 +320,19 @@ fn usd_grooms_from_blender_and_pixars_library_match_their_source() {
     .unwrap();
     let src = &source.file.hair;
     let (slo, shi) = src.bounds();
-    // Blender: cubic Catmull-Rom, pinned, Z up, metres, under two Xforms, color4f colours.
-    // usd-core: Unreal's groom convention, linear, Y up, centimetres.
-    for (file, colour, first_colour) in [
+    // Blender's USD: cubic Catmull-Rom, pinned, Z up, metres, under two Xforms, color4f colours.
+    // usd-core: Unreal's groom convention, linear, Y up, centimetres. Blender's Alembic: Y up by
+    // convention, metres detected from the extent, no colour.
+    for (file, colour) in [
         (
             "hair/usd/ponytail_blender.usdc",
-            "primvars:color",
-            [0.05, 0.03, 0.02],
+            Some(("primvars:color", [0.05, 0.03, 0.02])),
         ),
         (
             "hair/usd/ponytail_usdcore.usda",
-            "primvars:groom_color",
-            [0.06, 0.035, 0.02],
+            Some(("primvars:groom_color", [0.06, 0.035, 0.02])),
         ),
+        ("hair/alembic/ponytail_blender.abc", None),
     ] {
         let start = std::time::Instant::now();
         let l = load_hair(&data.join(file), &LoadOptions::default()).unwrap();
@@ -341,7 +341,11 @@ fn usd_grooms_from_blender_and_pixars_library_match_their_source() {
         let curves = l.file.curves.as_ref().unwrap();
         assert_eq!(h.strand_count(), src.strand_count(), "{file}");
         assert_eq!(curves.declared, (4933, 78928), "{file}");
-        assert_eq!(l.normalization.up_source, "declared by the file");
+        if file.ends_with(".abc") {
+            assert_eq!(l.normalization.up_source, "format convention");
+        } else {
+            assert_eq!(l.normalization.up_source, "declared by the file");
+        }
         let (lo, hi) = h.bounds();
         let overshoot = (slo - lo).max(hi - shi).max_element();
         let inside = (lo - slo).max(shi - hi).max_element();
@@ -369,13 +373,15 @@ fn usd_grooms_from_blender_and_pixars_library_match_their_source() {
             let t = h.thickness_at(s, h.strand_range(s).start + p);
             assert!((t - 0.02).abs() < 1e-5, "{file}: width {t}");
         }
-        assert_eq!(curves.colour.as_deref(), Some(colour));
-        let c = h.colour.as_ref().unwrap()[0];
-        for k in 0..3 {
-            assert!(
-                (c[k] - first_colour[k]).abs() < 1e-4,
-                "{file}: colour {c:?}"
-            );
+        assert_eq!(curves.colour.as_deref(), colour.map(|c| c.0));
+        if let Some((_, first_colour)) = colour {
+            let c = h.colour.as_ref().unwrap()[0];
+            for k in 0..3 {
+                assert!(
+                    (c[k] - first_colour[k]).abs() < 1e-4,
+                    "{file}: colour {c:?}"
+                );
+            }
         }
     }
 }

@@ -148,3 +148,35 @@ fn usd_reader_survives_mutations() {
     fuzz_usd("USD text", "usda", text.into_bytes(), 1_500);
     fuzz_usd("USD crate", "usdc", crate_bytes, 1_500);
 }
+
+#[test]
+fn alembic_reader_survives_mutations_and_names_what_it_refuses() {
+    use strandlight::hair::alembic::read_alembic;
+    let read = |b: &[u8]| read_alembic(b, &CurveSelection::default());
+    let hdf5 = [b"\x89HDF\r\n\x1a\n".as_slice(), &[0u8; 64]].concat();
+    let e = read(&hdf5).unwrap_err();
+    assert!(e.contains("HDF5"), "{e}");
+    assert!(read(b"Ogawa").unwrap_err().contains("not an Alembic"));
+    let mut unfinished = b"Ogawa\x00\x00\x01".to_vec();
+    unfinished.extend([0u8; 8]);
+    assert!(read(&unfinished).unwrap_err().contains("not finished"));
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    // Blender's archive (2 MB): truncations through its structure, then mutations.
+    let seed = std::fs::read(data.join("hair/alembic/ponytail_blender.abc")).unwrap();
+    let n = seed.len();
+    let mut refused = 0;
+    for k in 0..400 {
+        let cut = if k < 200 {
+            k * 16
+        } else {
+            n - (k - 199) * 97 % n
+        };
+        refused += usize::from(read(&seed[..cut.min(n)]).is_err());
+    }
+    println!("Alembic: 400 truncations, {refused} refused, none panicked");
+    fuzz_n("Alembic (Blender's ponytail)", seed, 3_000, |b| {
+        read(b).is_ok()
+    });
+}

@@ -10,13 +10,13 @@ use strandlight::session::{EnvironmentSource, HairSource, Session};
 pub struct EditArgs {
     /// A session file (.slsession) to open.
     pub session: Option<PathBuf>,
-    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz) instead of the generated default.
+    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz, .abc) instead of the generated default.
     #[arg(long, conflicts_with = "session")]
     pub hair: Option<PathBuf>,
-    /// USD: the prim whose curves are the hair (default: the stage's default prim).
+    /// USD or Alembic: the prim or object path whose curves are the hair.
     #[arg(long, requires = "hair")]
     pub hair_prim: Option<String>,
-    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    /// The time sampled curves are read at (USD: a time code; Alembic: seconds).
     #[arg(long, requires = "hair")]
     pub hair_time: Option<f64>,
     /// Environment (.hdr, .exr, .srbf.json) instead of the built-in sunny sky.

@@ -11,7 +11,8 @@ use strandlight::hair::usd::CurveSelection;
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// A .hair (cyHair), .tfx (TressFX 3/4), .gltf, .glb or USD (.usd, .usda, .usdc, .usdz) file.
+    /// A .hair (cyHair), .tfx (TressFX 3/4), .gltf, .glb, USD (.usd, .usda, .usdc, .usdz) or Alembic
+    /// (.abc) file.
     pub file: PathBuf,
     #[command(flatten)]
     pub space: SpaceArgs,
@@ -29,10 +30,12 @@ pub struct SpaceArgs {
     /// Extra scale after unit conversion.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
-    /// USD: the prim whose curves are read (default: the stage's default prim).
+    /// USD or Alembic: the prim or object path whose curves are read (USD default: the stage's
+    /// default prim; Alembic: the whole archive).
     #[arg(long)]
     pub prim: Option<String>,
-    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    /// The time sampled curves are read at (USD: a time code; Alembic: seconds; default: the
+    /// first sample).
     #[arg(long)]
     pub time: Option<f64>,
 }

@@ -30,13 +30,13 @@ pub struct RenderArgs {
     /// come from it, and the scene flags below are ignored (outputs, --reference and --software apply).
     #[arg(long)]
     pub session: Option<PathBuf>,
-    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz); default: a generated wavy hairstyle (10k strands).
+    /// Hair file (.hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz, .abc); default: a generated wavy hairstyle (10k strands).
     #[arg(long)]
     pub hair: Option<PathBuf>,
-    /// USD: the prim whose curves are the hair (default: the stage's default prim).
+    /// USD or Alembic: the prim or object path whose curves are the hair.
     #[arg(long, requires = "hair")]
     pub hair_prim: Option<String>,
-    /// USD: the time code time-sampled curves are read at (default: the earliest sample).
+    /// The time sampled curves are read at (USD: a time code; Alembic: seconds).
     #[arg(long, requires = "hair")]
     pub hair_time: Option<f64>,
     /// Style of the generated hair (when no --hair is given).

@@ -615,13 +615,15 @@ impl EditorApp {
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
             match ext.as_str() {
-                "hair" | "tfx" | "gltf" | "glb" | "usd" | "usda" | "usdc" | "usdz" => self.open_hair(path),
+                "hair" | "tfx" | "gltf" | "glb" | "usd" | "usda" | "usdc" | "usdz" | "abc" => {
+                    self.open_hair(path)
+                }
                 "hdr" | "exr" | "json" => self.load_environment(path, 40),
                 "slsession" => self.open_session(&path),
                 _ => self.message(
                     Level::Error,
                     format!(
-                        "{}: not a hair file (.hair, .tfx, .gltf, .glb, USD), an environment (.hdr, .exr, .srbf.json) or a session (.slsession)",
+                        "{}: not a hair file (.hair, .tfx, .gltf, .glb, USD, .abc), an environment (.hdr, .exr, .srbf.json) or a session (.slsession)",
                         path.display()
                     ),
                 ),

@@ -14,7 +14,7 @@ pub enum HairError {
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },
     #[error(
-        "{path}: unsupported file type (expected .hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz or .obj)"
+        "{path}: unsupported file type (expected .hair, .tfx, .gltf, .glb, .usd, .usda, .usdc, .usdz, .abc or .obj)"
     )]
     UnknownType { path: PathBuf },
 }

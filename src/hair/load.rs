@@ -1,5 +1,6 @@
 //! Loading any supported hair or mesh file into world space (cm, +Y up).
 
+use super::alembic::read_alembic;
 use super::curve_file::CurveFile;
 use super::error::HairError;
 use super::gltf_io::read_gltf;
@@ -92,6 +93,10 @@ pub fn read_hair_raw(path: &Path, curves: &CurveSelection) -> Result<RawHairFile
     }
     let bytes = read_file(path)?;
     match ext.as_str() {
+        "abc" => {
+            let file = read_alembic(&bytes, curves).map_err(|e| HairError::format(path, e))?;
+            from_curve_file(path, "Alembic", file)
+        }
         "hair" => {
             let (hair, h, clean) = read_cyhair(&bytes, path)?;
             use super::cyhair::{

@@ -1,6 +1,7 @@
 //! Hair geometry: file formats in and out, the in-memory representation, normalisation to world
 //! space (centimetres, +Y up), and procedural hairstyles.
 
+pub mod alembic;
 pub mod bytes;
 pub mod curve_file;
 pub mod curves;

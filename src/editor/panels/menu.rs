@@ -123,7 +123,9 @@ pub fn hair_dialog(app: &mut EditorApp) {
     if let Some(p) = rfd::FileDialog::new()
         .add_filter(
             "hair",
-            &["hair", "tfx", "gltf", "glb", "usd", "usda", "usdc", "usdz"],
+            &[
+                "hair", "tfx", "gltf", "glb", "usd", "usda", "usdc", "usdz", "abc",
+            ],
         )
         .pick_file()
     {
