@@ -634,6 +634,31 @@ fn a_painted_groom_round_trips_through_usd_and_pixars_library_reads_it() {
         h.strand_count(),
         h.point_count()
     );
+    // A session opening the file (the editor's Open) takes its look and its absorption as a
+    // paint layer, and renders the absorption the export held.
+    use strandlight::session::assemble::{
+        exported_look_and_paint, load_hair_source, session_absorption,
+    };
+    let source = strandlight::session::HairSource::File {
+        path: out.clone(),
+        blake3: None,
+        prim: None,
+        time: None,
+    };
+    let loaded = load_hair_source(&source).unwrap();
+    let (restored_look, layer) = exported_look_and_paint(&loaded).unwrap();
+    let mut session = strandlight::session::Session::default();
+    session.hair = source;
+    session.look = restored_look;
+    session.paint_layer = Some(strandlight::paint::layer::SharedLayer::new(layer));
+    let (again, _) = session_absorption(&session, &loaded.hair).unwrap();
+    let worst = again
+        .iter()
+        .flatten()
+        .zip(sigma_a.iter().flatten())
+        .map(|(a, b)| (a - b).abs() / b)
+        .fold(0f32, f32::max);
+    assert!(worst < 1e-6, "restored absorption off by {worst}");
     // Pixar's library reads what Unreal's groom importer looks for, and Blender's colour.
     let Some(mut python) = common::python_with("pxr") else {
         return;

@@ -71,7 +71,11 @@ pub enum Loaded {
         warnings: Vec<String>,
     },
     /// A hair file that loaded: it becomes the session's hair (an edit; the scene then reloads).
-    Hair { source: HairSource },
+    Hair {
+        source: HairSource,
+        /// The look and paint a groom strandlight exported carries back.
+        restored: Option<Box<(crate::session::Look, crate::paint::layer::PaintLayer)>>,
+    },
     /// An occluder mesh that loaded: it becomes the session's head (an edit; the scene reloads).
     Occluder { path: PathBuf },
     /// A new environment; applied as an edit when it arrives.
@@ -569,8 +573,12 @@ impl EditorApp {
                     prim: None,
                     time: None,
                 };
-                load_hair_source(&source).map_err(|e| e.to_string())?;
-                Ok(Loaded::Hair { source })
+                let loaded = load_hair_source(&source).map_err(|e| e.to_string())?;
+                let restored = crate::session::assemble::exported_look_and_paint(&loaded);
+                Ok(Loaded::Hair {
+                    source,
+                    restored: restored.map(Box::new),
+                })
             },
         ));
     }
@@ -802,10 +810,21 @@ impl EditorApp {
                     };
                     self.perform(Edit::Occluder(Box::new(occluder)), false);
                 }
-                Ok(Loaded::Hair { source }) => {
+                Ok(Loaded::Hair { source, restored }) => {
                     self.perform(Edit::Hair(source), false);
                     self.session.camera.target = None;
                     self.session.camera.distance = None;
+                    if let Some(restored) = restored {
+                        let (look, layer) = *restored;
+                        self.perform(Edit::Look(Box::new(look)), false);
+                        let layer = crate::paint::layer::SharedLayer::new(layer);
+                        self.perform(Edit::PaintLayer(Box::new((Some(layer), None))), false);
+                        self.message(
+                            Level::Info,
+                            "restored the look and paint strandlight exported with this groom"
+                                .to_string(),
+                        );
+                    }
                 }
                 Ok(Loaded::Environment {
                     environment,

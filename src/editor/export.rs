@@ -70,6 +70,7 @@ impl ExportJob {
             warning: None,
             mesh: live.hair_mesh.clone(),
             normalization: live.normalization,
+            look: None,
         };
         // The head the viewport shows.
         let occluder = live.occluder.clone();

@@ -41,6 +41,8 @@ pub struct LoadedHairSource {
     pub mesh: Option<TriangleMesh>,
     /// How the file came into world space (an occluder file of the session gets the same).
     pub normalization: Normalization,
+    /// The look strandlight exported with this groom (its USD), where the file carries one.
+    pub look: Option<Look>,
 }
 
 /// The generator's space: centimetres, +Y up, as it is.
@@ -88,6 +90,7 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 warning: None,
                 mesh: Some(params.head.occluder_mesh()),
                 normalization: GENERATOR_SPACE,
+                look: None,
             }
         }
         HairSource::File {
@@ -104,12 +107,19 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 ..LoadOptions::default()
             };
             let loaded = load_hair(path, &options)?;
+            let look = match loaded.file.curves.as_ref().and_then(|c| c.look.as_deref()) {
+                Some(json) => Some(serde_json::from_str::<Look>(json).map_err(|e| {
+                    AssembleError::Look(format!("{}: its strandlight look: {e}", path.display()))
+                })?),
+                None => None,
+            };
             LoadedHairSource {
                 hair: loaded.file.hair,
                 name: path.display().to_string(),
                 warning: changed_warning(path, blake3),
                 mesh: loaded.file.mesh,
                 normalization: loaded.normalization,
+                look,
             }
         }
     };
@@ -117,6 +127,19 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
         return Err(AssembleError::NoStrands(loaded.name));
     }
     Ok(loaded)
+}
+
+/// What a groom strandlight exported carries back: its look, and its per-point absorption as a
+/// paint layer of full weight, so the session renders the absorption the export held. None for
+/// any other file.
+pub fn exported_look_and_paint(loaded: &LoadedHairSource) -> Option<(Look, PaintLayer)> {
+    let look = loaded.look?;
+    let sigma_a = loaded.hair.sigma_a.as_ref()?;
+    let mut layer = PaintLayer::empty(loaded.hair.point_count(), loaded.hair.strand_count());
+    for (p, s) in layer.points.iter_mut().zip(sigma_a) {
+        *p = [s[0], s[1], s[2], 1.0];
+    }
+    Some((look, layer))
 }
 
 /// The environment (its lights unturned) and a warning when its file changed.
