@@ -647,10 +647,12 @@ fn a_painted_groom_round_trips_through_usd_and_pixars_library_reads_it() {
     };
     let loaded = load_hair_source(&source).unwrap();
     let (restored_look, layer) = exported_look_and_paint(&loaded).unwrap();
-    let mut session = strandlight::session::Session::default();
-    session.hair = source;
-    session.look = restored_look;
-    session.paint_layer = Some(strandlight::paint::layer::SharedLayer::new(layer));
+    let session = strandlight::session::Session {
+        hair: source,
+        look: restored_look,
+        paint_layer: Some(strandlight::paint::layer::SharedLayer::new(layer)),
+        ..Default::default()
+    };
     let (again, _) = session_absorption(&session, &loaded.hair).unwrap();
     let worst = again
         .iter()
