@@ -382,6 +382,21 @@ fn usd_and_alembic_grooms_from_blender_and_pixars_library_match_their_source() {
                     "{file}: colour {c:?}"
                 );
             }
+            // The colours as dye: a full-weight layer whose absorption gives the colours back.
+            use strandlight::paint::dye::{DEFAULT_BETA_N, colour_from_sigma_a};
+            let layer = strandlight::paint::PaintLayer::from_colours(h, DEFAULT_BETA_N).unwrap();
+            assert!(layer.fits(h.point_count(), h.strand_count()));
+            let p = layer.points[0];
+            let back = colour_from_sigma_a([p[0], p[1], p[2]].map(f64::from), DEFAULT_BETA_N);
+            for k in 0..3 {
+                let err = (back[k] as f32 - c[k]).abs() / c[k];
+                assert!(
+                    err < 1e-3 && p[3] == 1.0,
+                    "{file}: dye {p:?} gives {back:?}"
+                );
+            }
+        } else {
+            assert!(strandlight::paint::PaintLayer::from_colours(h, 0.3).is_none());
         }
     }
 }

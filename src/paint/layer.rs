@@ -133,6 +133,19 @@ impl PaintLayer {
         }
     }
 
+    /// A layer that dyes every point with the absorption its file colour gives (Chiang's
+    /// inversion at `beta_n`, `paint::dye`), at full weight; None when the hair has no colours.
+    /// A groom's colours from another tool become strandlight's dye this way.
+    pub fn from_colours(hair: &crate::hair::Hair, beta_n: f64) -> Option<Self> {
+        let colours = hair.colour.as_ref()?;
+        let mut layer = Self::empty(hair.point_count(), hair.strand_count());
+        for (p, c) in layer.points.iter_mut().zip(colours) {
+            let s = super::dye::sigma_a_from_colour(c.map(f64::from), beta_n);
+            *p = [s[0] as f32, s[1] as f32, s[2] as f32, 1.0];
+        }
+        Some(layer)
+    }
+
     /// Whether the layer was painted on a hair of this many points and strands.
     pub fn fits(&self, points: usize, strands: usize) -> bool {
         self.points.len() == points && self.strand_count == strands as u64

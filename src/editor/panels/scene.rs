@@ -48,17 +48,41 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
     }
     generator(app, ui);
     head(app, ui);
+    let mut dye = None;
     if let Some(live) = &app.live {
         // The driver's bounds, found once per hair (not every frame over every point).
-        let (strands, points, (lo, hi)) = {
+        let (strands, points, (lo, hi), coloured) = {
             let d = live.lock();
-            (d.hair.strand_count(), d.hair.point_count(), d.bounds)
+            let coloured = d.hair.colour.is_some();
+            (
+                d.hair.strand_count(),
+                d.hair.point_count(),
+                d.bounds,
+                coloured,
+            )
         };
         let size = hi - lo;
         ui.weak(format!(
             "{strands} strands, {points} points, {:.1} × {:.1} × {:.1} cm",
             size.x, size.y, size.z
         ));
+        if coloured
+            && ui
+                .button("Dye from the file's colours")
+                .on_hover_text(
+                    "The file carries a colour per point (groom_color, displayColor, the cyHair \
+                     colour array): paint every point with the absorption that colour gives \
+                     (Chiang's inversion), as a paint layer you can undo or paint over",
+                )
+                .clicked()
+        {
+            let hair = live.lock().hair.clone();
+            dye = crate::paint::PaintLayer::from_colours(&hair, crate::paint::dye::DEFAULT_BETA_N);
+        }
+    }
+    if let Some(layer) = dye {
+        let layer = crate::paint::SharedLayer::new(layer);
+        app.perform(Edit::PaintLayer(Box::new((Some(layer), None))), false);
     }
 }
 
