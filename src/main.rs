@@ -34,8 +34,12 @@ fn end_quietly_on_closed_pipe() {
 fn end_quietly_on_closed_pipe() {}
 
 fn main() {
-    end_quietly_on_closed_pipe();
     let cli = cli::Cli::parse();
+    // The editor keeps Rust's behaviour: a closed pipe on its log is an error it survives, not
+    // the end of an artist's session.
+    if !matches!(cli.command, None | Some(cli::Command::Edit(_))) {
+        end_quietly_on_closed_pipe();
+    }
     if let Err(e) = cli::run(cli) {
         eprintln!("error: {}", one_line(&e));
         std::process::exit(1);

@@ -595,6 +595,13 @@ fn bad_usd_curves_are_clear_errors() {
             ),
             "4 + 3k",
         ),
+        (
+            "absorption of the wrong length",
+            curves(&format!(
+                "uniform token type = \"linear\"\nint[] curveVertexCounts = [4]\npoint3f[] points = {FOUR}\nfloat3[] primvars:strandlight:sigma_a = [(1, 1, 1)] (interpolation = \"vertex\")"
+            )),
+            "sigma_a has 1 values",
+        ),
         ("no curves", usda("def Xform \"x\" {}"), "no BasisCurves"),
         ("not USD", "#usda 1.0\ndef Curves (((".to_string(), "USD"),
         (
@@ -611,6 +618,14 @@ fn bad_usd_curves_are_clear_errors() {
         println!("{name}: {e}");
         assert!(e.contains(&file) && e.contains(needle), "{name}: {e}");
     }
+    // A colour of an unexpected type costs the colour, not the groom.
+    let odd = usda(&format!(
+        "def BasisCurves \"c\"\n{{\nuniform token type = \"linear\"\nint[] curveVertexCounts = [4]\npoint3f[] points = {FOUR}\nfloat[] primvars:displayColor = [1, 2, 3, 4] (interpolation = \"vertex\")\n}}"
+    ));
+    let l = load_usda("odd_colour.usda", &odd).unwrap();
+    let skipped = &l.file.curves.as_ref().unwrap().skipped;
+    println!("odd colour: {skipped:?}");
+    assert!(l.file.hair.colour.is_none() && skipped.iter().any(|s| s.contains("displayColor")));
     let e = load_hair(Path::new("/nonexistent/g.usdc"), &LoadOptions::default())
         .err()
         .unwrap()
@@ -630,6 +645,8 @@ fn a_painted_groom_round_trips_through_usd_and_pixars_library_reads_it() {
     let mut look = Look::from_preset(Preset::Blond);
     look.d_f = 0.55;
     look.params.eta = 1.6;
+    // The widths carry the thickness scale: the look that travels has none.
+    look.thickness_scale = 1.7;
     let out = common::temp_file("usd-export", "painted.usda");
     write_painted_hair(&hair, &sigma_a, &look, &out).unwrap();
     let back = load_hair(&out, &LoadOptions::default()).unwrap();
@@ -643,7 +660,15 @@ fn a_painted_groom_round_trips_through_usd_and_pixars_library_reads_it() {
     }
     assert_eq!(h.sigma_a.as_deref(), Some(&sigma_a[..]), "absorption");
     let json = back.file.curves.as_ref().unwrap().look.as_deref().unwrap();
-    assert_eq!(serde_json::from_str::<Look>(json).unwrap(), look, "look");
+    let travelled = Look {
+        thickness_scale: 1.0,
+        ..look
+    };
+    assert_eq!(
+        serde_json::from_str::<Look>(json).unwrap(),
+        travelled,
+        "look"
+    );
     println!(
         "{} strands, {} points: points, widths, absorption and look came back exactly",
         h.strand_count(),

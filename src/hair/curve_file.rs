@@ -29,6 +29,9 @@ pub struct CurveFile {
     pub time: Option<f64>,
     /// strandlight's look, where the file is strandlight's own export (JSON of `session::Look`).
     pub look: Option<String>,
+    /// Points after sampling, so far.
+    #[serde(skip)]
+    pub sampled: u64,
 }
 
 /// A primvar of one batch: its interpolation and values (already expanded from any indices).
@@ -98,7 +101,7 @@ impl CurveBatch<'_> {
                 return Err(format!("{name}: width {k} is {}", w.values[k]));
             }
         }
-        if let Some(c) = &self.colour {
+        for c in self.colour.iter().chain(&self.sigma_a) {
             check_len(
                 name,
                 c.name,
@@ -107,11 +110,23 @@ impl CurveBatch<'_> {
                 expect(c.interpolation),
             )?;
         }
+        if let Some(a) = &self.sigma_a
+            && let Some(k) = a.values.iter().position(|v| !v.is_finite())
+        {
+            return Err(format!("{name}: absorption {k} is not finite"));
+        }
         let (mut ctrl, mut vary) = (0usize, 0usize);
         for (c, &n) in self.counts.iter().enumerate() {
             let n = n as usize;
             let v = self.kind.varying_count(n).unwrap_or(0);
             let (samples, points) = sample_curve(&self.kind, &self.points[ctrl..ctrl + n])?;
+            // Sampling adds points: the cap holds for what is kept, not only what was read.
+            out.sampled += points.len() as u64;
+            if out.sampled > MAX_POINTS {
+                return Err(format!(
+                    "{name}: more than {MAX_POINTS} points once sampled"
+                ));
+            }
             let slice = |i: Interpolation| match i {
                 Interpolation::Constant => 0..1,
                 Interpolation::Uniform => c..c + 1,

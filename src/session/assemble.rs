@@ -107,16 +107,24 @@ pub fn load_hair_source(source: &HairSource) -> Result<LoadedHairSource, Assembl
                 ..LoadOptions::default()
             };
             let loaded = load_hair(path, &options)?;
+            // A look this version cannot read (another version's, a hand edit) is left out with a
+            // warning: the groom itself still loads.
+            let mut warning = changed_warning(path, blake3);
             let look = match loaded.file.curves.as_ref().and_then(|c| c.look.as_deref()) {
-                Some(json) => Some(serde_json::from_str::<Look>(json).map_err(|e| {
-                    AssembleError::Look(format!("{}: its strandlight look: {e}", path.display()))
-                })?),
+                Some(json) => serde_json::from_str::<Look>(json)
+                    .map_err(|e| {
+                        warning = Some(format!(
+                            "{}: its strandlight look is not readable and was left out ({e})",
+                            path.display()
+                        ))
+                    })
+                    .ok(),
                 None => None,
             };
             LoadedHairSource {
                 hair: loaded.file.hair,
                 name: path.display().to_string(),
-                warning: changed_warning(path, blake3),
+                warning,
                 mesh: loaded.file.mesh,
                 normalization: loaded.normalization,
                 look,

@@ -77,6 +77,12 @@ fn groom_look<'a>(
             ("d_f", look.d_f as f64),
             ("d_b", look.d_b as f64),
         ],
-        json: serde_json::to_string(look).map_err(|e| format!("the look as JSON: {e}"))?,
+        // The widths carry the thickness scale already: the look that travels has none, or a
+        // reopened groom would be scaled twice.
+        json: serde_json::to_string(&Look {
+            thickness_scale: 1.0,
+            ..*look
+        })
+        .map_err(|e| format!("the look as JSON: {e}"))?,
     })
 }

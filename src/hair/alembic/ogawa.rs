@@ -6,7 +6,7 @@
 //! corrupt file is an error and never a large allocation.
 
 /// A child of a group.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Node {
     Group(u64),
     Data(u64),

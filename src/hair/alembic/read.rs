@@ -34,6 +34,7 @@ pub fn read_alembic(bytes: &[u8], selection: &CurveSelection) -> Result<CurveFil
         selection,
         out: &mut out,
         objects: 0,
+        visited: Default::default(),
     };
     walk.object(top[2], "", DMat4::IDENTITY, None)?;
     if out.batches.is_empty() {
@@ -68,27 +69,31 @@ struct TimeSampling {
 }
 
 impl TimeSampling {
-    /// The last sample index at or before `t` (0 before the first).
+    /// The time of sample `i`.
+    fn time(&self, i: u32) -> f64 {
+        let n = self.samples.len().max(1) as u32;
+        let cycle = (i / n) as f64;
+        let within = self.samples.get((i % n) as usize).copied().unwrap_or(0.0);
+        if self.period.is_finite() {
+            within + cycle * self.period
+        } else {
+            within
+        }
+    }
+
+    /// The last sample index at or before `t` (0 before the first), by bisection: sample times
+    /// rise with the index.
     fn index_at(&self, t: f64, count: u32) -> u32 {
-        let time = |i: u32| -> f64 {
-            let n = self.samples.len().max(1) as u32;
-            let cycle = (i / n) as f64;
-            let within = self.samples.get((i % n) as usize).copied().unwrap_or(0.0);
-            if self.period.is_finite() {
-                within + cycle * self.period
+        let (mut lo, mut hi) = (0u32, count);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if self.time(mid) <= t + 1e-9 {
+                lo = mid;
             } else {
-                within
-            }
-        };
-        let mut best = 0;
-        for i in 0..count {
-            if time(i) <= t + 1e-9 {
-                best = i;
-            } else {
-                break;
+                hi = mid;
             }
         }
-        best
+        lo
     }
 }
 
@@ -250,6 +255,14 @@ impl Archive<'_> {
         Ok(out)
     }
 
+    /// The time a property is read at: its sample's.
+    fn sample_time(&self, p: &Property, time: Option<f64>) -> f64 {
+        let i = self.sample_index(p, time);
+        self.time_samplings
+            .get(p.time_sampling)
+            .map_or(0.0, |ts| ts.time(i))
+    }
+
     /// The sample index a property is read at.
     fn sample_index(&self, p: &Property, time: Option<f64>) -> u32 {
         match (time, self.time_samplings.get(p.time_sampling)) {
@@ -340,6 +353,8 @@ struct Walk<'a, 'b> {
     selection: &'a CurveSelection,
     out: &'a mut CurveFile,
     objects: usize,
+    /// Object groups already read: a corrupt archive may point at one group many times.
+    visited: std::collections::HashSet<Node>,
 }
 
 impl Walk<'_, '_> {
@@ -353,6 +368,10 @@ impl Walk<'_, '_> {
     ) -> Result<(), String> {
         let depth = depth.map_or(0, |d| d + 1);
         self.objects += 1;
+        // Group 0 is the empty group, which any number of objects may share.
+        if group != Node::Group(0) && !self.visited.insert(group) {
+            return Err("an object appears twice in the hierarchy".into());
+        }
         if depth > MAX_DEPTH || self.objects > MAX_OBJECTS {
             return Err("the object hierarchy is deeper or larger than an archive can be".into());
         }
@@ -429,8 +448,9 @@ impl Walk<'_, '_> {
             Some(p) => a.f64s(p, time)?,
             None => return Ok((DMat4::IDENTITY, inherits)),
         };
-        if find(&inner, ".vals").is_some_and(|p| p.samples > 1) {
-            self.out.time.get_or_insert(time.unwrap_or(0.0));
+        if let Some(p) = find(&inner, ".vals").filter(|p| p.samples > 1) {
+            let t = a.sample_time(p, time);
+            self.out.time.get_or_insert(t);
         }
         // Without `.ops`, a sample of 16 values is one matrix.
         let ops = match find(&inner, ".ops") {
@@ -496,8 +516,9 @@ impl Walk<'_, '_> {
         }
         let need = |name: &str| find(&g, name).ok_or_else(|| format!("{path}: no {name}"));
         let p = need("P")?;
-        if p.samples > 1 || need("nVertices")?.samples > 1 {
-            self.out.time.get_or_insert(time.unwrap_or(0.0));
+        if p.samples > 1 {
+            let t = a.sample_time(p, time);
+            self.out.time.get_or_insert(t);
         }
         let points: Vec<Vec3> = a
             .f32s(p, time, 3)?
@@ -522,10 +543,15 @@ impl Walk<'_, '_> {
             .map(|(i, v)| (i, v.into_iter().map(|w| w * scale).collect::<Vec<f32>>()));
         let mut colour = None;
         for name in ["groom_color", "displayColor", "Cd", "color"] {
-            if let Some((i, v)) = geom_param(a, &arb, name, time, 3)? {
-                let v: Vec<Vec3> = v.chunks_exact(3).map(Vec3::from_slice).collect();
-                colour = Some((format!(".arbGeomParams/{name}"), i, v));
-                break;
+            match geom_param(a, &arb, name, time, 3) {
+                Ok(Some((i, v))) => {
+                    let v: Vec<Vec3> = v.chunks_exact(3).map(Vec3::from_slice).collect();
+                    colour = Some((format!(".arbGeomParams/{name}"), i, v));
+                    break;
+                }
+                Ok(None) => {}
+                // A colour of another type (half, RGBA) costs the colour, not the groom.
+                Err(e) => self.out.skipped.push(format!("{path}: colour {e}")),
             }
         }
         CurveBatch {
@@ -555,11 +581,9 @@ fn curve_kind(ty: u8, wrap: u8, basis: u8, path: &str) -> Result<CurveKind, Stri
         (0, 1) => Basis::Bezier,
         (0, 2) => Basis::Bspline,
         (0, 3) => Basis::CatmullRom,
-        (0, b) => {
-            return Err(format!(
-                "{path}: curve basis {b} (Hermite or power) is not read"
-            ));
-        }
+        (0, 4) => return Err(format!("{path}: Hermite curves are not read")),
+        (0, 5) => return Err(format!("{path}: power-basis curves are not read")),
+        (0, b) => return Err(format!("{path}: cubic curves with basis {b} are not read")),
         (t, _) => {
             return Err(format!(
                 "{path}: curve type {t} (variable order) is not read"

@@ -26,8 +26,10 @@ pub fn in_child<T: Wire>(
     read: impl FnOnce() -> Result<T, String>,
 ) -> Result<T, String> {
     let mut fds = [0i32; 2];
-    // SAFETY: pipe writes two descriptors into the array it is given.
-    if unsafe { libc::pipe(fds.as_mut_ptr()) } != 0 {
+    // Close-on-exec: a process the parent starts meanwhile must not hold the write end open, or
+    // the parent would wait for an end of file that never comes.
+    // SAFETY: pipe2 writes two descriptors into the array it is given.
+    if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
         return Err(format!(
             "cannot start the USD reader: {}",
             std::io::Error::last_os_error()
@@ -86,7 +88,9 @@ pub fn in_child<T: Wire>(
     let status = unsafe {
         libc::close(rx);
         let mut status = 0;
-        libc::waitpid(pid, &mut status, 0);
+        while libc::waitpid(pid, &mut status, 0) < 0
+            && std::io::Error::last_os_error().kind() == std::io::ErrorKind::Interrupted
+        {}
         status
     };
     let bytes = received?;
@@ -113,14 +117,24 @@ pub fn in_child<T: Wire>(
 /// allocation fails at once instead of exhausting the machine.
 #[cfg(unix)]
 unsafe fn limit_memory(extra: u64) {
+    // SAFETY: sysconf only reads a system constant.
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) }.max(4096) as u64;
     let mapped = std::fs::read_to_string("/proc/self/statm")
         .ok()
         .and_then(|s| s.split_whitespace().next()?.parse::<u64>().ok())
-        .map(|pages| pages * 4096);
-    if let Some(mapped) = mapped {
+        .map(|pages| pages * page);
+    let mut current = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: reading this process's own limit into a valid struct.
+    let known = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut current) } == 0;
+    if let (Some(mapped), true) = (mapped, known) {
+        // A soft limit above the hard one would be refused: stay under it.
+        let want = mapped.saturating_add(extra).min(current.rlim_max);
         let limit = libc::rlimit {
-            rlim_cur: mapped + extra,
-            rlim_max: mapped + extra,
+            rlim_cur: want,
+            rlim_max: current.rlim_max,
         };
         // SAFETY: setting this process's own limit from a valid struct.
         unsafe { libc::setrlimit(libc::RLIMIT_AS, &limit) };

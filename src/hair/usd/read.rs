@@ -275,9 +275,14 @@ fn read_curves(
     let mut colour = None;
     for c in COLOUR_PRIMVARS {
         let attr = format!("primvars:{c}");
-        if let Some((i, v)) = read_primvar(prim, &attr, time, Interpolation::Constant, vec3s)? {
-            colour = Some((attr, i, v));
-            break;
+        match read_primvar(prim, &attr, time, Interpolation::Constant, vec3s) {
+            Ok(Some((i, v))) => {
+                colour = Some((attr, i, v));
+                break;
+            }
+            Ok(None) => {}
+            // A colour of another type costs the colour, not the groom.
+            Err(e) => out.skipped.push(format!("colour {e}")),
         }
     }
     let sigma_a = read_primvar(prim, SIGMA_A_PRIMVAR, time, Interpolation::Vertex, vec3s)?;
@@ -482,6 +487,26 @@ fn get_index<T: Copy>(all: &[T], input: &mut &[u8]) -> Option<T> {
     all.get(u8::get(input)? as usize).copied()
 }
 
+/// An optional primvar: a flag, its interpolation, its values.
+fn put_primvar<T: bytemuck::Pod>(v: &Option<(Interpolation, Vec<T>)>, out: &mut Vec<u8>) {
+    match v {
+        None => 0u8.put(out),
+        Some((i, values)) => {
+            1u8.put(out);
+            put_index(&INTERPOLATIONS, i, out);
+            put_pods(values, out);
+        }
+    }
+}
+
+fn get_primvar<T: bytemuck::Pod>(input: &mut &[u8]) -> Option<Option<(Interpolation, Vec<T>)>> {
+    match u8::get(input)? {
+        0 => Some(None),
+        1 => Some(Some((get_index(&INTERPOLATIONS, input)?, get_pods(input)?))),
+        _ => None,
+    }
+}
+
 impl Wire for PrimCurves {
     fn put(&self, out: &mut Vec<u8>) {
         self.name.put(out);
@@ -489,14 +514,7 @@ impl Wire for PrimCurves {
         put_index(&WRAPS, &self.kind.wrap, out);
         put_pods(&self.counts, out);
         put_pods(&self.points, out);
-        match &self.widths {
-            None => 0u8.put(out),
-            Some((i, w)) => {
-                1u8.put(out);
-                put_index(&INTERPOLATIONS, i, out);
-                put_pods(w, out);
-            }
-        }
+        put_primvar(&self.widths, out);
         match &self.colour {
             None => 0u8.put(out),
             Some((name, i, c)) => {
@@ -506,14 +524,7 @@ impl Wire for PrimCurves {
                 put_pods(c, out);
             }
         }
-        match &self.sigma_a {
-            None => 0u8.put(out),
-            Some((i, v)) => {
-                1u8.put(out);
-                put_index(&INTERPOLATIONS, i, out);
-                put_pods(v, out);
-            }
-        }
+        put_primvar(&self.sigma_a, out);
         self.look.put(out);
     }
     fn get(input: &mut &[u8]) -> Option<Self> {
@@ -524,11 +535,7 @@ impl Wire for PrimCurves {
         };
         let counts = get_pods(input)?;
         let points = get_pods(input)?;
-        let widths = match u8::get(input)? {
-            0 => None,
-            1 => Some((get_index(&INTERPOLATIONS, input)?, get_pods(input)?)),
-            _ => return None,
-        };
+        let widths = get_primvar(input)?;
         let colour = match u8::get(input)? {
             0 => None,
             1 => Some((
@@ -538,11 +545,7 @@ impl Wire for PrimCurves {
             )),
             _ => return None,
         };
-        let sigma_a = match u8::get(input)? {
-            0 => None,
-            1 => Some((get_index(&INTERPOLATIONS, input)?, get_pods(input)?)),
-            _ => return None,
-        };
+        let sigma_a = get_primvar(input)?;
         Some(Self {
             name,
             kind,
