@@ -303,37 +303,37 @@ impl Archive<'_> {
         Ok((values, element))
     }
 
-    fn f32s(&self, p: &Property, time: Option<f64>, extent: u8) -> Result<Vec<f32>, String> {
-        if p.pod != POD_F32 || p.extent != extent {
-            return Err(format!("{} is not {extent} × float32", p.name));
+    /// A sample's values of one POD type, decoded from little endian.
+    fn numbers<T, const N: usize>(
+        &self,
+        p: &Property,
+        time: Option<f64>,
+        (pod, what): (u8, &str),
+        from_le: fn([u8; N]) -> T,
+    ) -> Result<Vec<T>, String> {
+        if p.pod != pod {
+            return Err(format!("{} is not {what}", p.name));
         }
         let (bytes, _) = self.sample(p, time)?;
         Ok(bytes
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .chunks_exact(N)
+            .map(|b| from_le(b.try_into().unwrap_or([0; N])))
             .collect())
+    }
+
+    fn f32s(&self, p: &Property, time: Option<f64>, extent: u8) -> Result<Vec<f32>, String> {
+        if p.extent != extent {
+            return Err(format!("{} is not {extent} × float32", p.name));
+        }
+        self.numbers(p, time, (POD_F32, "float32"), f32::from_le_bytes)
     }
 
     fn f64s(&self, p: &Property, time: Option<f64>) -> Result<Vec<f64>, String> {
-        if p.pod != POD_F64 {
-            return Err(format!("{} is not float64", p.name));
-        }
-        let (bytes, _) = self.sample(p, time)?;
-        Ok(bytes
-            .chunks_exact(8)
-            .map(|b| f64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
-            .collect())
+        self.numbers(p, time, (POD_F64, "float64"), f64::from_le_bytes)
     }
 
     fn i32s(&self, p: &Property, time: Option<f64>) -> Result<Vec<i32>, String> {
-        if p.pod != POD_I32 {
-            return Err(format!("{} is not int32", p.name));
-        }
-        let (bytes, _) = self.sample(p, time)?;
-        Ok(bytes
-            .chunks_exact(4)
-            .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect())
+        self.numbers(p, time, (POD_I32, "int32"), i32::from_le_bytes)
     }
 
     fn u8s(&self, p: &Property, time: Option<f64>) -> Result<Vec<u8>, String> {
