@@ -4,8 +4,10 @@
 // RGB loops index several per-channel arrays in lockstep (`for c in 0..3`); indices read better there.
 #![allow(clippy::needless_range_loop)]
 
+pub mod colour;
 pub mod editor;
 pub mod envmap;
+pub mod files;
 pub mod gpu;
 pub mod hair;
 pub mod live;

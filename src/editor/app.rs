@@ -684,7 +684,7 @@ impl EditorApp {
         let file = self.state_dir.join(RECENT_FILE);
         let text = serde_json::to_string_pretty(&self.recent).unwrap_or_default();
         let written = std::fs::create_dir_all(&self.state_dir)
-            .and_then(|_| crate::session::write_atomic(&file, text.as_bytes()));
+            .and_then(|_| crate::files::write_atomic(&file, text.as_bytes()));
         if let Err(e) = written {
             self.message(Level::Warning, format!("{}: {e}", file.display()));
         }

@@ -5,8 +5,9 @@
 //! records the session file it belongs to. At start, files of processes that are no longer running are
 //! offered (the newest); a file of a live process belongs to another open editor and is left alone.
 
+use crate::files::write_atomic;
 use crate::live::jobs::Job;
-use crate::session::{Session, write_atomic};
+use crate::session::Session;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

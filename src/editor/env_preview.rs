@@ -2,9 +2,9 @@
 //! renderer actually lights with), both at the same exposure, with the fit's error; and the map the
 //! viewport shows behind the hair.
 
+use crate::colour::{aces_filmic, srgb_encode};
 use crate::envmap::EnvMap;
 use crate::render::background::BackgroundMap;
-use crate::render::frame::{aces_filmic, srgb_encode};
 use crate::render::scene::Environment;
 use std::sync::Arc;
 

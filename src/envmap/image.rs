@@ -156,8 +156,7 @@ impl EnvMap {
     /// Writes a tone-mapped 8-bit sRGB PNG preview (Reinhard on exposure-scaled radiance; the EXR
     /// stays the linear data, this is only for looking at).
     pub fn write_png_preview(&self, path: &Path, exposure: f32) -> Result<(), EnvError> {
-        let srgb =
-            |x: f32| (crate::render::frame::srgb_encode(x.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
+        let srgb = |x: f32| (crate::colour::srgb_encode(x.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
         let mut img = image::RgbImage::new(self.width as u32, self.height as u32);
         for (i, px) in img.pixels_mut().enumerate() {
             let c = self.pixels[i].map(|v| v * exposure);

@@ -82,7 +82,7 @@ pub fn parse_colour(s: &str) -> Result<[f64; 3], String> {
             return Err(format!("'{s}' is not a #rrggbb colour"));
         }
         let byte = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).unwrap_or(0) as f64 / 255.0;
-        let decode = crate::render::frame::srgb_decode;
+        let decode = crate::colour::srgb_decode;
         return Ok([decode(byte(0)), decode(byte(2)), decode(byte(4))]);
     }
     let parts: Vec<&str> = s.split(',').collect();

@@ -119,7 +119,7 @@ impl PaintLayer {
 
     /// Writes the layer atomically (temporary file, fsync, rename).
     pub fn write(&self, path: &Path) -> Result<(), PaintLayerError> {
-        crate::session::write_atomic(path, &self.encode()).map_err(|source| PaintLayerError::Io {
+        crate::files::write_atomic(path, &self.encode()).map_err(|source| PaintLayerError::Io {
             path: path.into(),
             source,
         })

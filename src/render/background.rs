@@ -28,7 +28,7 @@ pub enum Background {
 impl Background {
     /// The colour as linear RGB (for a linear composite: the EXR).
     pub fn linear_colour(c: [u8; 3]) -> [f32; 3] {
-        c.map(|v| super::frame::srgb_decode(v as f64 / 255.0) as f32)
+        c.map(|v| crate::colour::srgb_decode(v as f64 / 255.0) as f32)
     }
 }
 

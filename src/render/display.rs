@@ -3,9 +3,9 @@
 //! before the transform) or a flat colour (mixed after it), into an Rgba8Unorm texture
 //! that egui draws. Display only: stills and EXRs never pass here. [`display_pixel`] is the CPU twin.
 
-use super::frame::{aces_filmic, srgb_encode};
 use super::progressive::DisplayImage;
 use super::targets::FrameTargets;
+use crate::colour::{aces_filmic, srgb_encode};
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};

@@ -44,7 +44,7 @@ pub fn write_painted_hair(
             ));
         }
     };
-    super::write_atomic(out, &bytes).map_err(|e| format!("{}: {e}", out.display()))
+    crate::files::write_atomic(out, &bytes).map_err(|e| format!("{}: {e}", out.display()))
 }
 
 /// The session's hair with its look and paint, to `out` (`strandlight export-hair`).

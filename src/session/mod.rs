@@ -11,7 +11,7 @@ pub mod model;
 pub use assemble::{AssembleError, Scene};
 pub use edit::{Edit, EditKind, apply};
 pub use history::History;
-pub use io::{SessionError, write_atomic};
+pub use io::SessionError;
 pub use model::{
     Absorption, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions,
     SESSION_VERSION, Session, ViewCamera,

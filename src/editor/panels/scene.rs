@@ -2,12 +2,12 @@
 //! (file, yaw), the still's render settings and the viewport's view transform.
 
 use super::widgets::{Changed, slider, slider32};
+use crate::colour::{srgb_decode, srgb_encode};
 use crate::editor::app::EditorApp;
 use crate::editor::panels::menu;
 use crate::hair::procedural::{Style, StyleParams};
 use crate::render::background::Background;
 use crate::render::display::{Solo, ViewTransform};
-use crate::render::frame::{srgb_decode, srgb_encode};
 use crate::render::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
 

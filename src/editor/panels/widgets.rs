@@ -91,9 +91,9 @@ pub fn reset_button(ui: &mut egui::Ui, enabled: bool) -> bool {
 
 /// Linear to sRGB-encoded byte, and back.
 pub fn linear_to_srgb8(x: f64) -> u8 {
-    (crate::render::frame::srgb_encode(x.clamp(0.0, 1.0) as f32) * 255.0 + 0.5) as u8
+    (crate::colour::srgb_encode(x.clamp(0.0, 1.0) as f32) * 255.0 + 0.5) as u8
 }
 
 pub fn srgb8_to_linear(b: u8) -> f64 {
-    crate::render::frame::srgb_decode(b as f64 / 255.0)
+    crate::colour::srgb_decode(b as f64 / 255.0)
 }
