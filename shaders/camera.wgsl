@@ -1,5 +1,5 @@
 // The camera (twin of src/render/camera.rs) and the fiber frame (twin of src/scattering/frame.rs and
-// src/render/shade.rs): rays through pixels, the closest point of a segment to a ray.
+// src/render/reference/shade.rs): rays through pixels, the closest point of a segment to a ray.
 
 struct Camera {
     view_proj: mat4x4<f32>,
@@ -19,7 +19,7 @@ struct Camera {
 }
 
 // A visibility sample's value: -(triangle + 1) for the occluder, 0 for nothing (twin of
-// render/occluder.rs: occluder_triangle; the hair is in the K-buffer).
+// render/passes/occluder.rs: occluder_triangle; the hair is in the K-buffer).
 fn visible_occluder(v: f32) -> u32 {
     return select(0u, u32(-v + 0.5), v < -0.5);
 }

@@ -11,7 +11,7 @@
 // them, and those in front of the occluder's nearest sample.
 // The composite pass then weighs the K fragments front to back (weight = transmittance in front x
 // opacity) and, with the folded tail, gives the last one the opacity of everything behind it.
-// Twin of src/render/kbuffer.rs. Prepended: circular_gaussian (PI), camera.
+// Twin of src/render/passes/kbuffer.rs. Prepended: circular_gaussian (PI), camera.
 
 struct KBufferInfo {
     // Fragments kept per pixel.

@@ -5,7 +5,7 @@
 // the hair, read from the shadow grid a little off the surface (clamped at the grid's faces, fading to 1
 // within a grid spacing outside it). Weighted by the
 // samples' coverage and the transmittance of the hair in front (the K-buffer's), and added to the
-// occluder buffer. Twin of src/render/occluder.rs (shade_occluder).
+// occluder buffer. Twin of src/render/passes/occluder.rs (shade_occluder).
 // Prepended: circular_gaussian (PI), shadow_grid (GpuLight, ShadeBatch, FLAG_SHADOWS), camera.
 
 struct OccluderInfo {

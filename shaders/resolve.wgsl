@@ -3,7 +3,7 @@
 // occluder's sample ids (its triangle + 1 with the top bit set; for the CPU twins), and the beauty = sum of the accumulated components
 // and the occluder's radiance times the exposure scale 2^EV. Linear, premultiplied by coverage; no tonemap.
 // Also the background behind each pixel: the environment map along the pixel's centre ray, exposed
-// (zero without a map); the composite is the picture's business (render/background.rs).
+// (zero without a map); the composite is the picture's business (render/passes/background.rs).
 // Prepended: circular_gaussian (PI), camera.
 
 struct ResolveInfo {
@@ -52,7 +52,7 @@ struct ResolveRows {
 
 // Radiance of the environment along the unit world direction d: the map turned back by the yaw
 // (envmap/direction.rs: rotate_yaw, uv_from_direction), bilinear between texel centres, wrapping in
-// azimuth, clamped at the poles. Twin of BackgroundMap::radiance (src/render/background.rs).
+// azimuth, clamped at the poles. Twin of BackgroundMap::radiance (src/render/passes/background.rs).
 fn background_radiance(d: vec3<f32>) -> vec3<f32> {
     let w = i32(info.env_width);
     let h = i32(info.env_height);
@@ -96,7 +96,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = id.y * camera.size.x + id.x;
-    // The occluder's samples (the hair is in the K-buffer: render/kbuffer.rs).
+    // The occluder's samples (the hair is in the K-buffer: render/passes/kbuffer.rs).
     var ids = vec4<u32>(0u);
     var covered = 0u;
     var nearest = 1.0;

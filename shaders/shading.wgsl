@@ -3,7 +3,7 @@
 // grid, read trilinearly), and accumulated per lobe weighted by the fragments' composite weights
 // (kbuffer.wgsl): per visible segment (`claim_segments` .. `gather_segments` below: the default, for
 // the frame and its preview) or per fragment (`shade`). Twin of
-// src/render/shade.rs (shade_point).
+// src/render/reference/shade.rs (shade_point).
 // With multiple scattering on, every light also adds Zinke's dual scattering in Xu's per-SRBF form
 // (global M^G and local M^L, from the light's T_f, sigma_f^2 and the optical depth behind the point on
 // the grid) to MS.global and MS.local.
@@ -172,7 +172,7 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     aov_ms_local[pixel] = aov_ms_local[pixel] + vec4<f32>(w * l.ms_local, 0.0);
 }
 
-// Segment shading (twin: src/render/shade.rs, `shade_pixels_by_segment`). A segment's
+// Segment shading (twin: src/render/reference/shade.rs, `shade_pixels_by_segment`). A segment's
 // shading point moves along it from pixel to pixel, but its tangent, the lights and (nearly) the view
 // direction do not: each visible segment is shaded once per light batch. Its single scattering
 // response to each light is evaluated once, at its midpoint, and weighted by the light's
@@ -362,7 +362,7 @@ fn list_repaint_keys(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Where a frame's segment shading lies, for progressive refinement's bands (twin:
-// src/render/row_segments.rs, `row_segments`): per image row, the segments whose topmost kept
+// src/render/refine/row_segments.rs, `row_segments`): per image row, the segments whose topmost kept
 // fragment lies in it, which are exactly the segments a band of rows claims when the bands run from
 // the top. `mark_first_rows` leaves height - that row in each visible segment's `segment_batches`
 // entry (cleared before and after: the claims' own use of it), `count_first_rows` adds them up.

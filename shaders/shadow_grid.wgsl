@@ -5,7 +5,7 @@
 // ln transmittance (<= 0) is stored with its sign bit set outside the occluder and clear inside
 // (`grid_ln_t_stored`), so that `grid_transmittance` reads one word per corner; -abs reads it back.
 
-// One SRBF light (twin of GpuLight in src/render/shading.rs); read by the grid build and shading.
+// One SRBF light (twin of GpuLight in src/render/passes/shading.rs); read by the grid build and shading.
 struct GpuLight {
     direction: vec3<f32>,
     lambda: f32,
@@ -14,7 +14,7 @@ struct GpuLight {
 }
 
 // One shading dispatch's batch of lights over rows of the image (twin of ShadeBatch in
-// src/render/shading.rs); read by the shading and occluder passes.
+// src/render/passes/shading.rs); read by the shading and occluder passes.
 struct ShadeBatch {
     first: u32,
     count: u32,

@@ -43,7 +43,7 @@ struct BuildRange {
 @group(0) @binding(8) var<storage, read> build_range: BuildRange;
 
 // Per light of the dispatch (from the first one's): two slices (the previous and the current one) of path
-// integrals, two vec4 per point: (tau, mass), (spread, 0) (SCRATCH_BYTES in src/render/shadow_grid.rs).
+// integrals, two vec4 per point: (tau, mass), (spread, 0) (SCRATCH_BYTES in src/render/passes/shadow_grid.rs).
 @group(0) @binding(9) var<storage, read_write> sweep_scratch: array<vec4<f32>>;
 
 const SWEEP_GROUP: u32 = 128u;

@@ -6,7 +6,7 @@ mod common;
 
 use std::process::Command;
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::background::{Background, BackgroundMap};
+use strandlight::render::passes::background::{Background, BackgroundMap};
 use strandlight::render::scene::default_environment;
 use strandlight::scattering::lut::Luts;
 use strandlight::scattering::params::HairParams;

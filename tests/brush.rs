@@ -19,7 +19,7 @@ fn context() -> GpuContext {
 
 /// The front depth of every pixel by brute force on the CPU: the nearest of the fragments every
 /// segment's ribbon (the fibre's true width) leaves in the pixels it touches (the K-buffer's CPU twin,
-/// [`strandlight::render::kbuffer::abuffer`]), None where no fibre touches the pixel.
+/// [`strandlight::render::reference::abuffer::abuffer`]), None where no fibre touches the pixel.
 struct CpuDepth {
     c: CameraUniform,
     front: Vec<Option<f32>>,
@@ -28,8 +28,8 @@ struct CpuDepth {
 impl CpuDepth {
     fn new(hair: &strandlight::hair::Hair, c: CameraUniform) -> Self {
         let points = strandlight::gpu::fiber_density::GpuHair::point_data(hair, 1.0);
-        let segments = strandlight::render::shade::segment_starts(hair);
-        let ab = strandlight::render::kbuffer::abuffer(&c, &points, &segments);
+        let segments = strandlight::render::reference::shade::segment_starts(hair);
+        let ab = strandlight::render::reference::abuffer::abuffer(&c, &points, &segments);
         Self {
             c,
             front: ab

@@ -10,7 +10,7 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::TriangleMesh;
 use strandlight::hair::procedural::Head;
 use strandlight::hair::procedural::head::HEAD_MESH_RINGS;
-use strandlight::render::background::Background;
+use strandlight::render::passes::background::Background;
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
 use strandlight::session::{HairSource, Scene, Session};

@@ -7,8 +7,8 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::render::display::{
     DisplayInfo, DisplayPass, Solo, ViewTransform, displayed_pixel,
 };
-use strandlight::render::progressive::DisplayImage;
-use strandlight::render::targets::FrameTargets;
+use strandlight::render::passes::targets::FrameTargets;
+use strandlight::render::refine::DisplayImage;
 
 #[test]
 fn the_display_pass_matches_its_cpu_twin() {

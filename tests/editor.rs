@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use strandlight::editor::{EditorApp, EditorOptions};
 use strandlight::hair::procedural::Style;
 use strandlight::render::Frame;
-use strandlight::render::progressive::WorkUnit;
+use strandlight::render::refine::WorkUnit;
 use strandlight::session::{HairSource, Session};
 
 fn tmp(name: &str) -> PathBuf {
@@ -554,7 +554,7 @@ fn head_pixels(f: &Frame) -> usize {
         .iter()
         .filter(|ids| {
             ids.iter()
-                .any(|&id| strandlight::render::occluder::occluder_triangle(id).is_some())
+                .any(|&id| strandlight::render::passes::occluder::occluder_triangle(id).is_some())
         })
         .count()
 }
@@ -613,7 +613,7 @@ fn the_head_and_the_environment_show_and_the_panel_changes_them() {
     h.step();
     assert_eq!(
         h.state().session.render.background,
-        strandlight::render::background::Background::Transparent
+        strandlight::render::passes::background::Background::Transparent
     );
     converge(&mut h);
     assert!(image(&h).background.is_empty());

@@ -263,8 +263,8 @@ fn cone_marching_matches_the_srbf_average_of_the_transmittance() {
 #[test]
 fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
     use strandlight::shadow::DensityPyramid;
-    use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::grid::{GridSources, GridValues, ShadowGrid};
+    use strandlight::shadow::voxels::VolumeGrid;
     let v = clump_volume();
     let pyramid = DensityPyramid::build(&v);
     let volume_grid = VolumeGrid {
@@ -328,10 +328,10 @@ fn light_space_sweeps_match_the_srbf_average_of_the_transmittance() {
 #[test]
 fn midplane_samples_follow_the_pyramid_at_the_sweeps_midpoints() {
     use strandlight::shadow::DensityPyramid;
-    use strandlight::shadow::cone::crossings;
-    use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::grid::ShadowGrid;
     use strandlight::shadow::sweep::{MidplaneSamples, SweepAxes, SweepLattice, sweep_lod};
+    use strandlight::shadow::voxels::VolumeGrid;
+    use strandlight::shadow::voxels::crossings;
     let v = clump_volume();
     let pyramid = DensityPyramid::build(&v);
     let grid = ShadowGrid::around(
@@ -527,8 +527,8 @@ fn forward_scattering_matches_ray_shooting_through_explicit_fibers() {
 /// at random points against the rays from those points.
 #[test]
 fn swept_forward_scattering_matches_ray_shooting_through_explicit_fibers() {
-    use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::grid::{GridSources, GridValues, ShadowGrid};
+    use strandlight::shadow::voxels::VolumeGrid;
     let f = dyed_fibers();
     let mut r = Rng01::new(32);
     let lights: Vec<(Vec3, f32)> = (0..8).map(|_| (r.unit(), 0.01)).collect();

@@ -51,17 +51,19 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 }
                 Some("Camera") => std::mem::size_of::<strandlight::render::camera::CameraUniform>(),
                 Some("ShadeBatch") => {
-                    std::mem::size_of::<strandlight::render::shading::ShadeBatch>()
+                    std::mem::size_of::<strandlight::render::passes::shading::ShadeBatch>()
                 }
-                Some("GpuLight") => std::mem::size_of::<strandlight::render::shading::GpuLight>(),
+                Some("GpuLight") => {
+                    std::mem::size_of::<strandlight::render::passes::shading::GpuLight>()
+                }
                 Some("ShadowGridInfo") => {
-                    std::mem::size_of::<strandlight::render::shadow_grid::ShadowGridInfo>()
+                    std::mem::size_of::<strandlight::render::passes::shadow_grid::ShadowGridInfo>()
                 }
                 Some("ResolveInfo") => {
-                    std::mem::size_of::<strandlight::render::resolve::ResolveInfo>()
+                    std::mem::size_of::<strandlight::render::passes::resolve::ResolveInfo>()
                 }
                 Some("OccluderInfo") => {
-                    std::mem::size_of::<strandlight::render::occluder::OccluderInfo>()
+                    std::mem::size_of::<strandlight::render::passes::occluder::OccluderInfo>()
                 }
                 Some("DisplayInfo") => {
                     std::mem::size_of::<strandlight::render::display::DisplayInfo>()
@@ -82,15 +84,17 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
             let expected = match c.name.as_deref() {
                 Some("SWEEP_RING") => strandlight::shadow::sweep::SWEEP_RING as f64,
                 Some("MIDPLANE_REFINE") => strandlight::shadow::sweep::MIDPLANE_REFINE as f64,
-                Some("SWEEP_SLOTS") => strandlight::render::shadow_grid::SWEEP_SLOTS as f64,
+                Some("SWEEP_SLOTS") => strandlight::render::passes::shadow_grid::SWEEP_SLOTS as f64,
                 Some("SINGLE_SAMPLES") => {
-                    strandlight::render::segment_shading::SINGLE_SAMPLES as f64
+                    strandlight::render::passes::segment_shading::SINGLE_SAMPLES as f64
                 }
-                Some("FLAG_SHADOWS") => strandlight::render::shading::FLAG_SHADOWS as f64,
+                Some("FLAG_SHADOWS") => strandlight::render::passes::shading::FLAG_SHADOWS as f64,
                 Some("FLAG_MULTIPLE_SCATTERING") => {
-                    strandlight::render::shading::FLAG_MULTIPLE_SCATTERING as f64
+                    strandlight::render::passes::shading::FLAG_MULTIPLE_SCATTERING as f64
                 }
-                Some("FLAG_SINGLE_KEPT") => strandlight::render::shading::FLAG_SINGLE_KEPT as f64,
+                Some("FLAG_SINGLE_KEPT") => {
+                    strandlight::render::passes::shading::FLAG_SINGLE_KEPT as f64
+                }
                 Some("TABLE_THETA_D") => table::TABLE_THETA_D as f64,
                 Some("TABLE_LAMBDA") => table::TABLE_LAMBDA as f64,
                 Some("TABLE_DPHI") => table::TABLE_DPHI as f64,
@@ -251,7 +255,7 @@ fn gpu_fiber_density_equals_the_cpu_volume() {
     use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
     use strandlight::hair::procedural::{Style, StyleParams, generate};
     use strandlight::shadow::FiberDensity;
-    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::voxels::VolumeGrid;
     let ctx = GpuContext::new_headless(&GpuOptions::from_env())
         .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
     let hair = generate(&StyleParams::new(Style::Wavy, 2000, 24, 3)).expect("generate");
@@ -330,7 +334,7 @@ fn gpu_srbf_transmittance_equals_the_cpu_cone_march() {
     };
     use strandlight::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
     use strandlight::hair::procedural::{Style, StyleParams, generate};
-    use strandlight::shadow::fiber_density::VolumeGrid;
+    use strandlight::shadow::voxels::VolumeGrid;
     use strandlight::shadow::{DensityPyramid, FiberDensity};
     let ctx = GpuContext::new_headless(&GpuOptions::from_env())
         .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
@@ -395,8 +399,8 @@ fn gpu_forward_scattering_equals_the_cpu_march() {
     use strandlight::hair::procedural::{Style, StyleParams, generate};
     use strandlight::scattering::{CausticModel, ModelVariant};
     use strandlight::shadow::FiberDensity;
-    use strandlight::shadow::fiber_density::VolumeGrid;
     use strandlight::shadow::forward::{ForwardTable, forward_scattering};
+    use strandlight::shadow::voxels::VolumeGrid;
     let ctx = GpuContext::new_headless(&GpuOptions::from_env())
         .unwrap_or_else(|e| panic!("this test needs a GPU adapter (lavapipe in CI): {e}"));
     let hair = generate(&StyleParams::new(Style::StraightLong, 3000, 20, 6)).expect("generate");

@@ -11,13 +11,13 @@ use strandlight::envmap::{SrbfLight, SrbfSet};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::{Head, Style};
-use strandlight::render::kbuffer::Tail;
-use strandlight::render::occluder::{
+use strandlight::render::passes::kbuffer::Tail;
+use strandlight::render::passes::occluder::{
     Occluder, SKIN_ALBEDO, occluder_triangle, shade_occluder_frame,
 };
 use strandlight::render::reference::REFERENCE_VARIANT;
+use strandlight::render::reference::shade::ShadingHair;
 use strandlight::render::scene::generated_hair;
-use strandlight::render::shade::ShadingHair;
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::Preset;
 use strandlight::scattering::lut::Luts;
@@ -214,7 +214,7 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
         [0.625, 0.875],
     ];
     let forward = Vec3::from(camera.forward);
-    let segments = strandlight::render::shade::segment_starts(&s.hair);
+    let segments = strandlight::render::reference::shade::segment_starts(&s.hair);
     let (mut checked, mut behind, mut seen_through) = (0, 0, 0f32);
     let (mut head_pixels_seen, mut dimmed_bare) = (0usize, 0usize);
     for i in 0..frame.pixel_count() {
@@ -244,7 +244,7 @@ fn the_occluder_and_its_solid_equal_their_cpu_twins() {
         for f in frame.kept_fragments(i) {
             let i0 = segments[f.id as usize - 1] as usize;
             let (a, b) = (s.hair.positions[i0], s.hair.positions[i0 + 1]);
-            let depth = strandlight::render::kbuffer::fragment_depth(&camera, a, b, x, y);
+            let depth = strandlight::render::reference::ribbon::fragment_depth(&camera, a, b, x, y);
             checked += 1;
             behind += (depth > deepest + 0.02) as usize;
             front += (depth < head) as u32;

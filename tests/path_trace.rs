@@ -11,7 +11,7 @@ use std::time::Instant;
 use strandlight::envmap::{EnvMap, SrbfLight, SrbfSet, load_env};
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
-use strandlight::render::path_trace::{
+use strandlight::render::reference::path_trace::{
     PathTraceSettings, path_trace_frame, path_trace_frame_with_stats,
 };
 use strandlight::render::reference::{ReferenceLighting, ReferenceScene};
@@ -149,7 +149,7 @@ fn furnace(
 /// normal incidence but falls to ~0.65-0.9 at grazing inclinations, where the three lobes miss what
 /// p >= 3 would carry) over ~10 bounces: there only the closure radiance + deficit = 1 is asserted,
 /// which holds whatever the kernel's albedo. Prints the mean per depth cut-off (the study behind
-/// [`strandlight::render::path_trace::DEFAULT_MAX_DEPTH`]) and single scattering with shadows.
+/// [`strandlight::render::reference::path_trace::DEFAULT_MAX_DEPTH`]) and single scattering with shadows.
 #[test]
 fn white_furnace_lossless_hair() {
     let t0 = Instant::now();

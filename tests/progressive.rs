@@ -8,8 +8,8 @@ use std::path::PathBuf;
 use std::time::Duration;
 use strandlight::envmap::SrbfSet;
 use strandlight::gpu::{GpuContext, GpuOptions};
-use strandlight::render::preview::PreviewMode;
-use strandlight::render::progressive::{ImageReady, WorkUnit};
+use strandlight::render::refine::preview::PreviewMode;
+use strandlight::render::refine::{ImageReady, WorkUnit};
 use strandlight::render::renderer::{TableBuild, build_draft_table, build_tables};
 use strandlight::render::{Camera, Frame, Renderer};
 use strandlight::scattering::lut::Luts;
@@ -77,9 +77,9 @@ fn refinement_converges_to_render_frame_and_restarts_on_changes() {
     let lights = sunny_lights();
     let scene = small_bob(true);
     // With the head: drawn, shaded batch by batch with the hair, and a solid in the volume.
-    let head = strandlight::render::occluder::Occluder::new(
+    let head = strandlight::render::passes::occluder::Occluder::new(
         strandlight::hair::procedural::Head::default().mesh(24, true),
-        strandlight::render::occluder::SKIN_ALBEDO,
+        strandlight::render::passes::occluder::SKIN_ALBEDO,
     );
     let new = || {
         let mut r = Renderer::new(
@@ -1068,7 +1068,7 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
 /// visibility pass.
 #[test]
 fn bands_are_sized_by_the_segments_their_rows_list() {
-    use strandlight::render::row_segments::row_segments;
+    use strandlight::render::refine::row_segments::row_segments;
     let ctx = context();
     let luts = Luts::default_tables();
     let lights = sunny_lights();
@@ -1128,7 +1128,7 @@ fn a_coarse_preview_of_dense_hair_draws_a_quarter_of_the_strands_four_times_as_w
     let luts = Luts::default_tables();
     let lights = sunny_lights();
     let mut scene = common::bob_scene(
-        strandlight::render::preview::THIN_PREVIEW_STRANDS,
+        strandlight::render::refine::preview::THIN_PREVIEW_STRANDS,
         192,
         144,
         Preset::Brown.params(),

@@ -10,17 +10,17 @@ use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::Hair;
 use strandlight::hair::procedural::Style;
 use strandlight::render::camera::CameraUniform;
-use strandlight::render::preview::PreviewMode;
-use strandlight::render::progressive::ImageReady;
 use strandlight::render::reference::REFERENCE_VARIANT;
-use strandlight::render::reference::{
-    ReferenceLighting, ReferenceScene, importance_sample_env, reference_frame,
-};
-use strandlight::render::scene::generated_hair;
-use strandlight::render::shade::{
+use strandlight::render::reference::shade::{
     EVERY_FRAGMENT, ShadingHair, ShadingPoint, shade_pixels, shade_pixels_by_segment, shade_point,
     shade_segment_single,
 };
+use strandlight::render::reference::{
+    ReferenceLighting, ReferenceScene, importance_sample_env, reference_frame,
+};
+use strandlight::render::refine::ImageReady;
+use strandlight::render::refine::preview::PreviewMode;
+use strandlight::render::scene::generated_hair;
 use strandlight::render::{Camera, Frame, HairLook, RenderSettings, Renderer};
 use strandlight::scattering::dual_terms::DualTables;
 use strandlight::scattering::lut::Luts;

@@ -8,10 +8,10 @@ use std::time::Instant;
 use strandlight::gpu::{GpuContext, GpuOptions};
 use strandlight::hair::procedural::Style;
 use strandlight::paint::dye::parse_colour;
-use strandlight::render::background::{Background, BackgroundMap};
 use strandlight::render::camera::CAMERA_PRESETS;
 use strandlight::render::frame::check_output_folders;
-use strandlight::render::path_trace::{PathTraceSettings, path_trace_frame};
+use strandlight::render::passes::background::{Background, BackgroundMap};
+use strandlight::render::reference::path_trace::{PathTraceSettings, path_trace_frame};
 use strandlight::render::reference::{
     ReferenceLighting, ReferenceScene, reference_frame, sample_srbf_lights,
 };
@@ -115,12 +115,12 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4)]
     pub samples: u32,
     /// Hair fragments kept per pixel by the K-buffer (1 to 32; each is shaded).
-    #[arg(long, default_value_t = strandlight::render::kbuffer::DEFAULT_FRAGMENTS)]
+    #[arg(long, default_value_t = strandlight::render::passes::kbuffer::DEFAULT_FRAGMENTS)]
     pub fragments: u32,
     /// The fragments behind the kept ones: drop (Yu 2012), fold (into the last kept) or spread (over
     /// the kept ones).
     #[arg(long, default_value = "spread")]
-    pub tail: strandlight::render::kbuffer::Tail,
+    pub tail: strandlight::render::passes::kbuffer::Tail,
     /// Exposure in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,

@@ -548,9 +548,11 @@ impl EditorApp {
                 Ok(Loaded::Environment {
                     pictures: Box::new(super::env_preview::pictures(
                         &environment,
-                        Arc::new(crate::render::background::BackgroundMap::from_environment(
-                            &environment,
-                        )),
+                        Arc::new(
+                            crate::render::passes::background::BackgroundMap::from_environment(
+                                &environment,
+                            ),
+                        ),
                     )),
                     environment: Box::new(environment),
                     source,

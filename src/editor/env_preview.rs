@@ -4,7 +4,7 @@
 
 use crate::colour::{aces_filmic, srgb_encode};
 use crate::envmap::EnvMap;
-use crate::render::background::BackgroundMap;
+use crate::render::passes::background::BackgroundMap;
 use crate::render::scene::Environment;
 use std::sync::Arc;
 

@@ -3,11 +3,9 @@
 
 use super::context::{GpuContext, compute_pipeline};
 use crate::hair::Hair;
-use crate::shadow::fiber_density::VolumeGrid;
+use crate::shadow::voxels::VolumeGrid;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
-
-pub const FIBER_DENSITY_WGSL: &str = include_str!("../../shaders/fiber_density.wgsl");
 
 /// The volume's placement as the shader reads it.
 #[repr(C)]
@@ -153,7 +151,7 @@ impl FiberDensityPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("fiber_density"),
-            source: wgpu::ShaderSource::Wgsl(FIBER_DENSITY_WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(super::shaders::FIBER_DENSITY.into()),
         });
         Self {
             deposit: compute_pipeline(device, &module, "deposit"),

@@ -20,6 +20,8 @@ pub const RESOLVE: &str = include_str!("../../shaders/resolve.wgsl");
 pub const OCCLUDER: &str = include_str!("../../shaders/occluder.wgsl");
 pub const DUAL_RESPONSE: &str = include_str!("../../shaders/dual_response.wgsl");
 pub const DUAL_EVAL: &str = include_str!("../../shaders/dual_eval.wgsl");
+pub const FIBER_DENSITY: &str = include_str!("../../shaders/fiber_density.wgsl");
+pub const DISPLAY: &str = include_str!("../../shaders/display.wgsl");
 
 /// The dual-scattering test harness: the fast model, the dual responses, bindings and entry point.
 pub fn dual_eval_module() -> String {
@@ -110,10 +112,7 @@ pub fn modules() -> Vec<(&'static str, String)> {
             "fast_eval",
             format!("{}\n{}", fast_model_library(), FAST_EVAL),
         ),
-        (
-            "fiber_density",
-            super::fiber_density::FIBER_DENSITY_WGSL.to_string(),
-        ),
+        ("fiber_density", FIBER_DENSITY.to_string()),
         ("density_downsample", DENSITY_DOWNSAMPLE.to_string()),
         ("transmittance_eval", transmittance_eval_module()),
         ("forward_eval", forward_eval_module()),
@@ -121,7 +120,7 @@ pub fn modules() -> Vec<(&'static str, String)> {
         ("shading", shading_module()),
         ("resolve", resolve_module()),
         ("occluder", occluder_module()),
-        ("display", crate::render::display::DISPLAY_WGSL.to_string()),
+        ("display", DISPLAY.to_string()),
         ("shadow_grid_build", shadow_grid_build_module()),
         ("dual_eval", dual_eval_module()),
     ]

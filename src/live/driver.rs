@@ -14,11 +14,11 @@ use crate::hair::TriangleMesh;
 use crate::hair::normalize::Normalization;
 use crate::paint::SharedLayer;
 use crate::paint::brush::effective;
-use crate::render::background::{Background, BackgroundMap};
 use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
-use crate::render::occluder::Occluder;
-use crate::render::preview::PreviewMode;
-use crate::render::progressive::{ImageReady, Progress};
+use crate::render::passes::background::{Background, BackgroundMap};
+use crate::render::passes::occluder::Occluder;
+use crate::render::refine::preview::PreviewMode;
+use crate::render::refine::{ImageReady, Progress};
 use crate::render::renderer::{ParamTables, TableBuild, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
@@ -135,7 +135,7 @@ pub fn unit_budget(ctx: &GpuContext) -> std::time::Duration {
     if ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
         SOFTWARE_UNIT_BUDGET
     } else {
-        crate::render::progressive::DEFAULT_UNIT_BUDGET
+        crate::render::refine::DEFAULT_UNIT_BUDGET
     }
 }
 
@@ -752,7 +752,7 @@ impl LiveDriver {
             .is_some_and(|(params, azimuthal)| {
                 // One build at a time (a slider drag would pile them up on the GPU's cores), but
                 // tables the process keeps (an undo after a new eta's draft) need none.
-                (self.tables.is_none() || crate::render::table_cache::holds(params))
+                (self.tables.is_none() || crate::render::renderer::table_cache::holds(params))
                     && (self.first_image_in().is_some()
                         || self.progress.is_some_and(|p| p.converged)
                         || self.renderer.preview_factor() < 2

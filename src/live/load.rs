@@ -5,7 +5,7 @@
 
 use super::driver::{LiveDriver, prepare};
 use crate::gpu::GpuContext;
-use crate::render::background::BackgroundMap;
+use crate::render::passes::background::BackgroundMap;
 use crate::scattering::lut::Luts;
 use crate::session::Session;
 use crate::session::assemble::{load_environment_source, load_hair_source};

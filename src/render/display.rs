@@ -3,14 +3,13 @@
 //! before the transform) or a flat colour (mixed after it), into an Rgba8Unorm texture
 //! that egui draws. Display only: stills and EXRs never pass here. [`display_pixel`] is the CPU twin.
 
-use super::progressive::DisplayImage;
-use super::targets::FrameTargets;
 use crate::colour::{aces_filmic, srgb_encode};
 use crate::gpu::context::{bind_buffers, compute_pipeline};
+use crate::render::passes::targets::FrameTargets;
+use crate::render::refine::DisplayImage;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
-pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// What the viewport shows: the beauty or one scattering component alone (the AOVs).
@@ -208,7 +207,7 @@ impl DisplayPass {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("display"),
-            source: wgpu::ShaderSource::Wgsl(DISPLAY_WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(crate::gpu::shaders::DISPLAY.into()),
         });
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("display"),

@@ -2,10 +2,10 @@
 //! optionally with AOV layers R, TT, TRT, MS.global, MS.local and depth Z), with the render's
 //! parameters as header attributes; a tonemapped PNG preview (ACES filmic, sRGB), never used for the EXR.
 
-use super::background::Background;
-use super::kbuffer::{Fragment, PixelFragments};
-use super::targets::COMPONENTS;
 use crate::colour::{aces_filmic, srgb_encode};
+use crate::render::passes::background::Background;
+use crate::render::passes::kbuffer::{Fragment, PixelFragments};
+use crate::render::passes::targets::COMPONENTS;
 use std::path::Path;
 
 #[derive(Clone, Debug)]

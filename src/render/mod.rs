@@ -1,30 +1,21 @@
-//! The hair renderer (Xu et al. 2011 Sec. 5 on wgpu): visibility, per-SRBF shading batches with
-//! self-shadowing, resolve; shared by `strandlight render`, `bench` and the editor.
+//! The hair renderer (Xu et al. 2011 Sec. 5 on wgpu), shared by `strandlight render`, `bench` and the
+//! editor. Its rooms follow the pipeline:
+//! - [`renderer`]: the facade the front ends drive (resources for one hairstyle, updated in place);
+//! - [`passes`]: the GPU passes of a frame, in order;
+//! - [`refine`]: progressive refinement (which bounded unit next, its cost model, previews, repaints);
+//! - [`reference`]: the CPU twins and reference modes (shading, A-buffer, path tracer);
+//! - camera, frame read-back and output, display transform, scenes, tiled stills, pass timing.
 
-pub mod background;
 pub mod camera;
 pub mod display;
 pub mod frame;
-pub mod kbuffer;
-pub mod occluder;
-pub mod path_trace;
-pub mod preview;
-pub mod progressive;
+pub mod passes;
 pub mod reference;
-pub mod reference_lights;
+pub mod refine;
 pub mod renderer;
-pub mod resolve;
-pub mod row_segments;
 pub mod scene;
-pub mod segment_shading;
-pub mod shade;
-pub mod shading;
-pub mod shadow_grid;
-pub mod table_cache;
-pub mod targets;
 pub mod tiled;
 pub mod timing;
-pub mod visibility;
 
 pub use camera::Camera;
 pub use frame::Frame;

@@ -137,10 +137,10 @@ impl StandardScene {
     }
 
     /// The generated head under every scene's hair (as under the default render's).
-    pub fn occluder(&self) -> super::occluder::Occluder {
-        super::occluder::Occluder::new(
+    pub fn occluder(&self) -> crate::render::passes::occluder::Occluder {
+        crate::render::passes::occluder::Occluder::new(
             crate::hair::procedural::Head::default().occluder_mesh(),
-            super::occluder::SKIN_ALBEDO,
+            crate::render::passes::occluder::SKIN_ALBEDO,
         )
     }
 

@@ -3,12 +3,12 @@
 //! ([`Camera::tile_uniform`]), and pasted into one [`Frame`]. The shadow grid is built once and kept
 //! across tiles (it does not depend on the camera).
 
-use super::camera::{Camera, Tile};
-use super::frame::Frame;
-use super::kbuffer::KBufferTargets;
-use super::renderer::{RenderError, Renderer};
 use crate::gpu::GpuContext;
 use crate::gpu::context::binding_limit;
+use crate::render::camera::{Camera, Tile};
+use crate::render::frame::Frame;
+use crate::render::passes::kbuffer::KBufferTargets;
+use crate::render::renderer::{RenderError, Renderer};
 
 /// Tiles of at most this many pixels a side by default (16 MiB per RGBA float buffer).
 pub const DEFAULT_TILE: u32 = 1024;

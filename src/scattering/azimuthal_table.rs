@@ -38,10 +38,10 @@
 //! 30 and more). See docs/fast-form.md.
 
 use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
+use super::fast_azimuthal::LAMBDA_PRIME_MAX;
 use super::fast_azimuthal::{Rgb32, bravais_eta_prime, fresnel_schlick, sigma_a_prime};
 use super::fast_exact_azimuthal::for_each_window_node;
 use super::fast_params::FastHairParams;
-use super::fast_response::LAMBDA_PRIME_MAX;
 use super::half_cells::{half_pair, round_to_half_bits};
 use super::params::HairParams;
 use rayon::prelude::*;

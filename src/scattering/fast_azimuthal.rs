@@ -26,6 +26,9 @@ use super::circular_gaussian::{asin_precise, bessel_i0_scaled};
 use super::lut::{Luts, lut_sample_c, lut_sample_h, lut_sample_r, wrap_angle_f32};
 use std::f32::consts::{PI, SQRT_2, TAU};
 
+/// lambda' is clamped to this (the C_k table's end); the azimuthal Gaussian is nearly flat there.
+pub const LAMBDA_PRIME_MAX: f32 = 10.0;
+
 pub type Rgb32 = [f32; 3];
 
 /// eta'(theta_d) = sqrt(eta^2 - sin^2 theta_d) / cos theta_d (Bravais, perpendicular).

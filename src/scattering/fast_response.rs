@@ -19,13 +19,11 @@
 
 use super::azimuthal_table::AzimuthalTable;
 use super::circular_gaussian::{GaussianEnd, bessel_i0_scaled, gaussian_quadratic_moments_between};
+use super::fast_azimuthal::LAMBDA_PRIME_MAX;
 use super::fast_azimuthal::{Rgb32, eta_star_mean, inner_integral_r};
 use super::fast_params::{FastHairParams, LONGITUDINAL_PUBLISHED};
 use super::lut::Luts;
 use std::f32::consts::{FRAC_PI_2, PI};
-
-/// lambda' is clamped to this (the C_k table's end); the azimuthal Gaussian is nearly flat there.
-pub const LAMBDA_PRIME_MAX: f32 = 10.0;
 
 /// The product of Xu's 1D Gaussians g(x; mu1, l1) g(x; mu2, l2) = scale g(x; mu, l)
 /// (g(x; mu, l) = exp(-(x - mu)^2 / l^2)). Returns (scale, mu, l).

@@ -10,7 +10,7 @@ use crate::hair::load::{LoadOptions, load_hair, load_mesh};
 use crate::hair::normalize::Normalization;
 use crate::hair::procedural::generate;
 use crate::paint::{AbsorptionSpec, PaintLayer};
-use crate::render::occluder::Occluder;
+use crate::render::passes::occluder::Occluder;
 use crate::render::scene::{Environment, default_environment, load_environment};
 use crate::render::{Camera, HairLook, RenderSettings};
 use std::path::Path;

@@ -4,7 +4,6 @@
 
 use super::model::{SESSION_VERSION, Session};
 use crate::files::write_atomic;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -128,7 +127,7 @@ impl Session {
         if !matches!(r.samples, 2 | 4) {
             return Err(format!("render samples must be 2 or 4, got {}", r.samples));
         }
-        let most = crate::render::kbuffer::MAX_FRAGMENTS;
+        let most = crate::render::passes::kbuffer::MAX_FRAGMENTS;
         if !(1..=most).contains(&r.fragments) {
             return Err(format!(
                 "render fragments must be 1 to {most}, got {}",

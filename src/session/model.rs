@@ -307,7 +307,7 @@ pub struct RenderOptions {
     #[serde(default = "default_fragments")]
     pub fragments: u32,
     #[serde(default)]
-    pub tail: crate::render::kbuffer::Tail,
+    pub tail: crate::render::passes::kbuffer::Tail,
     /// Exposure in stops (applied to the EXR as `render --exposure` does).
     pub exposure: f32,
     pub shadows: bool,
@@ -317,11 +317,11 @@ pub struct RenderOptions {
     /// What the viewport and the PNG show behind the hair (the EXR writes it only when `render
     /// --background` asks).
     #[serde(default)]
-    pub background: crate::render::background::Background,
+    pub background: crate::render::passes::background::Background,
 }
 
 fn default_fragments() -> u32 {
-    crate::render::kbuffer::DEFAULT_FRAGMENTS
+    crate::render::passes::kbuffer::DEFAULT_FRAGMENTS
 }
 
 impl Default for RenderOptions {
@@ -408,7 +408,7 @@ impl Default for OccluderOptions {
         Self {
             show: true,
             mesh: None,
-            albedo: crate::render::occluder::SKIN_ALBEDO,
+            albedo: crate::render::passes::occluder::SKIN_ALBEDO,
         }
     }
 }

@@ -9,7 +9,7 @@
 //! of light arriving without crossing any fiber is exp(-tau) (Poisson). sqrt(<sin^2>) stands in for
 //! <|sin|>: exact for aligned fibers, 4% high for isotropic ones. No opacity constant is involved.
 
-use super::cone::{crossings, trilinear};
+use super::voxels::{VolumeGrid, box_exit, crossings, trilinear};
 use crate::hair::Hair;
 use glam::Vec3;
 
@@ -30,25 +30,6 @@ pub struct FiberDensity {
     pub length_density: Vec<f32>,
     /// The fraction of the voxel inside an occluder ([`FiberDensity::add_solid`]; empty: none).
     pub solid: Vec<f32>,
-}
-
-/// Distance from p along omega (unit) to where the ray leaves the box origin + voxel * [0, dims];
-/// infinite for a zero direction.
-pub fn box_exit(origin: Vec3, voxel: f32, dims: [usize; 3], p: Vec3, omega: Vec3) -> f32 {
-    let hi = origin + voxel * Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
-    let mut exit = f32::INFINITY;
-    for ax in 0..3 {
-        let w = omega[ax];
-        if w.abs() > 1e-12 {
-            let t = if w > 0.0 {
-                (hi[ax] - p[ax]) / w
-            } else {
-                (origin[ax] - p[ax]) / w
-            };
-            exit = exit.min(t);
-        }
-    }
-    exit
 }
 
 /// The absorption of an empty voxel: the length-weighted mean over its 26 neighbours (0 if they are
@@ -87,41 +68,6 @@ fn neighbour_absorption(dims: [usize; 3], v: usize, length: &[f64], sums: &[[f64
         return [0.0; 3];
     }
     sig.map(|x| (x / len) as f32)
-}
-
-/// Largest number of voxels along one axis.
-pub const MAX_DIM: usize = 256;
-
-/// Where the volume lies: one voxel of margin around the hair's bounds, the voxel grown if an axis
-/// would need more than MAX_DIM voxels. Shared by the CPU builder and the GPU pass.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct VolumeGrid {
-    pub origin: Vec3,
-    pub voxel: f32,
-    pub dims: [usize; 3],
-}
-
-impl VolumeGrid {
-    pub fn around(hair: &Hair, voxel: f32) -> Self {
-        let (lo, hi) = hair.bounds();
-        let mut voxel = voxel.max(1e-4);
-        let extent = (hi - lo).max(Vec3::splat(voxel));
-        let largest = extent.max_element();
-        if largest / voxel > (MAX_DIM - 2) as f32 {
-            voxel = largest / (MAX_DIM - 2) as f32;
-        }
-        let origin = lo - Vec3::splat(voxel);
-        let dims = [0, 1, 2].map(|a| ((extent[a] / voxel).ceil() as usize + 2).min(MAX_DIM));
-        Self {
-            origin,
-            voxel,
-            dims,
-        }
-    }
-
-    pub fn voxel_count(&self) -> usize {
-        self.dims[0] * self.dims[1] * self.dims[2]
-    }
 }
 
 impl FiberDensity {

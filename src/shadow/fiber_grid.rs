@@ -7,12 +7,12 @@
 //! walked in order (Amanatides and Woo 1987); a segment listed in several cells is reported only by the
 //! cell that holds the ray's point of closest approach, so every crossing is reported once.
 
-use super::fiber_density::box_exit;
+use super::voxels::box_exit;
 use crate::hair::Hair;
 use glam::Vec3;
 
 /// One segment as rays see it. Segments are numbered as the renderer numbers them
-/// ([`crate::render::shade::segment_starts`]).
+/// ([`crate::render::reference::shade::segment_starts`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FiberSegment {
     pub a: Vec3,

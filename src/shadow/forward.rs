@@ -23,8 +23,9 @@
 //! voxel holds its neighbours'): reading it as zero where the trilinear density is not made every
 //! fourth crossing in a sparse clump a clear fiber, and T_f of blond hair 1.5-2x too high in blue.
 
-use super::cone::{DensityPyramid, crossings};
+use super::cone::DensityPyramid;
 use super::fiber_density::FiberDensity;
+use super::voxels::crossings;
 use crate::scattering::dual_terms::dual_samples_across;
 use crate::scattering::{HairParams, ModelVariant};
 use glam::Vec3;

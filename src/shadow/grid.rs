@@ -6,8 +6,9 @@
 //! [`srbf_forward`] is the cone march, the sweeps' reference (docs/shadows.md).
 
 use super::cone::{DensityPyramid, srbf_cones};
-use super::fiber_density::{FiberDensity, VolumeGrid};
+use super::fiber_density::FiberDensity;
 use super::forward::{ForwardScattering, ForwardTable, forward_scattering};
+use super::voxels::VolumeGrid;
 use glam::Vec3;
 
 /// Floor of the stored transmittances (they are stored as logarithms).
@@ -140,21 +141,6 @@ pub struct GridValues {
 }
 
 impl GridValues {
-    /// The values for lights given as (centre direction, lambda).
-    pub fn build(grid: ShadowGrid, src: &GridSources, lights: &[(Vec3, f32)]) -> Self {
-        let volume = src.forward.map(|(v, _)| v).or(src.occluder);
-        let samples = super::sweep::MidplaneSamples::build(&grid, src.pyramid, volume);
-        Self {
-            grid,
-            lights: lights
-                .iter()
-                .map(|&(centre, lambda)| {
-                    super::sweep::sweep_light(&grid, src, &samples, centre, lambda)
-                })
-                .collect(),
-        }
-    }
-
     /// The grid's trilinear reading at p for light `light` (of the logarithms, for the
     /// transmittances): what the shading pass reads (`grid_shadow` in `shaders/shadow_grid.wgsl`).
     /// Points inside the occluder (depth_behind = [`GRID_INSIDE_SOLID`]) are left out and the

@@ -9,6 +9,7 @@ pub mod ray_shooting;
 pub mod sample_packing;
 pub mod solid;
 pub mod sweep;
+pub mod voxels;
 
 pub use cone::DensityPyramid;
 pub use fiber_density::FiberDensity;

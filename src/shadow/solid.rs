@@ -6,7 +6,7 @@
 //! `SOLID_DEPTH_PER_VOXEL * fraction / voxel` (isotropic: no orientation tensor) with the absorption
 //! `SOLID_SIGMA_A`, the forward table's last (a_f ~ 0: nothing is forward-scattered through skin).
 
-use super::fiber_density::VolumeGrid;
+use super::voxels::VolumeGrid;
 use crate::hair::TriangleMesh;
 
 /// Expected crossings per voxel of path through a wholly solid voxel (e^-8 = 3e-4 per voxel).

@@ -17,10 +17,13 @@
 //! width is the average over the directions of [`srbf_cones_on_ring`] with [`SWEEP_RING`] on the ring
 //! (the centre and three: the cone march, the reference, takes six), each a thin path.
 
-use super::cone::{DensityPyramid, crossings, srbf_cones_on_ring};
+use super::cone::{DensityPyramid, srbf_cones_on_ring};
 use super::fiber_density::FiberDensity;
 use super::forward::{ForwardTable, PathIntegrals, forward_integrand_of, forward_spread_weighted};
-use super::grid::{GRID_INSIDE_SOLID, GRID_MIN_TRANSMITTANCE, GridShadow, GridSources, ShadowGrid};
+use super::grid::{
+    GRID_INSIDE_SOLID, GRID_MIN_TRANSMITTANCE, GridShadow, GridSources, GridValues, ShadowGrid,
+};
+use super::voxels::crossings;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -517,4 +520,20 @@ pub fn sweep_light(
             g
         })
         .collect()
+}
+
+/// The CPU grid is built here, by the sweeps, so that the grid's types need nothing of them.
+impl GridValues {
+    /// The values for lights given as (centre direction, lambda).
+    pub fn build(grid: ShadowGrid, src: &GridSources, lights: &[(Vec3, f32)]) -> Self {
+        let volume = src.forward.map(|(v, _)| v).or(src.occluder);
+        let samples = MidplaneSamples::build(&grid, src.pyramid, volume);
+        Self {
+            grid,
+            lights: lights
+                .iter()
+                .map(|&(centre, lambda)| sweep_light(&grid, src, &samples, centre, lambda))
+                .collect(),
+        }
+    }
 }

@@ -6,9 +6,9 @@ use crate::colour::{srgb_decode, srgb_encode};
 use crate::editor::app::EditorApp;
 use crate::editor::panels::menu;
 use crate::hair::procedural::{Style, StyleParams};
-use crate::render::background::Background;
 use crate::render::display::{Solo, ViewTransform};
-use crate::render::targets::COMPONENTS;
+use crate::render::passes::background::Background;
+use crate::render::passes::targets::COMPONENTS;
 use crate::session::{Edit, EnvironmentSource, HairSource, RenderOptions};
 
 const STYLES: [(Style, &str); 6] = [

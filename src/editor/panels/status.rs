@@ -1,7 +1,7 @@
 //! The status bar: adapter, hair and light counts, refinement progress, UI frame time, jobs, messages.
 
 use crate::editor::app::{EditorApp, Level};
-use crate::render::progressive::UNIT_PASSES;
+use crate::render::refine::UNIT_PASSES;
 
 pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
@@ -121,7 +121,7 @@ struct Snapshot {
     points: usize,
     lights: u32,
     size: (u32, u32),
-    progress: Option<crate::render::progressive::Progress>,
+    progress: Option<crate::render::refine::Progress>,
     final_image: bool,
     first: Option<std::time::Duration>,
     sharp: Option<std::time::Duration>,

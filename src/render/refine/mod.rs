@@ -7,7 +7,7 @@
 //!
 //! The plan after a change: first, when the renderer has one ([`Renderer::set_preview`]), a preview of
 //! the change (reduced resolution, all lights, the shadow grid as it stands:
-//! [`super::preview`]); then the fiber-density volume (when geometry or absorption changed: its
+//! [`crate::render::refine::preview`]); then the fiber-density volume (when geometry or absorption changed: its
 //! deposit in ranges of segments, whose fixed-point sums add up exactly, then its resolve), the
 //! shadow grid in ranges of sweeps (`SWEEP_SLOTS` entries per light, one per direction; when the volume, the
 //! lights or the forward table changed), visibility in ranges of segments (the K-buffer's atomic
@@ -25,14 +25,17 @@
 //! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
 //! the shadow grid has built.
 
-use super::preview::preview_target;
-use super::renderer::{RenderError, Renderer};
-use super::segment_shading::last_light_batch;
-use super::shade::strand_partner;
-use super::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
-use super::shadow_grid::SWEEP_SLOTS;
-use super::targets::FrameTargets;
+pub mod preview;
+pub mod row_segments;
+
 use crate::gpu::GpuContext;
+use crate::render::passes::segment_shading::last_light_batch;
+use crate::render::passes::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
+use crate::render::passes::shadow_grid::SWEEP_SLOTS;
+use crate::render::passes::targets::FrameTargets;
+use crate::render::reference::shade::strand_partner;
+use crate::render::refine::preview::preview_target;
+use crate::render::renderer::{RenderError, Renderer};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -329,14 +332,14 @@ pub struct Refinement {
     last_done: Option<Instant>,
     idle_gaps: Vec<Duration>,
     /// Shadow-grid entries built for the current volume, lights and tables.
-    pub(super) grid_done: u32,
+    pub(in crate::render) grid_done: u32,
     /// The sweeps' samples built for the current pyramid (`MidplaneSamples`; a new light count or
     /// multiple-scattering toggle keeps them, `GpuShadowGrid::with_lights`).
-    pub(super) samples_done: u32,
+    pub(in crate::render) samples_done: u32,
     /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
     /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
     /// preview shades those lights unshadowed).
-    pub(super) grid_partial: Vec<bool>,
+    pub(in crate::render) grid_partial: Vec<bool>,
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
     budget: Duration,
@@ -355,7 +358,7 @@ pub struct Refinement {
     /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
     visibility_cost: Option<f64>,
     /// The same for the preview's visibility.
-    pub(super) preview_visibility_cost: Option<f64>,
+    pub(in crate::render) preview_visibility_cost: Option<f64>,
     /// The frame's shading bands per K-buffer slot (costs per light: the front slot shades every
     /// covered pixel, the others only where more fragments lie, cheaper), and
     /// the preview's (costs per row of all lights).
@@ -363,8 +366,8 @@ pub struct Refinement {
     preview_bands: Bands,
     /// The frame's visible segments per row, topmost row (None: not read back for this view yet);
     /// shading by segment, a band's cost is about its rows' count times `segment_cost` per light
-    /// ([`super::row_segments`]).
-    pub(super) row_segments: Option<Vec<u32>>,
+    /// ([`crate::render::refine::row_segments`]).
+    pub(in crate::render) row_segments: Option<Vec<u32>>,
     /// Measured seconds per listed segment and light of a shading unit, and per pixel of its rows.
     segment_cost: Option<f64>,
     pixel_cost: Option<f64>,
@@ -387,13 +390,13 @@ pub struct Refinement {
     /// When the plan was last restarted, and how many times (a finished unit planned before the
     /// latest restart still shows its image, but does not show the latest change).
     started: Instant,
-    pub(super) restarts: u64,
+    pub(in crate::render) restarts: u64,
     /// A change since the last image shown (preview or full): the plan starts with a preview.
-    pub(super) preview_owed: bool,
+    pub(in crate::render) preview_owed: bool,
     /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
-    pub(super) preview_auto_factor: Option<u32>,
+    pub(in crate::render) preview_auto_factor: Option<u32>,
     /// An adapted divisor that waits for the preview's next visibility pass (a camera move).
-    pub(super) preview_deferred_factor: Option<u32>,
+    pub(in crate::render) preview_deferred_factor: Option<u32>,
     /// Rows of the full image that the first pass has finished under every light since the restart.
     sharp_rows: u32,
     /// A preview unit was submitted since the restart, whether it drew a new view, and the time its
@@ -463,7 +466,7 @@ impl Default for Refinement {
 
 impl Refinement {
     /// A new plan's state for the context's device.
-    pub(super) fn for_device(ctx: &GpuContext) -> Self {
+    pub(in crate::render) fn for_device(ctx: &GpuContext) -> Self {
         Self {
             parallel_workgroups: parallel_workgroups(ctx),
             ..Self::default()
@@ -471,12 +474,12 @@ impl Refinement {
     }
 
     /// The longest time one unit should take.
-    pub(super) fn budget(&self) -> Duration {
+    pub(in crate::render) fn budget(&self) -> Duration {
         self.budget
     }
 
     /// `render_frame` did the whole frame.
-    pub(super) fn complete_frame(&mut self) {
+    pub(in crate::render) fn complete_frame(&mut self) {
         self.stage = Stage::Converged;
         self.preview_owed = false;
     }
@@ -544,12 +547,12 @@ impl Refinement {
     }
 
     /// The preview's targets were made anew: its rows' costs are unknown.
-    pub(super) fn preview_bands_reset(&mut self) {
+    pub(in crate::render) fn preview_bands_reset(&mut self) {
         self.preview_bands = Bands::default();
     }
 
     /// The image width changed by `ratio`.
-    pub(super) fn resized(&mut self, ratio: f64) {
+    pub(in crate::render) fn resized(&mut self, ratio: f64) {
         for b in &mut self.bands {
             b.resized(ratio);
         }
@@ -742,12 +745,12 @@ impl Refinement {
 
     /// A new grid buffer (zeros, not a light's values): every group counts as unbuilt until swept,
     /// so the preview shades them unshadowed.
-    pub(super) fn grid_unbuilt(&mut self, group_entries: u32, total: u32) {
+    pub(in crate::render) fn grid_unbuilt(&mut self, group_entries: u32, total: u32) {
         self.grid_partial = vec![true; total.div_ceil(group_entries.max(1)) as usize];
     }
 
     /// The whole grid was built in one go (`render_frame`, the benchmark's timing).
-    pub(super) fn grid_complete(&mut self, total: u32) {
+    pub(in crate::render) fn grid_complete(&mut self, total: u32) {
         self.grid_partial.clear();
         self.grid_done = total;
     }
@@ -819,7 +822,7 @@ impl Renderer {
 
     /// A change the image on screen does not show yet: the frame's plan starts again from the first
     /// stage the change made stale, with a preview first.
-    pub(super) fn restart_refinement(&mut self) {
+    pub(in crate::render) fn restart_refinement(&mut self) {
         self.refinement.preview_owed = true;
         self.single_kept = false;
         self.replan();
@@ -829,7 +832,7 @@ impl Renderer {
     /// dual-scattering terms (the grid's forward terms, the shading's dual terms): when the image is
     /// converged and shaded by segment, the segments keep their single scattering and the plan shades
     /// multiple scattering alone ([`Renderer::keeps_single_scattering`]).
-    pub(super) fn refine_multiple_only(&mut self, change: impl FnOnce(&mut Self)) {
+    pub(in crate::render) fn refine_multiple_only(&mut self, change: impl FnOnce(&mut Self)) {
         // Converged, or kept already (a plan shading multiple scattering alone, its single
         // scattering untouched); not in the middle of a repaint (its segments part-way).
         let keep = match self.refinement.stage {
@@ -947,7 +950,8 @@ impl Renderer {
             let first = self.segment_first[k as usize] as usize;
             for p in &self.point_data[first..first + 2] {
                 let at = glam::Vec3::new(p[0], p[1], p[2]);
-                let Some(q) = super::camera::project(&cam, at).filter(|_| self.tile.is_none())
+                let Some(q) =
+                    crate::render::camera::project(&cam, at).filter(|_| self.tile.is_none())
                 else {
                     return 0..height;
                 };
@@ -968,7 +972,7 @@ impl Renderer {
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
     /// no new preview is owed for it (new tables, a deferred volume rebuild).
-    pub(super) fn restart_as_refinement(&mut self, change: impl FnOnce(&mut Self)) {
+    pub(in crate::render) fn restart_as_refinement(&mut self, change: impl FnOnce(&mut Self)) {
         let owed = self.refinement.preview_owed;
         change(self);
         self.refinement.preview_owed = owed;
@@ -986,7 +990,7 @@ impl Renderer {
         }
     }
 
-    pub(super) fn replan(&mut self) {
+    pub(in crate::render) fn replan(&mut self) {
         let stage = if self.refinement.preview_owed && self.preview_factor() > 1 {
             Stage::PreviewVisibility { first: 0 }
         } else {
@@ -1193,7 +1197,7 @@ impl Renderer {
         ctx: &GpuContext,
     ) -> (
         crate::gpu::context::PendingRead,
-        super::camera::CameraUniform,
+        crate::render::camera::CameraUniform,
     ) {
         (
             ctx.start_read(&[&self.targets.view_depth]),
@@ -1202,7 +1206,7 @@ impl Renderer {
     }
 
     /// The camera uniform of the whole image as the frame is drawn now.
-    pub fn view_camera(&self) -> super::camera::CameraUniform {
+    pub fn view_camera(&self) -> crate::render::camera::CameraUniform {
         self.camera_view.uniform(
             self.settings.width,
             self.settings.height,

@@ -1,5 +1,5 @@
 //! A brute-force path-traced reference (CPU, rayon): the same visible points as the GPU frame, lit by
-//! the reference mode's lighting ([`super::reference::ReferenceLighting`]), with every order of
+//! the reference mode's lighting ([`crate::render::reference::ReferenceLighting`]), with every order of
 //! scattering traced through the explicit fibers ([`FiberGrid`]). It is the ground truth for the
 //! renderer's dual scattering and for the reference mode's ray shooting: nothing in it is fitted or
 //! approximated but the environment image's texels (constant radiance per texel).
@@ -38,10 +38,14 @@
 //! azimuth follows the offset h, uniform in (-1, 1), through phi = phi(p, h). Whatever form the model's
 //! own longitudinal function takes, this is only a density: the weight is the true kernel over it.
 
-use super::reference::{DirectionalLight, REFERENCE_VARIANT, ReferenceLighting, ReferenceScene};
-use super::shade::{LobeRadiance, ShadingHair, ShadingPoint, fold_visible_points};
 use crate::envmap::EnvMap;
 use crate::envmap::direction::{direction_from_uv, rotate_yaw, uv_from_direction};
+use crate::render::reference::shade::{
+    LobeRadiance, ShadingHair, ShadingPoint, fold_visible_points,
+};
+use crate::render::reference::{
+    DirectionalLight, REFERENCE_VARIANT, ReferenceLighting, ReferenceScene,
+};
 use crate::scattering::frame::{FiberAngles, FiberFrame, wrap_angle};
 use crate::scattering::marschner::{
     AzimuthalLobe, deon_variance, dphi_dh, ln_longitudinal_deon, phi_p, scattering_s,
@@ -332,7 +336,7 @@ impl Cdf {
 }
 
 /// The environment image as a light: texels drawn by luminance x solid angle (the CDF of
-/// [`super::reference::importance_sample_env`]), the direction uniform in the texel (in u, v), turned by
+/// [`crate::render::reference::importance_sample_env`]), the direction uniform in the texel (in u, v), turned by
 /// `yaw`; each sample carries L / pdf.
 struct EnvSampler<'a> {
     env: &'a EnvMap,
@@ -690,10 +694,10 @@ impl Tracer<'_> {
     }
 }
 
-/// The per-pixel loop of [`super::shade::shade_pixels`] (same rays, same points, same coverage
+/// The per-pixel loop of [`crate::render::reference::shade::shade_pixels`] (same rays, same points, same coverage
 /// weights), with a seeded random stream per pixel and point, over the given pixels in parallel.
 fn trace_pixels(
-    frame: &super::Frame,
+    frame: &crate::render::Frame,
     scene: &ReferenceScene,
     settings: &PathTraceSettings,
     pixels: &[usize],
@@ -733,10 +737,10 @@ fn trace_pixels(
 /// components replace the frame's and the exposure is applied. Order 0 goes into R, TT, TRT, higher
 /// orders into MS.global.
 pub fn path_trace_frame(
-    frame: &super::Frame,
+    frame: &crate::render::Frame,
     scene: &ReferenceScene,
     settings: &PathTraceSettings,
-) -> super::Frame {
+) -> crate::render::Frame {
     path_trace_frame_with_stats(frame, scene, settings).0
 }
 
@@ -761,10 +765,10 @@ pub struct PathTraceStats {
 
 /// As [`path_trace_frame`], plus [`PathTraceStats`].
 pub fn path_trace_frame_with_stats(
-    frame: &super::Frame,
+    frame: &crate::render::Frame,
     scene: &ReferenceScene,
     settings: &PathTraceSettings,
-) -> (super::Frame, PathTraceStats) {
+) -> (crate::render::Frame, PathTraceStats) {
     let pixels: Vec<usize> = frame.covered().collect();
     let estimates = trace_pixels(frame, scene, settings, &pixels);
     let coverage: f64 = pixels.iter().map(|&i| frame.beauty[i][3] as f64).sum();

@@ -3,24 +3,8 @@
 //! which encodes the passes in order (fiber density and pyramid when geometry or absorption changed,
 //! the per-light shadow grid when they or the lights changed, visibility, shading batches, resolve).
 
-use super::background::BackgroundMap;
-use super::camera::{Camera, Tile};
-use super::frame::Frame;
-use super::kbuffer::{DEFAULT_FRAGMENTS, KBufferTargets, MAX_FRAGMENTS, Tail};
-use super::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
-use super::preview::{Preview, PreviewMode};
-use super::progressive::Refinement;
-use super::resolve::{ResolveInfo, ResolvePass};
-use super::segment_shading::SegmentTargets;
-use super::shading::{
-    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs,
-    ShadingPass,
-};
-use super::shadow_grid::{GpuShadowGrid, ShadowGridInputs, ShadowGridPass};
-use super::table_cache::with_cache;
-use super::targets::{COMPONENTS, FrameTargets, MAX_SEGMENTS};
-use super::timing::PassTimer;
-use super::visibility::VisibilityPass;
+pub mod table_cache;
+
 use crate::envmap::SrbfLight;
 use crate::gpu::GpuContext;
 use crate::gpu::context::binding_limit;
@@ -30,16 +14,34 @@ use crate::gpu::fast_eval::GpuLuts;
 use crate::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
 use crate::gpu::forward::{forward_table_texels, upload_forward_table};
 use crate::hair::Hair;
+use crate::render::camera::{Camera, Tile};
+use crate::render::frame::Frame;
+use crate::render::passes::background::BackgroundMap;
+use crate::render::passes::kbuffer::{DEFAULT_FRAGMENTS, KBufferTargets, MAX_FRAGMENTS, Tail};
+use crate::render::passes::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
+use crate::render::passes::resolve::{ResolveInfo, ResolvePass};
+use crate::render::passes::segment_shading::SegmentTargets;
+use crate::render::passes::shading::{
+    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, GpuLight, ShadeBatch, ShadingInputs,
+    ShadingPass,
+};
+use crate::render::passes::shadow_grid::{GpuShadowGrid, ShadowGridInputs, ShadowGridPass};
+use crate::render::passes::targets::{COMPONENTS, FrameTargets, MAX_SEGMENTS};
+use crate::render::passes::visibility::VisibilityPass;
 use crate::render::reference::REFERENCE_VARIANT;
+use crate::render::refine::Refinement;
+use crate::render::refine::preview::{Preview, PreviewMode};
+use crate::render::renderer::table_cache::with_cache;
+use crate::render::timing::PassTimer;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_terms::DualTables;
 use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
 use crate::scattering::lut::Luts;
 use crate::scattering::params::{HairParams, LongitudinalModel};
-use crate::shadow::fiber_density::{MAX_DIM, VolumeGrid};
 use crate::shadow::forward::ForwardTable;
 use crate::shadow::grid::ShadowGrid;
 use crate::shadow::solid::solid_fraction;
+use crate::shadow::voxels::{MAX_DIM, VolumeGrid};
 use glam::Vec3;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -147,7 +149,7 @@ pub fn same_tables(a: &HairParams, b: &HairParams) -> bool {
 
 /// Builds the [`ParamTables`] of `params`, keeping `reuse` when its eta and eccentricity are the same
 /// (and it is no draft);
-/// the process keeps the tables of the last few parameter sets ([`super::table_cache`]), so a set
+/// the process keeps the tables of the last few parameter sets ([`crate::render::renderer::table_cache`]), so a set
 /// built before is taken from there.
 pub fn build_tables(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>) -> ParamTables {
     // The caller's table where it serves, kept or built: callers tell a new azimuthal table by
@@ -215,7 +217,7 @@ impl TableBuild {
     /// keeps the tables of `params` (an undo): then, and without `draft`, the tables. `reuse` as
     /// for [`build_tables`].
     pub fn build(params: &HairParams, reuse: Option<&Arc<AzimuthalTable>>, draft: bool) -> Self {
-        if draft && !super::table_cache::holds(params) {
+        if draft && !crate::render::renderer::table_cache::holds(params) {
             Self::Azimuthal(build_draft_table(params))
         } else {
             Self::Tables(build_tables(params, reuse))
@@ -348,109 +350,110 @@ impl RenderSettings {
 
 pub struct Renderer {
     pub settings: RenderSettings,
-    pub(super) hair: GpuHair,
-    pub(super) point_count: usize,
-    pub(super) skip: f32,
-    pub(super) volume: GpuFiberDensity,
-    pub(super) pyramid: GpuDensityPyramid,
-    pub(super) shadow_grid: GpuShadowGrid,
-    pub(super) luts: GpuLuts,
-    pub(super) look: HairLook,
+    pub(in crate::render) hair: GpuHair,
+    pub(in crate::render) point_count: usize,
+    pub(in crate::render) skip: f32,
+    pub(in crate::render) volume: GpuFiberDensity,
+    pub(in crate::render) pyramid: GpuDensityPyramid,
+    pub(in crate::render) shadow_grid: GpuShadowGrid,
+    pub(in crate::render) luts: GpuLuts,
+    pub(in crate::render) look: HairLook,
     /// The exact parameters the forward and dual tables were built for.
-    pub(super) tables_for: HairParams,
-    pub(super) params: wgpu::Buffer,
-    pub(super) forward_table: wgpu::Buffer,
-    pub(super) dual_tables: wgpu::Buffer,
+    pub(in crate::render) tables_for: HairParams,
+    pub(in crate::render) params: wgpu::Buffer,
+    pub(in crate::render) forward_table: wgpu::Buffer,
+    pub(in crate::render) dual_tables: wgpu::Buffer,
     /// The azimuthal table the buffer holds (sized for the largest, an elliptical fiber's).
-    pub(super) azimuthal: Arc<AzimuthalTable>,
-    pub(super) azimuthal_table: wgpu::Buffer,
-    pub(super) camera: wgpu::Buffer,
+    pub(in crate::render) azimuthal: Arc<AzimuthalTable>,
+    pub(in crate::render) azimuthal_table: wgpu::Buffer,
+    pub(in crate::render) camera: wgpu::Buffer,
     /// The camera the uniform was made from (rewritten when the image size changes).
-    pub(super) camera_view: Camera,
+    pub(in crate::render) camera_view: Camera,
     /// The tile of a larger still the camera renders (None: the whole image).
-    pub(super) tile: Option<Tile>,
-    pub(super) lights: wgpu::Buffer,
-    pub(super) light_count: u32,
-    pub(super) resolve_info: wgpu::Buffer,
+    pub(in crate::render) tile: Option<Tile>,
+    pub(in crate::render) lights: wgpu::Buffer,
+    pub(in crate::render) light_count: u32,
+    pub(in crate::render) resolve_info: wgpu::Buffer,
     /// What `resolve_info` holds.
-    pub(super) resolve_params: ResolveInfo,
+    pub(in crate::render) resolve_params: ResolveInfo,
     /// The background's map texels (one zero texel without one).
-    pub(super) background_map: wgpu::Buffer,
+    pub(in crate::render) background_map: wgpu::Buffer,
     /// The occluder (the head) drawn, shaded and held in the volume as a solid.
-    pub(super) occluder: Option<SceneOccluder>,
-    pub(super) targets: FrameTargets,
-    pub(super) density_pass: FiberDensityPass,
-    pub(super) pyramid_pass: DensityPyramidPass,
-    pub(super) shadow_grid_pass: ShadowGridPass,
-    pub(super) visibility_pass: VisibilityPass,
-    pub(super) shading_pass: ShadingPass,
+    pub(in crate::render) occluder: Option<SceneOccluder>,
+    pub(in crate::render) targets: FrameTargets,
+    pub(in crate::render) density_pass: FiberDensityPass,
+    pub(in crate::render) pyramid_pass: DensityPyramidPass,
+    pub(in crate::render) shadow_grid_pass: ShadowGridPass,
+    pub(in crate::render) visibility_pass: VisibilityPass,
+    pub(in crate::render) shading_pass: ShadingPass,
     /// The frame's per-segment radiance (None: the frame shades per fragment).
-    pub(super) segment_targets: Option<SegmentTargets>,
+    pub(in crate::render) segment_targets: Option<SegmentTargets>,
     /// The hair's longest segment and its bounds (whether segments are short enough, as the eye sees
     /// them, to be shaded once each: [`MAX_SEGMENT_ANGLE`]).
-    pub(super) segment_extent: (f32, Vec3, Vec3),
+    pub(in crate::render) segment_extent: (f32, Vec3, Vec3),
     /// The frame's batches shade segments (else fragments).
-    pub(super) by_segment: bool,
-    pub(super) resolve_pass: ResolvePass,
+    pub(in crate::render) by_segment: bool,
+    pub(in crate::render) resolve_pass: ResolvePass,
     /// The fragments per pixel asked for (`settings.fragments` is fewer when the K-buffer would not
     /// fit one binding at this size).
-    pub(super) requested_fragments: u32,
-    pub(super) volume_dirty: bool,
+    pub(in crate::render) requested_fragments: u32,
+    pub(in crate::render) volume_dirty: bool,
     /// The rows [0, converged_rows) whose every fragment is shaded (the others, part-way through
     /// progressive refinement, resolve normalised); u32::MAX after `render_frame`.
-    pub(super) converged_rows: u32,
+    pub(in crate::render) converged_rows: u32,
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
     /// one ([`Renderer::set_absorption_deferred`]).
-    pub(super) volume_stale: bool,
+    pub(in crate::render) volume_stale: bool,
     /// The stale volume's density changed too (a deferred thickness change): its rebuild changes the
     /// grid's transmittance, which single scattering reads.
-    pub(super) volume_stale_density: bool,
+    pub(in crate::render) volume_stale_density: bool,
     /// The volume holds an old absorption that nothing reads now (multiple scattering off): rebuilt
     /// when multiple scattering is turned on.
-    pub(super) volume_absorption_old: bool,
-    pub(super) shadow_grid_dirty: bool,
+    pub(in crate::render) volume_absorption_old: bool,
+    pub(in crate::render) shadow_grid_dirty: bool,
     /// The refinement's plan re-shades multiple scattering alone: the segments' single scattering
     /// from the last converged pass still holds (a change that reaches only the forward and
     /// dual-scattering terms: new tables, a deferred absorption's volume).
-    pub(super) single_kept: bool,
+    pub(in crate::render) single_kept: bool,
     /// Each segment's first point, in segment order (the brush's repaint finds the segments at the
     /// points a dab changed: [`Renderer::repaint_points`]).
-    pub(super) segment_first: Vec<u32>,
+    pub(in crate::render) segment_first: Vec<u32>,
     /// The segments a planned repaint shades again (sorted), and the image rows they cover.
-    pub(super) repaint: Vec<u32>,
-    pub(super) repaint_rows: std::ops::Range<u32>,
+    pub(in crate::render) repaint: Vec<u32>,
+    pub(in crate::render) repaint_rows: std::ops::Range<u32>,
     /// Segments of dabs that came while a repaint was under way: repainted after it.
-    pub(super) repaint_pending: Vec<u32>,
+    pub(in crate::render) repaint_pending: Vec<u32>,
     /// Whether each pair of segments 2k, 2k + 1 shares its multiple-scattering sample (index k:
-    /// [`super::shade::ms_paired`] at the absorption on the GPU), kept to notice a dab that changes it.
-    pub(super) ms_pairs: Vec<bool>,
+    /// [`crate::render::reference::shade::ms_paired`] at the absorption on the GPU), kept to notice a dab that changes it.
+    pub(in crate::render) ms_pairs: Vec<bool>,
     /// The pairs (their even segments) whose sharing dabs changed since the last repaint started:
     /// their partners' multiple scattering moved ([`Renderer::repaint_points`]).
-    pub(super) flips_pending: Vec<u32>,
+    pub(in crate::render) flips_pending: Vec<u32>,
     /// The pairs whose sharing changed for the repaint under way (sorted even segments).
-    pub(super) repaint_flips: Vec<u32>,
-    /// Every [`super::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
+    pub(in crate::render) repaint_flips: Vec<u32>,
+    /// Every [`crate::render::refine::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
     /// preview draws (None for a hair of few strands).
-    pub(super) preview_strands: Option<super::kbuffer::SegmentSubset>,
+    pub(in crate::render) preview_strands: Option<crate::render::passes::kbuffer::SegmentSubset>,
     /// The visible segments per row, read back after the frame's visibility (band sizes).
-    pub(super) row_readback: Option<super::row_segments::RowSegmentsReadback>,
+    pub(in crate::render) row_readback:
+        Option<crate::render::refine::row_segments::RowSegmentsReadback>,
     /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
-    pub(super) point_data: Vec<[f32; 4]>,
-    pub(super) timer: Option<PassTimer>,
-    pub(super) last_ran: Vec<&'static str>,
+    pub(in crate::render) point_data: Vec<[f32; 4]>,
+    pub(in crate::render) timer: Option<PassTimer>,
+    pub(in crate::render) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
-    pub(super) refinement: Refinement,
+    pub(in crate::render) refinement: Refinement,
     /// Whether and how refinement previews a change, and the preview's targets.
-    pub(super) preview_mode: PreviewMode,
-    pub(super) preview: Option<Preview>,
+    pub(in crate::render) preview_mode: PreviewMode,
+    pub(in crate::render) preview: Option<Preview>,
     /// The frame's visibility pass has drawn the current camera and fibres (refinement reuses it
     /// after a parameter change).
-    pub(super) visibility_valid: bool,
+    pub(in crate::render) visibility_valid: bool,
 }
 
 /// The occluder as the renderer holds it.
-pub(super) struct SceneOccluder {
-    pub(super) gpu: GpuOccluder,
+pub(in crate::render) struct SceneOccluder {
+    pub(in crate::render) gpu: GpuOccluder,
     /// Its fraction of each voxel of the volume.
     solid: Vec<f32>,
     shadow_offset: f32,
@@ -468,10 +471,10 @@ fn environment_buffer(device: &wgpu::Device, map: Option<&BackgroundMap>) -> wgp
     })
 }
 
-/// [`super::shade::ms_paired`] of every pair of segments 2k, 2k + 1 (index k).
+/// [`crate::render::reference::shade::ms_paired`] of every pair of segments 2k, 2k + 1 (index k).
 fn all_ms_pairs(segment_first: &[u32], sigma_a: &[[f32; 3]]) -> Vec<bool> {
     (0..segment_first.len().div_ceil(2))
-        .map(|k| super::shade::ms_paired(segment_first, sigma_a, 2 * k as u32))
+        .map(|k| crate::render::reference::shade::ms_paired(segment_first, sigma_a, 2 * k as u32))
         .collect()
 }
 
@@ -592,13 +595,13 @@ impl Renderer {
         check(
             "the shadow sweeps' working memory",
             grid.largest_slice() as u64
-                * super::shadow_grid::SCRATCH_BYTES
+                * crate::render::passes::shadow_grid::SCRATCH_BYTES
                 * lights.len().max(1) as u64,
         )?;
         check(
             "the shadow sweeps' samples",
             crate::shadow::sweep::MidplaneSamples::layout(&grid).1 as u64
-                * super::shadow_grid::SAMPLE_BYTES,
+                * crate::render::passes::shadow_grid::SAMPLE_BYTES,
         )?;
         let gpu_hair = GpuHair::new(device, hair, sigma_a);
         let grid = settings.volume_grid(hair);
@@ -642,7 +645,7 @@ impl Renderer {
             })
         };
         let gpu_hair_segments = gpu_hair.segment_count;
-        let segment_first = super::shade::segment_starts(hair);
+        let segment_first = crate::render::reference::shade::segment_starts(hair);
         let ms_pairs = all_ms_pairs(&segment_first, sigma_a);
         let mut renderer = Self {
             hair: gpu_hair,
@@ -716,13 +719,18 @@ impl Renderer {
             flips_pending: Vec::new(),
             repaint_flips: Vec::new(),
             row_readback: None,
-            preview_strands: (hair.strand_count() >= super::preview::THIN_PREVIEW_STRANDS)
+            preview_strands: (hair.strand_count()
+                >= crate::render::refine::preview::THIN_PREVIEW_STRANDS)
                 .then(|| {
                     let segments: Vec<u32> = (0..hair.strand_count())
                         .map(|s| hair.strand_range(s).len().saturating_sub(1) as u32)
                         .collect();
-                    let stride = super::preview::PREVIEW_STRAND_STRIDE;
-                    super::kbuffer::SegmentSubset::new(&ctx.device, &segments, stride)
+                    let stride = crate::render::refine::preview::PREVIEW_STRAND_STRIDE;
+                    crate::render::passes::kbuffer::SegmentSubset::new(
+                        &ctx.device,
+                        &segments,
+                        stride,
+                    )
                 })
                 .flatten(),
             point_data: GpuHair::point_data(hair, 1.0),
@@ -1085,7 +1093,8 @@ impl Renderer {
             .collect();
         for k in segments {
             let even = k & !1;
-            let paired = super::shade::ms_paired(&self.segment_first, sigma_a, even);
+            let paired =
+                crate::render::reference::shade::ms_paired(&self.segment_first, sigma_a, even);
             let Some(was) = self.ms_pairs.get_mut(k as usize / 2) else {
                 continue;
             };
@@ -1098,7 +1107,7 @@ impl Renderer {
 
     /// The segments that join point `i`: the one from it and the one to it (from i - 1, in the
     /// same strand).
-    pub(super) fn segments_at_point(&self, i: u32) -> impl Iterator<Item = u32> + '_ {
+    pub(in crate::render) fn segments_at_point(&self, i: u32) -> impl Iterator<Item = u32> + '_ {
         [Some(i), i.checked_sub(1)]
             .into_iter()
             .flatten()
@@ -1229,8 +1238,8 @@ impl Renderer {
         let group = self
             .settings
             .lights_per_pass
-            .clamp(1, super::shading::MAX_LIGHTS_PER_PASS)
-            * super::shadow_grid::SWEEP_SLOTS;
+            .clamp(1, crate::render::passes::shading::MAX_LIGHTS_PER_PASS)
+            * crate::render::passes::shadow_grid::SWEEP_SLOTS;
         self.refinement
             .grid_unbuilt(group, self.shadow_grid.entry_count());
     }
@@ -1511,7 +1520,7 @@ impl Renderer {
     }
 
     /// What the shadow-grid build reads.
-    pub(super) fn shadow_grid_inputs(&self) -> ShadowGridInputs<'_> {
+    pub(in crate::render) fn shadow_grid_inputs(&self) -> ShadowGridInputs<'_> {
         ShadowGridInputs {
             pyramid: &self.pyramid,
             volume: &self.volume,
@@ -1520,12 +1529,12 @@ impl Renderer {
             light_group: self
                 .settings
                 .lights_per_pass
-                .clamp(1, super::shading::MAX_LIGHTS_PER_PASS),
+                .clamp(1, crate::render::passes::shading::MAX_LIGHTS_PER_PASS),
         }
     }
 
     /// What the shading pass reads.
-    pub(super) fn shading_inputs(&self) -> ShadingInputs<'_> {
+    pub(in crate::render) fn shading_inputs(&self) -> ShadingInputs<'_> {
         ShadingInputs {
             camera: &self.camera,
             params: &self.params,
@@ -1731,7 +1740,7 @@ impl Renderer {
     }
 
     /// Reads every output of `t` (the frame's targets or the preview's) back, waiting for the GPU.
-    pub(super) fn read_targets(
+    pub(in crate::render) fn read_targets(
         &self,
         ctx: &GpuContext,
         t: &FrameTargets,

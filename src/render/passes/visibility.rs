@@ -1,12 +1,12 @@
 //! The visibility pass: the occluder (the head) into the multisampled id and depth targets
 //! (`shaders/visibility.wgsl`), then the hair's fragments into the K-buffer, which reads that depth
-//! ([`super::kbuffer`]), and after the last segment the K-buffer's composite.
+//! ([`crate::render::passes::kbuffer`]), and after the last segment the K-buffer's composite.
 
-use super::kbuffer::{KBufferPass, SegmentSubset};
-use super::occluder::GpuOccluder;
-use super::targets::{DEPTH_FORMAT, FrameTargets, VISIBILITY_FORMAT};
 use crate::gpu::fiber_density::GpuHair;
 use crate::gpu::shaders;
+use crate::render::passes::kbuffer::{KBufferPass, SegmentSubset};
+use crate::render::passes::occluder::GpuOccluder;
+use crate::render::passes::targets::{DEPTH_FORMAT, FrameTargets, VISIBILITY_FORMAT};
 
 pub struct VisibilityPass {
     occluder: wgpu::RenderPipeline,

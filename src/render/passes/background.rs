@@ -6,9 +6,9 @@
 //! the composite (beauty + (1 - alpha) background) happens where a picture is made: the editor's
 //! display pass, the PNG, and the EXR only when a background is asked for.
 
-use super::scene::Environment;
 use crate::envmap::EnvMap;
 use crate::envmap::direction::{rotate_yaw, uv_from_direction};
+use crate::render::scene::Environment;
 use glam::{DVec3, Vec3};
 use std::fmt;
 use std::str::FromStr;
@@ -222,7 +222,7 @@ mod tests {
         let bg = BackgroundMap::from_map(&map, 0.0);
         assert_eq!((bg.width, bg.height), (2048, 1024));
         assert!((bg.radiance(Vec3::Y)[0] - 2.0).abs() < 1e-5);
-        let mut env = super::super::scene::default_environment();
+        let mut env = crate::render::scene::default_environment();
         env.image = None;
         let bg = BackgroundMap::from_environment(&env);
         assert_eq!(bg.width as usize, RECONSTRUCTION_WIDTH);

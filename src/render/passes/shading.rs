@@ -1,24 +1,28 @@
 //! The shading passes (`shaders/shading.wgsl`): per batch of at most [`MAX_LIGHTS_PER_PASS`] SRBF
 //! lights (Xu 2011's multi-pass scheme), its lights' R, TT and TRT radiance (and with multiple
-//! scattering MS.global and MS.local): per visible segment ([`super::segment_shading`], the default,
+//! scattering MS.global and MS.local): per visible segment ([`crate::render::passes::segment_shading`], the default,
 //! gathered into the component buffers after the last batch), or per fragment, one dispatch per
 //! K-buffer slot within a batch, added to the component buffers.
 
-use super::occluder::{GpuOccluder, OccluderPass, shades_occluder};
-use super::row_segments::{RowSegmentsInputs, RowSegmentsPass, RowSegmentsReadback};
-use super::segment_shading::{SegmentShadingPass, SegmentTargets, last_light_batch};
-use super::targets::FrameTargets;
 use crate::gpu::context::{bind_entries, compute_pipeline};
 use crate::gpu::shaders;
+use crate::render::passes::occluder::{GpuOccluder, OccluderPass, shades_occluder};
+use crate::render::passes::segment_shading::{
+    SegmentShadingPass, SegmentTargets, last_light_batch,
+};
+use crate::render::passes::targets::FrameTargets;
+use crate::render::refine::row_segments::{
+    RowSegmentsInputs, RowSegmentsPass, RowSegmentsReadback,
+};
 use bytemuck::{Pod, Zeroable};
 
 pub const MAX_LIGHTS_PER_PASS: u32 = 16;
 pub const FLAG_SHADOWS: u32 = 1;
 pub const FLAG_MULTIPLE_SCATTERING: u32 = 2;
-/// The batches shade segments ([`super::segment_shading`]), not fragments.
+/// The batches shade segments ([`crate::render::passes::segment_shading`]), not fragments.
 pub const FLAG_SEGMENTS: u32 = 4;
 /// A batch by segment shades multiple scattering alone: the segments' single scattering is kept from
-/// the last converged pass ([`super::Renderer::keeps_single_scattering`]).
+/// the last converged pass ([`crate::render::Renderer::keeps_single_scattering`]).
 pub const FLAG_SINGLE_KEPT: u32 = 8;
 
 /// One SRBF light as the shaders read it.
@@ -142,7 +146,7 @@ impl ShadingPass {
     }
 
     /// The visible segments per row of `targets`' K-buffer (the frame's or the preview's, seen by
-    /// `camera`) into `readback`, copied for reading ([`super::row_segments`]). Leaves the
+    /// `camera`) into `readback`, copied for reading ([`crate::render::refine::row_segments`]). Leaves the
     /// segments' claims cleared.
     pub fn encode_row_segments(
         &self,

@@ -5,9 +5,9 @@
 //! rows shades, and a band's cost is about its count times the cost of a segment under a light. The
 //! counts are read back asynchronously after the visibility pass (a few kilobytes, never waited for).
 
-use super::frame::Frame;
-use super::segment_shading::SegmentTargets;
 use crate::gpu::context::{bind_entries as bind, compute_pipeline};
+use crate::render::frame::Frame;
+use crate::render::passes::segment_shading::SegmentTargets;
 use std::sync::{Arc, Mutex};
 
 /// The counts from a frame's K-buffer (the CPU twin of the two kernels).
@@ -199,7 +199,7 @@ impl RowSegmentsReadback {
     }
 }
 
-impl super::Renderer {
+impl crate::render::Renderer {
     /// The frame's visible segments per row (topmost row) as refinement holds them: None until they
     /// are read back after the view's visibility pass (shading by segment only).
     pub fn row_segments(&self) -> Option<&[u32]> {
@@ -213,7 +213,7 @@ impl super::Renderer {
 
     /// After the frame's whole visibility pass (in the same encoder): counts its segments per row
     /// when refinement has no counts for this view and the frame shades by segment.
-    pub(super) fn encode_row_segments(
+    pub(in crate::render) fn encode_row_segments(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -224,7 +224,7 @@ impl super::Renderer {
     }
 
     /// [`Self::encode_row_segments`] with the read-back apart (`render_frame` holds its timer).
-    pub(super) fn encode_row_segments_into(
+    pub(in crate::render) fn encode_row_segments_into(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -248,7 +248,7 @@ impl super::Renderer {
     }
 
     /// After the preview's whole visibility pass: the same for the preview's K-buffer.
-    pub(super) fn encode_preview_row_segments(
+    pub(in crate::render) fn encode_preview_row_segments(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -266,7 +266,7 @@ impl super::Renderer {
     }
 
     /// After a submission: asks for the counts' mapping if they were copied in it.
-    pub(super) fn request_row_segments(&mut self) {
+    pub(in crate::render) fn request_row_segments(&mut self) {
         let preview = self.preview.as_mut().and_then(|p| p.row_readback.as_mut());
         for r in self.row_readback.iter_mut().chain(preview) {
             r.request();
@@ -274,7 +274,7 @@ impl super::Renderer {
     }
 
     /// After a device poll: hands counts that have landed to refinement (and the preview).
-    pub(super) fn receive_row_segments(&mut self) {
+    pub(in crate::render) fn receive_row_segments(&mut self) {
         let height = self.targets.height as usize;
         if let Some(counts) = self.row_readback.as_mut().and_then(|r| r.take())
             && counts.len() == height
@@ -290,7 +290,7 @@ impl super::Renderer {
     }
 
     /// The view changed: the counts (and read-backs under way) no longer describe it.
-    pub(super) fn forget_row_segments(&mut self) {
+    pub(in crate::render) fn forget_row_segments(&mut self) {
         self.refinement.row_segments = None;
         if let Some(r) = &mut self.row_readback {
             r.cancel();

@@ -7,15 +7,15 @@
 //! preview's shading takes about [`preview_target`] of the unit budget. A coarse preview of dense
 //! hair draws a quarter of the strands (`Renderer::preview_subset`).
 
-use super::camera::CameraUniform;
-use super::frame::Frame;
-use super::kbuffer::{SegmentSubset, Tail};
-use super::renderer::{RenderError, Renderer};
-use super::shading::{
+use crate::gpu::GpuContext;
+use crate::render::camera::CameraUniform;
+use crate::render::frame::Frame;
+use crate::render::passes::kbuffer::{SegmentSubset, Tail};
+use crate::render::passes::shading::{
     FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
 };
-use super::targets::FrameTargets;
-use crate::gpu::GpuContext;
+use crate::render::passes::targets::FrameTargets;
+use crate::render::renderer::{RenderError, Renderer};
 use std::time::Duration;
 
 /// The preview's K-buffer: four fragments, each shaded, the rest spread over them (one fragment
@@ -60,15 +60,15 @@ pub const THIN_PREVIEW_STRANDS: usize = 4000;
 pub const MAX_PREVIEW_FACTOR: u32 = 16;
 
 /// The preview's targets and camera.
-pub(super) struct Preview {
+pub(in crate::render) struct Preview {
     pub factor: u32,
     pub targets: FrameTargets,
     pub camera: wgpu::Buffer,
     /// The visibility pass has drawn the current camera (a parameter change reuses it).
     pub visible: bool,
-    /// Its K-buffer's visible segments per row ([`super::row_segments`]) and their read-back.
+    /// Its K-buffer's visible segments per row ([`crate::render::refine::row_segments`]) and their read-back.
     pub row_segments: Option<Vec<u32>>,
-    pub row_readback: Option<super::row_segments::RowSegmentsReadback>,
+    pub row_readback: Option<crate::render::refine::row_segments::RowSegmentsReadback>,
 }
 
 impl Preview {
@@ -90,7 +90,7 @@ impl Renderer {
 
     /// The image size changed: the preview's targets go (made again at the new size), and the
     /// automatic divisor scales with the image's side so the preview keeps its cost.
-    pub(super) fn resized_preview(&mut self, width: u32, height: u32) {
+    pub(in crate::render) fn resized_preview(&mut self, width: u32, height: u32) {
         self.preview = None;
         // Adapted at the old size.
         self.refinement.preview_deferred_factor = None;
@@ -123,7 +123,7 @@ impl Renderer {
 
     /// Makes the preview's targets for the current size and divisor; its height, or None when there
     /// is no preview.
-    pub(super) fn prepare_preview(&mut self, device: &wgpu::Device) -> Option<u32> {
+    pub(in crate::render) fn prepare_preview(&mut self, device: &wgpu::Device) -> Option<u32> {
         let factor = self.preview_factor();
         if factor < 2 {
             return None;
@@ -177,14 +177,14 @@ impl Renderer {
     /// [`PREVIEW_STRAND_STRIDE`] at [`THIN_PREVIEW_FACTOR`] or coarser, of a hair with at least
     /// [`THIN_PREVIEW_STRANDS`] strands. A preview pixel then spans 8 x 8 or more of the frame's and
     /// its visibility pass (nearly all of a new view's preview time) draws a quarter of the segments.
-    pub(super) fn preview_subset(&self, factor: u32) -> Option<&SegmentSubset> {
+    pub(in crate::render) fn preview_subset(&self, factor: u32) -> Option<&SegmentSubset> {
         self.preview_strands
             .as_ref()
             .filter(|_| factor >= THIN_PREVIEW_FACTOR)
     }
 
     /// The segments the preview's visibility pass draws.
-    pub(super) fn preview_draw_count(&self) -> u32 {
+    pub(in crate::render) fn preview_draw_count(&self) -> u32 {
         self.preview_draws_at(self.preview.as_ref().map_or(1, |p| p.factor))
     }
 
@@ -195,12 +195,12 @@ impl Renderer {
     }
 
     /// Whether the preview's visibility shows the current camera.
-    pub(super) fn preview_visible(&self) -> bool {
+    pub(in crate::render) fn preview_visible(&self) -> bool {
         self.preview.as_ref().is_some_and(|p| p.visible)
     }
 
     /// The camera, the image size or the fibres' width changed: both visibility passes must run again.
-    pub(super) fn invalidate_visibility(&mut self) {
+    pub(in crate::render) fn invalidate_visibility(&mut self) {
         self.visibility_valid = false;
         self.forget_row_segments();
         // The preview draws its visibility anyway: a divisor that waited for it applies.
@@ -213,7 +213,7 @@ impl Renderer {
     }
 
     /// Encodes the preview's visibility pass with the current camera.
-    pub(super) fn encode_preview_visibility(
+    pub(in crate::render) fn encode_preview_visibility(
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
@@ -253,7 +253,7 @@ impl Renderer {
     /// eye), in the frame's segment buffers, whose markers the first unit clears (the frame's
     /// visibility unit clears them again before the frame shades); else per fragment, one dispatch
     /// per K-buffer slot.
-    pub(super) fn encode_preview(
+    pub(in crate::render) fn encode_preview(
         &self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
@@ -326,7 +326,7 @@ impl Renderer {
 
     /// A preview of this change took `preview_time` (its units): the automatic divisor moves
     /// towards [`preview_target`] (time goes with the pixels, the square of the divisor).
-    pub(super) fn adapt_preview(&mut self, preview_time: Duration) {
+    pub(in crate::render) fn adapt_preview(&mut self, preview_time: Duration) {
         if self.preview_mode != PreviewMode::Auto {
             return;
         }

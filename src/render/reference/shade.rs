@@ -2,12 +2,12 @@
 //! response, same swept transmittance) used to test the GPU end to end, and the pixel loop the
 //! reference mode shares with it.
 
-use super::camera::{CameraUniform, closest_on_segment, pixel_ray};
-use super::frame::Frame;
-use super::kbuffer::{Fragment, PixelFragments};
 use crate::envmap::SrbfLight;
 use crate::envmap::srbf::srbf_integral;
 use crate::hair::Hair;
+use crate::render::camera::{CameraUniform, closest_on_segment, pixel_ray};
+use crate::render::frame::Frame;
+use crate::render::passes::kbuffer::{Fragment, PixelFragments};
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
     dual_scattering_components, global_response_lobe_in_view, local_response,
@@ -324,7 +324,7 @@ pub fn shade_segment_single(
 
 /// Whether a resolved sample id names a hair segment (segment + 1; not 0, not the occluder's).
 pub fn is_hair(id: u32) -> bool {
-    id != 0 && id & super::occluder::OCCLUDER_ID_BIT == 0
+    id != 0 && id & crate::render::passes::occluder::OCCLUDER_ID_BIT == 0
 }
 
 /// Which of a pixel's K-buffer fragments are shaded, as (segment + 1, weight).

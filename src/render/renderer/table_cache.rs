@@ -10,7 +10,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::renderer::{ParamTables, same_tables};
+use crate::render::renderer::{ParamTables, same_tables};
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::params::HairParams;
 
@@ -67,7 +67,7 @@ impl TableCache {
     }
 }
 
-/// The process's cache ([`super::renderer::build_tables`] reads and fills it).
+/// The process's cache ([`crate::render::renderer::build_tables`] reads and fills it).
 static CACHE: Mutex<TableCache> = Mutex::new(TableCache::new(CACHED_PARAMETER_SETS));
 
 /// Runs `f` on the process's cache, locked (`f` must not build tables: the lock is not re-entrant).

@@ -3,16 +3,16 @@
 //! segments of the rows' kept K-buffer fragments are listed once, each is shaded (each light's
 //! single-scattering response once at its midpoint, weighted by the light's transmittance at its
 //! ends and midpoint; multiple scattering once per pair of consecutive segments of a strand, at the
-//! point they share: [`super::shade::ShadingHair::ms_key`]), and once every batch has shaded them the
+//! point they share: [`crate::render::reference::shade::ShadingHair::ms_key`]), and once every batch has shaded them the
 //! rows' pixels gather their fragments' radiance, single scattering interpolated along each segment.
-//! The per-fragment pass ([`super::shading`]) shades the frame and preview without
+//! The per-fragment pass ([`crate::render::passes::shading`]) shades the frame and preview without
 //! `RenderSettings::segment_shading`, a view in which a segment subtends more than
-//! [`super::renderer::MAX_SEGMENT_ANGLE`], and a hair whose segments' radiance would not fit one
+//! [`crate::render::renderer::MAX_SEGMENT_ANGLE`], and a hair whose segments' radiance would not fit one
 //! binding.
 
-use super::shading::{ShadeBatch, ShadingInputs};
-use super::targets::FrameTargets;
 use crate::gpu::context::{bind_entries as bind, compute_pipeline};
+use crate::render::passes::shading::{ShadeBatch, ShadingInputs};
+use crate::render::passes::targets::FrameTargets;
 
 /// Samples of single scattering along a segment: its ends and its midpoint (t = 0, 1/2, 1).
 pub const SINGLE_SAMPLES: u64 = 3;
@@ -26,7 +26,7 @@ pub struct SegmentTargets {
     /// Per segment: 1 + the first light of the last batch that shaded it (0: none).
     pub batches: wgpu::Buffer,
     /// [0]: segments listed by the unit's claim, [1]: multiple scattering's keys (`ms_key` of
-    /// `shaders/shading.wgsl`, [`super::shade::ShadingHair::ms_key`]), [2]: a repaint's candidates.
+    /// `shaders/shading.wgsl`, [`crate::render::reference::shade::ShadingHair::ms_key`]), [2]: a repaint's candidates.
     pub work_count: wgpu::Buffer,
     pub work_list: wgpu::Buffer,
     /// Per multiple-scattering key: 1 + the first light of the last batch that claimed it (0: none;
@@ -44,7 +44,7 @@ pub struct SegmentTargets {
     /// `shade_segments`' indirect dispatch.
     pub work_args: wgpu::Buffer,
     /// R, TT, TRT at each segment's t = 0, 1/2, 1 (index 3 segment + 2 t), MS.global and MS.local
-    /// at each key's sample (index key: [`super::shade::ShadingHair::ms_point`]). Written by a
+    /// at each key's sample (index key: [`crate::render::reference::shade::ShadingHair::ms_point`]). Written by a
     /// frame's first light batch, added to by the others.
     pub radiance: [wgpu::Buffer; 5],
 }
@@ -78,7 +78,7 @@ impl SegmentTargets {
             radiance: std::array::from_fn(|c| {
                 let samples = if c < 3 { SINGLE_SAMPLES } else { 1 };
                 buffer(
-                    super::targets::COMPONENTS[c],
+                    crate::render::passes::targets::COMPONENTS[c],
                     n * RADIANCE_BYTES_PER_SEGMENT / SINGLE_SAMPLES * samples,
                     none,
                 )

@@ -1,9 +1,9 @@
 //! The resolve pass (`shaders/resolve.wgsl`): coverage, depth, sample ids, the exposed beauty and the
 //! background behind every pixel.
 
-use super::targets::FrameTargets;
 use crate::gpu::context::{buffer_init, compute_pipeline};
 use crate::gpu::shaders;
+use crate::render::passes::targets::FrameTargets;
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
@@ -12,7 +12,7 @@ pub struct ResolveInfo {
     /// 2^EV.
     pub exposure_scale: f32,
     pub samples: u32,
-    /// The background map's size (0 x 0: none) and its yaw, radians ([`super::background::BackgroundMap`]).
+    /// The background map's size (0 x 0: none) and its yaw, radians ([`crate::render::passes::background::BackgroundMap`]).
     pub env_width: u32,
     pub env_height: u32,
     pub env_yaw: f32,
@@ -22,7 +22,7 @@ pub struct ResolveInfo {
 const _: () = assert!(std::mem::size_of::<ResolveInfo>() == 32);
 
 impl ResolveInfo {
-    /// No background map yet ([`super::renderer::Renderer::set_background`] gives one).
+    /// No background map yet ([`crate::render::renderer::Renderer::set_background`] gives one).
     pub fn new(exposure: f32, samples: u32) -> Self {
         Self {
             exposure_scale: exposure.exp2(),

@@ -6,14 +6,14 @@
 //! holds it as an opaque solid ([`crate::shadow::solid`]), so it shadows the hair. [`shade_occluder`]
 //! is the CPU twin.
 
-use super::camera::CameraUniform;
-use super::shade::GridShadows;
-use super::shading::{ShadeBatch, ShadingInputs};
-use super::targets::FrameTargets;
 use crate::envmap::SrbfLight;
 use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
 use crate::hair::TriangleMesh;
+use crate::render::camera::CameraUniform;
+use crate::render::passes::shading::{ShadeBatch, ShadingInputs};
+use crate::render::passes::targets::FrameTargets;
+use crate::render::reference::shade::GridShadows;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -166,7 +166,7 @@ pub fn shade_occluder_frame(
                 (i % frame.width as usize) as f32,
                 (i / frame.width as usize) as f32,
             );
-            let (origin, dir) = super::camera::pixel_ray(camera, x + 0.5, y + 0.5);
+            let (origin, dir) = crate::render::camera::pixel_ray(camera, x + 0.5, y + 0.5);
             let mut out = [0f32; 3];
             for (k, &id) in ids.iter().enumerate() {
                 let Some(tri) = occluder_triangle(id) else {

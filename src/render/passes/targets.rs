@@ -2,7 +2,7 @@
 //! depth textures, the hair's K-buffer, the per-component accumulation buffers and the resolved
 //! outputs.
 
-use super::kbuffer::{KBufferTargets, Tail};
+use crate::render::passes::kbuffer::{KBufferTargets, Tail};
 
 /// Component buffers, in order: R, TT, TRT, MS.global, MS.local (linear radiance, coverage-weighted).
 pub const COMPONENTS: [&str; 5] = ["R", "TT", "TRT", "MS.global", "MS.local"];

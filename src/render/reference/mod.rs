@@ -15,8 +15,14 @@
 //!   What this reference does not share with the renderer is what the renderer approximates: the
 //!   fiber-density volume, the SRBF cone filtering and the shadow grid's interpolation.
 
-use super::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
+pub mod abuffer;
+pub mod lights;
+pub mod path_trace;
+pub mod ribbon;
+pub mod shade;
+
 use crate::envmap::EnvMap;
+use crate::render::reference::shade::{LobeRadiance, ShadingPoint, fiber_angles, fiber_frame};
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_response::{
     dual_scattering_components, global_response_lobe_in_view, local_response_behind,
@@ -34,7 +40,9 @@ use crate::shadow::forward::{ForwardScattering, ForwardTable};
 use crate::shadow::ray_shooting::{crossings_behind, shoot_forward};
 use glam::Vec3;
 
-pub use super::reference_lights::{DirectionalLight, importance_sample_env, sample_srbf_lights};
+pub use crate::render::reference::lights::{
+    DirectionalLight, importance_sample_env, sample_srbf_lights,
+};
 
 /// The variant the fast model approximates (and the reference evaluates).
 pub const REFERENCE_VARIANT: ModelVariant = ModelVariant {
@@ -219,33 +227,36 @@ impl ReferenceLighting<'_> {
 pub struct ReferenceScene<'a> {
     pub hair: &'a crate::hair::Hair,
     pub sigma_a: &'a [[f32; 3]],
-    pub look: &'a super::HairLook,
+    pub look: &'a crate::render::HairLook,
     pub lighting: ReferenceLighting<'a>,
-    pub settings: &'a super::RenderSettings,
-    pub camera: &'a super::Camera,
+    pub settings: &'a crate::render::RenderSettings,
+    pub camera: &'a crate::render::Camera,
 }
 
 /// The reference shading of the points the GPU frame sees (same coverage, depth and ids); its
 /// components replace the frame's and the exposure is applied. With `settings.multiple_scattering`
 /// it is dual scattering by ray shooting through the fibers (shadows by the same rays); without, single
 /// scattering with the volume's exp(-tau) (or no) shadows.
-pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::Frame {
+pub fn reference_frame(
+    frame: &crate::render::Frame,
+    scene: &ReferenceScene,
+) -> crate::render::Frame {
     let lights = scene.lighting.lights();
     let settings = scene.settings;
     let variant = REFERENCE_VARIANT.with_longitudinal(scene.look.longitudinal());
     let params = &scene.look.params;
-    let hair = super::shade::ShadingHair::new(scene.hair, scene.sigma_a);
+    let hair = crate::render::reference::shade::ShadingHair::new(scene.hair, scene.sigma_a);
     let cam = scene
         .camera
         .uniform(frame.width, frame.height, settings.min_width_px);
     let pixels: Vec<usize> = frame.covered().collect();
     let shade = |shadows: &ReferenceShadows| {
-        super::shade::shade_pixels(
+        crate::render::reference::shade::shade_pixels(
             frame,
             &cam,
             &hair,
             &pixels,
-            super::shade::EVERY_FRAGMENT,
+            crate::render::reference::shade::EVERY_FRAGMENT,
             |sp, wo| reference_shade(params, variant, sp, wo, &lights, shadows),
         )
     };
@@ -255,7 +266,7 @@ pub fn reference_frame(frame: &super::Frame, scene: &ReferenceScene) -> super::F
             .then(|| FiberGrid::build(scene.hair, scene.sigma_a));
         // The tables the renderer reads (each point reads them at its own absorption): the same
         // build, taken from the process's cache when the renderer made them.
-        let tables = super::renderer::build_tables(params, None);
+        let tables = crate::render::renderer::build_tables(params, None);
         let azimuthal = if tables.azimuthal.matches(&scene.look.fast) {
             tables.azimuthal.clone()
         } else {
