@@ -25,10 +25,12 @@
 //! bit. A change (parameters, camera, lights, absorption) restarts the plan; a camera move keeps what
 //! the shadow grid has built.
 
+pub mod costs;
 pub mod preview;
 pub mod row_segments;
 
 use crate::gpu::GpuContext;
+use costs::*;
 use crate::render::passes::segment_shading::last_light_batch;
 use crate::render::passes::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use crate::render::passes::shadow_grid::SWEEP_SLOTS;
@@ -42,53 +44,6 @@ use std::time::{Duration, Instant};
 /// The default longest submission (units should stay under 50 ms, what a UI sharing the queue waits
 /// behind at most; the budget leaves room for the estimate's error).
 pub const DEFAULT_UNIT_BUDGET: Duration = Duration::from_millis(30);
-
-/// First guesses, before a unit of the kind has been measured: conservative (lavapipe on two cores
-/// sweeps a light of a 48-point grid in about 60 ms, 8 entries, and shades about 15 ms per row of a
-/// 16-light batch at 720 pixels).
-const GUESS_GRID_ENTRY_S: f64 = 10e-3;
-/// A sample of the shadow grid's sweeps (`MidplaneSamples`; lavapipe, two cores: 350-500 ns; a guess
-/// of 50 ns would put S1's 343k samples in one 110-140 ms unit).
-const GUESS_GRID_SAMPLE_S: f64 = 500e-9;
-const GUESS_SHADE_ROW_S: f64 = 40e-3;
-/// A voxel resolved (lavapipe, two cores: 100-580 ns depending on the machine; a guess of 400 ns can
-/// make S1's first resolve unit of 87.5k voxels take 51 ms at 35 ms units).
-const GUESS_VOXEL_S: f64 = 600e-9;
-/// The fewest voxels a resolve unit and rows a backdrop unit hold (a unit's fixed cost, which a tiny
-/// budget cannot hold, would otherwise shrink them to one of each).
-const MIN_RESOLVE_VOXELS: u32 = 16_384;
-const MIN_BACKDROP_ROWS: u32 = 8;
-/// A deposited segment (lavapipe: ~0.4 us each past the sums' clear).
-const GUESS_SEGMENT_S: f64 = 1e-6;
-/// A segment drawn into the K-buffer (lavapipe, two cores: with a guess of 1 us, S0's preview drew
-/// 30000 segments in one 406 ms unit, the shader's compilation included).
-const GUESS_VISIBILITY_SEGMENT_S: f64 = 8e-6;
-/// A visible segment under one light, shaded by segment (lavapipe, two cores: 2.7 us on S1).
-const GUESS_SEGMENT_LIGHT_S: f64 = 10e-6;
-/// A pixel of a shading unit's rows (the claim, gather and resolve; lavapipe, two cores: ~0.7 us
-/// on S1).
-const GUESS_PIXEL_S: f64 = 0.5e-6;
-/// A pixel of a repaint's gather and resolve, and what the last light batch's gather adds to a
-/// pixel of its band (lavapipe, two cores: 0.65-0.95 us on S1, and 0.3-0.9 us).
-const GUESS_GATHER_PIXEL_S: f64 = 1e-6;
-/// A shading unit listing fewer segments does not update the cost per segment.
-const MIN_MEASURED_SEGMENTS: u64 = 64;
-/// The row width and the lights of that guess.
-const GUESS_ROW_PIXELS: f64 = 720.0;
-const GUESS_ROW_LIGHTS: f64 = 16.0;
-/// K-buffer slots with their own shading bands (the slots behind the fourth share the last).
-const MAX_SLOTS: usize = 4;
-
-/// A cost estimate after a measurement: the mean of the last estimate and the measurement (so one slow
-/// unit does not halve the next ones), or the measurement when there was none.
-fn ema(old: Option<f64>, new: f64) -> Option<f64> {
-    Some(old.map_or(new, |o| 0.5 * (o + new)))
-}
-
-/// The bands of K-buffer slot `slot`.
-fn slot_bands(slot: u32) -> usize {
-    (slot as usize).min(MAX_SLOTS - 1)
-}
 
 /// One bounded piece of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -240,74 +195,6 @@ pub struct RefineStats {
 /// The passes the units belong to, in [`RefineStats::pass_time`] order.
 pub const UNIT_PASSES: [&str; 5] = ["preview", "volume", "shadow grid", "visibility", "shading"];
 
-/// Row bands of one image (the frame's or the preview's), sized from measured costs.
-#[derive(Default)]
-struct Bands {
-    /// Mean seconds per row of one unit's work (None: not measured yet).
-    cost: Option<f64>,
-    /// Measured seconds per row, per image row (0: not measured yet). A row costs about the same in
-    /// every batch (the same pixels under as many lights), so a band is sized from its own rows'
-    /// costs, not from the mean of the (often empty) rows above it.
-    row_cost: Vec<f64>,
-    /// Rows of the last band.
-    last: u32,
-}
-
-impl Bands {
-    /// Rows of a band from `row` (of `height`): as many as `budget` holds by the rows' own measured
-    /// costs (else the `prior` ones: an upper bound, the front slot's for the others; else the mean
-    /// row's, or `guess`, and then at most twice the last band); at least one; whole workgroups (8
-    /// rows) where the budget allows.
-    fn rows(&self, row: u32, height: u32, budget: f64, guess: f64, prior: &[f64]) -> u32 {
-        let fallback = self.cost.unwrap_or(guess).max(1e-12);
-        let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
-        for r in row..height {
-            let own = self.row_cost.get(r as usize).copied().unwrap_or(0.0);
-            let c = if own > 0.0 {
-                own
-            } else {
-                prior.get(r as usize).copied().unwrap_or(0.0)
-            };
-            unknown |= c <= 0.0;
-            let c = if c > 0.0 { c } else { fallback };
-            if n > 0 && t + c > budget {
-                break;
-            }
-            t += c;
-            n += 1;
-        }
-        if unknown {
-            n = n.min(2 * self.last.max(1));
-        }
-        let mut n = n.max(1);
-        if n >= 8 && n < height - row {
-            n -= n % 8;
-        }
-        n
-    }
-
-    /// A band of `rows` rows from `row0` took `elapsed` seconds.
-    fn measured(&mut self, row0: u32, rows: u32, elapsed: f64) {
-        let per = elapsed / rows.max(1) as f64;
-        self.cost = ema(self.cost, per);
-        let end = (row0 + rows) as usize;
-        if self.row_cost.len() < end {
-            self.row_cost.resize(end, 0.0);
-        }
-        self.row_cost[row0 as usize..end].fill(per);
-    }
-
-    /// The image width changed by `ratio`: a row costs about that much more (or less), and the next
-    /// band starts small.
-    fn resized(&mut self, ratio: f64) {
-        if let Some(c) = &mut self.cost {
-            *c *= ratio.max(1e-6);
-        }
-        self.row_cost.clear();
-        self.last = 1;
-    }
-}
-
 impl Stage {
     /// The image is converged (the plan may still draw the preview's visibility for the next
     /// change).
@@ -316,150 +203,102 @@ impl Stage {
     }
 }
 
-/// A light batch as a band's sizing sees it: its lights, and whether it gathers the band's segments
-/// into pixels (and resolves them).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct BandShape {
-    lights: u32,
-    gathers: bool,
-}
-
-/// Where progressive refinement stands (owned by the [`Renderer`]).
+/// Where progressive refinement stands (owned by the [`Renderer`]): the stage of the plan, the unit
+/// in flight, what the units cost ([`CostModel`]), the shadow grid's progress and the preview's.
 pub struct Refinement {
     stage: Stage,
     /// When the last unit finished, until the next is submitted; and the gaps between a unit's
     /// completion and the next submission (what a driver of the refinement leaves idle).
     last_done: Option<Instant>,
     idle_gaps: Vec<Duration>,
-    /// Shadow-grid entries built for the current volume, lights and tables.
-    pub(in crate::render) grid_done: u32,
-    /// The sweeps' samples built for the current pyramid (`MidplaneSamples`; a new light count or
-    /// multiple-scattering toggle keeps them, `GpuShadowGrid::with_lights`).
-    pub(in crate::render) samples_done: u32,
-    /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
-    /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
-    /// preview shades those lights unshadowed).
-    pub(in crate::render) grid_partial: Vec<bool>,
     /// Estimated seconds of the shading units submitted since the restart (for the progress).
     shade_done: f64,
-    budget: Duration,
-    /// The part of the budget units are sized to, but the preview's shading ([`Renderer::set_budget_share`]).
-    budget_share: f64,
-    /// Seconds per shadow-grid entry, per sample of its sweeps and per deposited segment (None: not
-    /// measured yet).
-    grid_cost: Option<f64>,
-    samples_cost: Option<f64>,
-    volume_cost: Option<f64>,
-    /// Seconds per voxel resolved, and per row of the image's resolve before shading.
-    resolve_cost: Option<f64>,
-    backdrop_cost: Option<f64>,
-    /// Rows of the last backdrop unit.
-    backdrop_last: u32,
-    /// Seconds per segment drawn by the visibility pass (the frame's and the preview's).
-    visibility_cost: Option<f64>,
-    /// The same for the preview's visibility.
-    pub(in crate::render) preview_visibility_cost: Option<f64>,
-    /// The frame's shading bands per K-buffer slot (costs per light: the front slot shades every
-    /// covered pixel, the others only where more fragments lie, cheaper), and
-    /// the preview's (costs per row of all lights).
-    bands: [Bands; MAX_SLOTS],
-    preview_bands: Bands,
-    /// The frame's visible segments per row, topmost row (None: not read back for this view yet);
-    /// shading by segment, a band's cost is about its rows' count times `segment_cost` per light
-    /// ([`crate::render::refine::row_segments`]).
-    pub(in crate::render) row_segments: Option<Vec<u32>>,
-    /// Measured seconds per listed segment and light of a shading unit, and per pixel of its rows.
-    segment_cost: Option<f64>,
-    pixel_cost: Option<f64>,
-    /// Measured seconds per pixel of a repaint's gather (and resolve).
-    gather_cost: Option<f64>,
-    /// Measured seconds per pixel that a shading unit which gathers (by segment, the last light
-    /// batch's and the preview's) costs over the others (S1's top band, no segments: 25 ms under a
-    /// light batch, 63 ms under the last).
-    batch_gather_cost: Option<f64>,
-    /// Measured seconds per segment and light of a repaint's units.
-    repaint_cost: Option<f64>,
-    /// Items of the last grid unit.
-    grid_last: u32,
-    /// Workgroups the device runs side by side when that is a handful (a software rasteriser's
-    /// threads: lavapipe gives each thread whole workgroups), else 1. A grid unit of fewer entries
-    /// (one workgroup each) than a multiple of it leaves threads idle.
-    parallel_workgroups: u32,
     in_flight: Option<InFlight>,
     stats: RefineStats,
     /// When the plan was last restarted, and how many times (a finished unit planned before the
     /// latest restart still shows its image, but does not show the latest change).
     started: Instant,
     pub(in crate::render) restarts: u64,
-    /// A change since the last image shown (preview or full): the plan starts with a preview.
-    pub(in crate::render) preview_owed: bool,
-    /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
-    pub(in crate::render) preview_auto_factor: Option<u32>,
-    /// An adapted divisor that waits for the preview's next visibility pass (a camera move).
-    pub(in crate::render) preview_deferred_factor: Option<u32>,
     /// Rows of the full image that the first pass has finished under every light since the restart.
     sharp_rows: u32,
-    /// A preview unit was submitted since the restart, whether it drew a new view, and the time its
-    /// shading units took.
-    preview_started: bool,
-    preview_new_view: bool,
-    preview_shading: Duration,
+    pub(in crate::render) costs: CostModel,
+    pub(in crate::render) grid: GridProgress,
+    pub(in crate::render) preview_state: PreviewState,
 }
 
-/// [`Refinement::parallel_workgroups`] of the context's device: a software adapter's threads
-/// (lavapipe runs `LP_NUM_THREADS`, by default one per core, at most 32), 1 on hardware.
-fn parallel_workgroups(ctx: &GpuContext) -> u32 {
-    if ctx.adapter.get_info().device_type != wgpu::DeviceType::Cpu {
-        return 1;
+/// How far the shadow grid is built for the current volume, lights and tables.
+#[derive(Default)]
+pub(in crate::render) struct GridProgress {
+    /// Shadow-grid entries built.
+    pub(in crate::render) done: u32,
+    /// The sweeps' samples built for the current pyramid (`MidplaneSamples`; a new light count or
+    /// multiple-scattering toggle keeps them, `GpuShadowGrid::with_lights`).
+    pub(in crate::render) samples_done: u32,
+    /// Light groups whose grid entries are part-way through a rebuild (a light's sweeps add into its
+    /// entries, finished by the last: such an entry is neither the old value nor the new one, and the
+    /// preview shades those lights unshadowed).
+    pub(in crate::render) partial: Vec<bool>,
+}
+
+impl GridProgress {
+    /// A new grid buffer (zeros, not a light's values): every group counts as unbuilt until swept,
+    /// so the preview shades them unshadowed.
+    pub(in crate::render) fn unbuilt(&mut self, group_entries: u32, total: u32) {
+        self.partial = vec![true; total.div_ceil(group_entries.max(1)) as usize];
     }
-    std::env::var("LP_NUM_THREADS")
-        .ok()
-        .and_then(|v| v.trim().parse::<u32>().ok())
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32))
-        .clamp(1, 32)
+
+    /// The whole grid was built in one go (`render_frame`, the benchmark's timing).
+    pub(in crate::render) fn complete(&mut self, total: u32) {
+        self.partial.clear();
+        self.done = total;
+    }
+
+    /// Records a grid unit over entries [first, first + count) of `total`, in groups of
+    /// `group_entries` (the last may be shorter): a group it leaves part-way is partial, one it
+    /// completes is not.
+    fn built(&mut self, first: u32, count: u32, group_entries: u32, total: u32) {
+        let g = group_entries.max(1);
+        let groups = total.div_ceil(g);
+        self.partial.resize(groups as usize, false);
+        let end = first + count;
+        for group in first / g..end.div_ceil(g).min(groups) {
+            let group_end = ((group + 1) * g).min(total);
+            self.partial[group as usize] = end < group_end;
+        }
+    }
+}
+
+/// What the plan owes and has done of the preview of the latest change.
+#[derive(Default)]
+pub(in crate::render) struct PreviewState {
+    /// A change since the last image shown (preview or full): the plan starts with a preview.
+    pub(in crate::render) owed: bool,
+    /// The preview's resolution divisor when chosen automatically (adapted to its measured time).
+    pub(in crate::render) auto_factor: Option<u32>,
+    /// An adapted divisor that waits for the preview's next visibility pass (a camera move).
+    pub(in crate::render) deferred_factor: Option<u32>,
+    /// A preview unit was submitted since the restart, whether it drew a new view, and the time its
+    /// shading units took.
+    started: bool,
+    new_view: bool,
+    shading: Duration,
 }
 
 impl Default for Refinement {
     fn default() -> Self {
         Self {
             stage: Stage::Visibility { first: 0 },
-            grid_done: 0,
-            samples_done: 0,
-            grid_partial: Vec::new(),
-            shade_done: 0.0,
-            budget: DEFAULT_UNIT_BUDGET,
-            budget_share: 1.0,
-            grid_cost: None,
-            gather_cost: None,
-            batch_gather_cost: None,
-            repaint_cost: None,
-            parallel_workgroups: 1,
-            samples_cost: None,
-            volume_cost: None,
-            resolve_cost: None,
-            backdrop_cost: None,
-            backdrop_last: MIN_BACKDROP_ROWS,
-            visibility_cost: None,
-            preview_visibility_cost: None,
-            bands: Default::default(),
-            preview_bands: Bands::default(),
-            row_segments: None,
-            segment_cost: None,
-            pixel_cost: None,
-            grid_last: 1,
-            in_flight: None,
             last_done: None,
             idle_gaps: Vec::new(),
+            shade_done: 0.0,
+            in_flight: None,
             stats: RefineStats::default(),
             started: Instant::now(),
             restarts: 0,
-            preview_owed: false,
-            preview_auto_factor: None,
-            preview_deferred_factor: None,
             sharp_rows: 0,
-            preview_started: false,
-            preview_new_view: false,
-            preview_shading: Duration::ZERO,
+            costs: CostModel::default(),
+            grid: GridProgress::default(),
+            preview_state: PreviewState::default(),
         }
     }
 }
@@ -468,116 +307,24 @@ impl Refinement {
     /// A new plan's state for the context's device.
     pub(in crate::render) fn for_device(ctx: &GpuContext) -> Self {
         Self {
-            parallel_workgroups: parallel_workgroups(ctx),
+            costs: CostModel::for_device(ctx),
             ..Self::default()
         }
-    }
-
-    /// The longest time one unit should take.
-    pub(in crate::render) fn budget(&self) -> Duration {
-        self.budget
     }
 
     /// `render_frame` did the whole frame.
     pub(in crate::render) fn complete_frame(&mut self) {
         self.stage = Stage::Converged;
-        self.preview_owed = false;
+        self.preview_state.owed = false;
     }
 
-    /// Seconds a unit after the preview is sized to: the budget's share.
-    fn unit_seconds(&self) -> f64 {
-        self.budget.as_secs_f64() * self.budget_share
-    }
-
-    /// Items a unit may hold: the budget over the measured (or guessed) cost per item, at most twice
-    /// the previous unit of the kind (`last`: costs are uneven, empty rows and empty sweep slots cost
-    /// almost nothing, so one cheap unit must not size a huge next one); at least one, at most what
-    /// remains.
-    fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
-        let per_item = per_item.unwrap_or(guess).max(1e-12);
-        let n = (self.unit_seconds() / per_item)
-            .floor()
-            .min(2.0 * last.max(1) as f64);
-        (n.min(remaining as f64) as u32)
-            .max(1)
-            .min(remaining.max(1))
-    }
-
-    /// Seconds per row and light of a shading batch at K-buffer slot `slot` (measured or guessed).
-    fn light_row_cost(&self, slot: u32) -> f64 {
-        self.bands[slot_bands(slot)]
-            .cost
-            .unwrap_or(GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS)
-    }
-
-    /// A finished preview (at divisor `factor`, `lights` lights) gives the first-sample bands the
-    /// cost of the rows not measured yet (the first bands of a new view are sized from the picture,
-    /// not from the mean of the empty rows above it). Per fragment a preview row costs what `factor`
-    /// frame rows of its width under every light do, so a frame row costs about its preview row's
-    /// cost times `factor` over the lights. `by_segment` a preview row shades the segments of its
-    /// `factor` frame rows that its four fragments a pixel keep: at most 11k of 59k on S1 at divisor
-    /// 11, so a frame row costs about its preview row's over the lights (S1 on lavapipe: about 13 ms a
-    /// preview row and 14 ms a frame row, every light).
-    fn seed_from_preview(&mut self, factor: u32, lights: u32, height: u32, by_segment: bool) {
-        // A new view (the preview drew its visibility): the rows measured before show another picture.
-        let new_view = self.preview_new_view;
-        let f = factor.max(1);
-        let scale = if by_segment { 1.0 } else { f as f64 };
-        let seeded: Vec<f64> = (0..height)
-            .map(|y| {
-                let measured = self.bands[0]
-                    .row_cost
-                    .get(y as usize)
-                    .copied()
-                    .unwrap_or(0.0);
-                let preview = self
-                    .preview_bands
-                    .row_cost
-                    .get((y / f) as usize)
-                    .copied()
-                    .unwrap_or(0.0);
-                if measured > 0.0 && !(new_view && preview > 0.0) {
-                    measured
-                } else {
-                    preview * scale / lights.max(1) as f64
-                }
-            })
-            .collect();
-        self.bands[0].row_cost = seeded;
-    }
-
-    /// The preview's targets were made anew: its rows' costs are unknown.
-    pub(in crate::render) fn preview_bands_reset(&mut self) {
-        self.preview_bands = Bands::default();
-    }
-
-    /// The image width changed by `ratio`.
-    pub(in crate::render) fn resized(&mut self, ratio: f64) {
-        for b in &mut self.bands {
-            b.resized(ratio);
-        }
-        self.preview_bands = Bands::default();
-        // A segment's fragments go with the image's width.
-        for c in [
-            &mut self.visibility_cost,
-            &mut self.preview_visibility_cost,
-            &mut self.backdrop_cost,
-        ] {
-            *c = c.map(|c| c * ratio.max(1e-6));
-        }
-    }
-
-    /// Folds a finished unit's time into the cost per item (mean of the last estimate and the
-    /// measurement, so one slow unit does not halve the next ones); `batch`: a shading unit's
-    /// K-buffer slot and light count.
-    /// `listed`: the segments a shading unit (the frame's or the preview's) listed, when counted,
-    /// and its pixels.
+    /// Folds a finished unit's time into the statistics and the cost model ([`CostModel::measured`]).
     fn measured(
         &mut self,
         unit: WorkUnit,
         elapsed: Duration,
         batch: Option<(u32, u32)>,
-        (listed, gathers): (Option<(u64, u64)>, bool),
+        listed: (Option<(u64, u64)>, bool),
     ) {
         if elapsed > self.stats.longest {
             self.stats.longest = elapsed;
@@ -593,180 +340,10 @@ impl Refinement {
             WorkUnit::Shade { .. } | WorkUnit::Repaint { .. } | WorkUnit::RepaintGather { .. } => 4,
         };
         self.stats.pass_time[pass] += elapsed;
-        let seconds = elapsed.as_secs_f64();
-        match unit {
-            WorkUnit::ShadowGrid { count, .. } => {
-                let per = seconds / count.max(1) as f64;
-                self.grid_cost = ema(self.grid_cost, per);
-            }
-            WorkUnit::GridSamples { count, .. } => {
-                let per = seconds / count.max(1) as f64;
-                self.samples_cost = ema(self.samples_cost, per);
-            }
-            WorkUnit::Shade { row0, rows, .. } => {
-                let (slot, lights) = batch.unwrap_or((0, 1));
-                let per_light = seconds / lights.max(1) as f64;
-                self.bands[slot_bands(slot)].measured(row0, rows, per_light);
-                self.segments_measured(seconds, lights, listed, gathers);
-            }
-            WorkUnit::Preview { row0, rows } => {
-                self.preview_shading += elapsed;
-                self.preview_bands.measured(row0, rows, seconds);
-                let lights = batch.map_or(1, |b| b.1);
-                self.segments_measured(seconds, lights, listed, gathers);
-            }
-            WorkUnit::Volume { count, .. } => {
-                let per = seconds / count.max(1) as f64;
-                self.volume_cost = ema(self.volume_cost, per);
-            }
-            // The clear, composite and resolve of the last part ride along: an overstatement. The
-            // frame's and the preview's apart: a segment leaves fragments in proportion to the
-            // image's resolution.
-            WorkUnit::Visibility { count, .. } if count > 0 => {
-                let per = seconds / count as f64;
-                self.visibility_cost = ema(self.visibility_cost, per);
-            }
-            WorkUnit::PreviewVisibility { count, .. } if count > 0 => {
-                let per = seconds / count as f64;
-                self.preview_visibility_cost = ema(self.preview_visibility_cost, per);
-            }
-            WorkUnit::Backdrop { rows, .. } => {
-                let per = seconds / rows.max(1) as f64;
-                self.backdrop_cost = ema(self.backdrop_cost, per);
-            }
-            WorkUnit::VolumeResolve { count, .. } => {
-                let per = seconds / count.max(1) as f64;
-                self.resolve_cost = ema(self.resolve_cost, per);
-            }
-            WorkUnit::Repaint { segments, .. } => {
-                let lights = batch.map_or(1, |b| b.1);
-                self.segments_measured(seconds, lights, listed, false);
-                if segments as u64 >= MIN_MEASURED_SEGMENTS {
-                    let per = seconds / (lights.max(1) * segments) as f64;
-                    self.repaint_cost = ema(self.repaint_cost, per);
-                }
-            }
-            // The gather and resolve of its rows: the cost per pixel.
-            WorkUnit::RepaintGather { .. } => {
-                if let Some((_, pixels)) = listed.filter(|l| l.1 > 0) {
-                    self.gather_cost = ema(self.gather_cost, seconds / pixels as f64);
-                }
-            }
-            WorkUnit::DensityPyramid
-            | WorkUnit::Visibility { .. }
-            | WorkUnit::PreviewVisibility { .. } => {}
+        if let WorkUnit::Preview { .. } = unit {
+            self.preview_state.shading += elapsed;
         }
-    }
-
-    /// A shading unit under `lights` lights took `seconds` over `listed` = (segments, pixels): a
-    /// unit of a few segments measures the cost per pixel (the claim; with `gathers`, what the
-    /// gather and resolve add to it), the others the cost per segment and light past it.
-    fn segments_measured(
-        &mut self,
-        seconds: f64,
-        lights: u32,
-        listed: Option<(u64, u64)>,
-        gathers: bool,
-    ) {
-        let Some((segments, pixels)) = listed else {
-            return;
-        };
-        let pixel = self.pixel_cost.unwrap_or(GUESS_PIXEL_S);
-        let gather = match gathers {
-            true => self.batch_gather_cost.unwrap_or(GUESS_GATHER_PIXEL_S),
-            false => 0.0,
-        };
-        if segments < MIN_MEASURED_SEGMENTS {
-            // Only where the segments' own part is small: a preview row of 42 segments under 40
-            // lights took 10 ms, and taken for its 45 pixels' cost it made a pixel 400 times dearer
-            // than it is (every later band then held one row).
-            let listed = (lights.max(1) as u64 * segments) as f64
-                * self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S);
-            if pixels > 0 && listed < 0.25 * seconds {
-                let per = (seconds - listed) / pixels as f64;
-                if gathers {
-                    // At once up, slowly down: the same band's gather took 0.3 to 0.9 us a pixel
-                    // from one run to the next, and a band sized at the lower overran by 60 %.
-                    let past = (per - pixel).max(0.1 * per);
-                    self.batch_gather_cost = Some(match self.batch_gather_cost {
-                        Some(c) if c > past => 0.8 * c + 0.2 * past,
-                        _ => past,
-                    });
-                } else {
-                    self.pixel_cost = ema(self.pixel_cost, per);
-                }
-            }
-            return;
-        }
-        let fixed = pixels as f64 * (pixel + gather);
-        let per = (seconds - fixed).max(0.5 * seconds) / (lights.max(1) as u64 * segments) as f64;
-        self.segment_cost = ema(self.segment_cost, per);
-    }
-
-    /// Rows of a band from `row` (of `height`, `width` pixels a row) by `counts`, the segments
-    /// each row lists, under each of `shapes` (the light batches that shade the band): as many as
-    /// `budget` seconds hold under the dearest at the measured costs per segment and light, per
-    /// pixel and per pixel gathered; at least one, whole workgroups (8 rows) where the budget
-    /// allows.
-    fn segment_band_rows(
-        &self,
-        counts: &[u32],
-        (row, height, width): (u32, u32, u32),
-        shapes: &[BandShape],
-        budget: f64,
-    ) -> u32 {
-        let segment = self.segment_cost.unwrap_or(GUESS_SEGMENT_LIGHT_S);
-        let pixel = self.pixel_cost.unwrap_or(GUESS_PIXEL_S) * width as f64;
-        let gather = self.batch_gather_cost.unwrap_or(GUESS_GATHER_PIXEL_S) * width as f64;
-        let row_cost = |n: f64| {
-            shapes
-                .iter()
-                .map(|b| {
-                    let gathered = if b.gathers { gather } else { 0.0 };
-                    n * segment * b.lights.max(1) as f64 + pixel + gathered
-                })
-                .fold(0.0, f64::max)
-        };
-        let (mut t, mut n) = (0.0, 0u32);
-        for r in row..height {
-            let c = row_cost(counts.get(r as usize).copied().unwrap_or(0) as f64);
-            if n > 0 && t + c > budget {
-                break;
-            }
-            t += c;
-            n += 1;
-        }
-        let mut n = n.max(1);
-        if n >= 8 && n < height - row {
-            n -= n % 8;
-        }
-        n
-    }
-
-    /// A new grid buffer (zeros, not a light's values): every group counts as unbuilt until swept,
-    /// so the preview shades them unshadowed.
-    pub(in crate::render) fn grid_unbuilt(&mut self, group_entries: u32, total: u32) {
-        self.grid_partial = vec![true; total.div_ceil(group_entries.max(1)) as usize];
-    }
-
-    /// The whole grid was built in one go (`render_frame`, the benchmark's timing).
-    pub(in crate::render) fn grid_complete(&mut self, total: u32) {
-        self.grid_partial.clear();
-        self.grid_done = total;
-    }
-
-    /// Records a grid unit over entries [first, first + count) of `total`, in groups of
-    /// `group_entries` (the last may be shorter): a group it leaves part-way is partial, one it
-    /// completes is not.
-    fn grid_built(&mut self, first: u32, count: u32, group_entries: u32, total: u32) {
-        let g = group_entries.max(1);
-        let groups = total.div_ceil(g);
-        self.grid_partial.resize(groups as usize, false);
-        let end = first + count;
-        for group in first / g..end.div_ceil(g).min(groups) {
-            let group_end = ((group + 1) * g).min(total);
-            self.grid_partial[group as usize] = end < group_end;
-        }
+        self.costs.measured(unit, elapsed, batch, listed);
     }
 }
 
@@ -793,7 +370,7 @@ pub struct Progress {
 impl Renderer {
     /// The longest time one unit should take (default [`DEFAULT_UNIT_BUDGET`]).
     pub fn set_unit_budget(&mut self, budget: Duration) {
-        self.refinement.budget = budget.max(Duration::from_micros(100));
+        self.refinement.costs.budget = budget.max(Duration::from_micros(100));
     }
 
     /// Sizes units to `share` (0.1 to 1) of the budget, all but the preview's shading bands (which
@@ -801,7 +378,7 @@ impl Renderer {
     /// tables' build) takes part of its cores, which stretches units past their measured costs
     /// ([`crate::live::driver::budget_share`]).
     pub fn set_budget_share(&mut self, share: f64) {
-        self.refinement.budget_share = share.clamp(0.1, 1.0);
+        self.refinement.costs.budget_share = share.clamp(0.1, 1.0);
     }
 
     /// Whether frames read the shadow grid at all.
@@ -823,7 +400,7 @@ impl Renderer {
     /// A change the image on screen does not show yet: the frame's plan starts again from the first
     /// stage the change made stale, with a preview first.
     pub(in crate::render) fn restart_refinement(&mut self) {
-        self.refinement.preview_owed = true;
+        self.refinement.preview_state.owed = true;
         self.single_kept = false;
         self.replan();
     }
@@ -839,7 +416,7 @@ impl Renderer {
             Stage::Converged | Stage::PreparePreview { .. } => {
                 self.by_segment
                     && self.settings.multiple_scattering
-                    && !self.refinement.preview_owed
+                    && !self.refinement.preview_state.owed
                     && self.repaint_pending.is_empty()
             }
             Stage::Repaint { .. } | Stage::RepaintGather { .. } => false,
@@ -864,7 +441,7 @@ impl Renderer {
         let ready = self.by_segment
             && self.segment_targets.is_some()
             && self.visibility_valid
-            && !r.preview_owed
+            && !r.preview_state.owed
             && matches!(
                 r.stage,
                 Stage::Converged
@@ -973,9 +550,9 @@ impl Renderer {
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
     /// no new preview is owed for it (new tables, a deferred volume rebuild).
     pub(in crate::render) fn restart_as_refinement(&mut self, change: impl FnOnce(&mut Self)) {
-        let owed = self.refinement.preview_owed;
+        let owed = self.refinement.preview_state.owed;
         change(self);
-        self.refinement.preview_owed = owed;
+        self.refinement.preview_state.owed = owed;
         self.replan();
     }
 
@@ -991,7 +568,7 @@ impl Renderer {
     }
 
     pub(in crate::render) fn replan(&mut self) {
-        let stage = if self.refinement.preview_owed && self.preview_factor() > 1 {
+        let stage = if self.refinement.preview_state.owed && self.preview_factor() > 1 {
             Stage::PreviewVisibility { first: 0 }
         } else {
             self.main_stage()
@@ -1001,9 +578,9 @@ impl Renderer {
         self.flips_pending.clear();
         self.repaint_flips.clear();
         let r = &mut self.refinement;
-        r.preview_started = false;
-        r.preview_new_view = false;
-        r.preview_shading = Duration::ZERO;
+        r.preview_state.started = false;
+        r.preview_state.new_view = false;
+        r.preview_state.shading = Duration::ZERO;
         r.sharp_rows = 0;
         r.shade_done = 0.0;
         r.stats = RefineStats::default();
@@ -1078,14 +655,16 @@ impl Renderer {
         }
         if ready.is_some() && restart == r.restarts {
             // The image shows the latest change.
-            r.preview_owed = false;
+            r.preview_state.owed = false;
             match ready {
                 Some(ImageReady::Preview) => {
                     r.stats.preview.get_or_insert(since);
-                    let shading = r.preview_shading;
+                    let shading = r.preview_state.shading;
                     let factor = self.preview.as_ref().map_or(1, |p| p.factor);
                     let by_segment = self.by_segment;
-                    r.seed_from_preview(factor, self.light_count, self.settings.height, by_segment);
+                    let new_view = r.preview_state.new_view;
+                    let size = (factor, self.light_count, self.settings.height);
+                    r.costs.seed_from_preview(size, by_segment, new_view);
                     self.adapt_preview(shading);
                 }
                 _ => {
@@ -1131,11 +710,11 @@ impl Renderer {
                 *d = Some(Instant::now());
             }
         });
-        self.refinement.preview_started |= matches!(
+        self.refinement.preview_state.started |= matches!(
             unit,
             WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
         );
-        self.refinement.preview_new_view |= matches!(unit, WorkUnit::PreviewVisibility { .. });
+        self.refinement.preview_state.new_view |= matches!(unit, WorkUnit::PreviewVisibility { .. });
         self.refinement.in_flight = Some(InFlight {
             unit,
             submitted: Instant::now(),
@@ -1229,7 +808,7 @@ impl Renderer {
         );
         // (A preview's visibility drawn after convergence for the next change is not a preview
         // under way: no change is owed a preview then.)
-        let in_flight = r.preview_owed
+        let in_flight = r.preview_state.owed
             && r.in_flight.as_ref().is_some_and(|f| {
                 f.restart == r.restarts
                     && matches!(
@@ -1237,7 +816,7 @@ impl Renderer {
                         WorkUnit::Preview { .. } | WorkUnit::PreviewVisibility { .. }
                     )
             });
-        in_flight || (planned && r.preview_started)
+        in_flight || (planned && r.preview_state.started)
     }
 
     /// What shows `image`: the frame's targets, and for the preview its targets with the rows of the
@@ -1311,8 +890,8 @@ impl Renderer {
         ready: Option<ImageReady>,
     ) -> Progress {
         let r = &self.refinement;
-        let grid_cost = r.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
-        let samples_cost = r.samples_cost.unwrap_or(GUESS_GRID_SAMPLE_S);
+        let grid_cost = r.costs.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
+        let samples_cost = r.costs.samples_cost.unwrap_or(GUESS_GRID_SAMPLE_S);
         let entries = self.shadow_grid.entry_count() as f64;
         let samples = self.shadow_grid.sample_count() as f64;
         // The grid's sweeps and the samples they read (rebuilt with the pyramid: done when the
@@ -1323,7 +902,7 @@ impl Renderer {
             0.0
         };
         let grid_done = if self.grid_needed() {
-            r.grid_done as f64 * grid_cost + (r.samples_done as f64).min(samples) * samples_cost
+            r.grid.done as f64 * grid_cost + (r.grid.samples_done as f64).min(samples) * samples_cost
         } else {
             grid_total
         };
@@ -1331,7 +910,7 @@ impl Renderer {
         let shade_total: f64 = self
             .shading_pass
             .frame_batches()
-            .map(|b| height * r.light_row_cost(b.slot) * b.count as f64)
+            .map(|b| height * r.costs.light_row_cost(b.slot) * b.count as f64)
             .sum();
         let shade_done = r.shade_done;
         let converged = r.stage == Stage::Converged && r.in_flight.is_none();
@@ -1365,32 +944,32 @@ impl Renderer {
         let samples = self.shadow_grid.sample_count();
         let group = self.shadow_grid_inputs().light_group;
         let r = &mut self.refinement;
-        if r.grid_done >= target {
+        if r.grid.done >= target {
             return None;
         }
-        if r.samples_done < samples {
-            let count = r.items(
-                r.samples_cost,
+        if r.grid.samples_done < samples {
+            let count = r.costs.items(
+                r.costs.samples_cost,
                 GUESS_GRID_SAMPLE_S,
                 u32::MAX / 2,
-                samples - r.samples_done,
+                samples - r.grid.samples_done,
             );
-            let first = r.samples_done;
-            r.samples_done += count;
+            let first = r.grid.samples_done;
+            r.grid.samples_done += count;
             return Some(WorkUnit::GridSamples { first, count });
         }
-        let remaining = target - r.grid_done;
-        let mut count = r.items(r.grid_cost, GUESS_GRID_ENTRY_S, r.grid_last, remaining);
+        let remaining = target - r.grid.done;
+        let mut count = r.costs.items(r.costs.grid_cost, GUESS_GRID_ENTRY_S, r.costs.grid_last, remaining);
         // Whole rounds of the device's side-by-side workgroups where an entry is one workgroup (a
         // unit within one light group: `ShadowGridPass::encode`): on lavapipe on two cores three
         // entries took as long as four (40-50 ms against the two's 21).
-        let p = r.parallel_workgroups.max(1);
+        let p = r.costs.parallel_workgroups.max(1);
         if count > p && count <= group && count < remaining {
             count -= count % p;
         }
-        r.grid_last = count;
-        let first = r.grid_done;
-        r.grid_done += count;
+        r.costs.grid_last = count;
+        let first = r.grid.done;
+        r.grid.done += count;
         Some(WorkUnit::ShadowGrid { first, count })
     }
 
@@ -1407,12 +986,12 @@ impl Renderer {
         // divisor (fragments go with the resolution), or the guess.
         let factor = self.preview.as_ref().map_or(1.0, |p| p.factor as f64);
         let cost = match preview {
-            true => r.preview_visibility_cost,
+            true => r.costs.preview_visibility_cost,
             false => r
-                .visibility_cost
-                .or(r.preview_visibility_cost.map(|c| c * factor)),
+                .costs.visibility_cost
+                .or(r.costs.preview_visibility_cost.map(|c| c * factor)),
         };
-        r.items(cost, GUESS_VISIBILITY_SEGMENT_S, u32::MAX / 2, remaining)
+        r.costs.items(cost, GUESS_VISIBILITY_SEGMENT_S, u32::MAX / 2, remaining)
     }
 
     /// The next unit of the plan (sized to the budget); advances the plan past it. The shadow grid is
@@ -1481,8 +1060,8 @@ impl Renderer {
                 }
                 // Segments cost about the same each: sized by the budget alone (no doubling from
                 // a small first unit).
-                let count = r.items(
-                    r.volume_cost,
+                let count = r.costs.items(
+                    r.costs.volume_cost,
                     GUESS_SEGMENT_S,
                     u32::MAX / 2,
                     segments - first,
@@ -1496,7 +1075,7 @@ impl Renderer {
                 let voxels = self.volume.grid.voxel_count() as u32;
                 let r = &mut self.refinement;
                 let count = r
-                    .items(r.resolve_cost, GUESS_VOXEL_S, u32::MAX / 2, voxels - first)
+                    .costs.items(r.costs.resolve_cost, GUESS_VOXEL_S, u32::MAX / 2, voxels - first)
                     .max(MIN_RESOLVE_VOXELS)
                     .min(voxels - first);
                 r.stage = if first + count >= voxels {
@@ -1543,13 +1122,13 @@ impl Renderer {
                 // the background's, and the cost per row measured in one unit can double in the
                 // next when a table worker shares the cores).
                 if row == 0 {
-                    r.backdrop_last = 2 * MIN_BACKDROP_ROWS;
+                    r.costs.backdrop_last = 2 * MIN_BACKDROP_ROWS;
                 }
                 let rows = r
-                    .items(r.backdrop_cost, guess, r.backdrop_last, height - row)
+                    .costs.items(r.costs.backdrop_cost, guess, r.costs.backdrop_last, height - row)
                     .max(MIN_BACKDROP_ROWS)
                     .min(height - row);
-                r.backdrop_last = rows;
+                r.costs.backdrop_last = rows;
                 r.stage = if row + rows < height {
                     Stage::Backdrop { row: row + rows }
                 } else if batches == 0 {
@@ -1581,27 +1160,27 @@ impl Renderer {
                 let (slot, lights) = self.batch_shape(batch).unwrap_or((0, 1));
                 let lights = lights.max(1) as f64;
                 let r = &mut self.refinement;
-                let budget = r.unit_seconds() / lights;
+                let budget = r.costs.unit_seconds() / lights;
                 let rows = if band > 0 {
                     band.min(height - row)
                 } else {
                     let k = slot_bands(slot);
-                    let prior: &[f64] = if k > 0 { &r.bands[0].row_cost } else { &[] };
+                    let prior: &[f64] = if k > 0 { &r.costs.bands[0].row_cost } else { &[] };
                     let guess = GUESS_SHADE_ROW_S / GUESS_ROW_LIGHTS;
                     let by_counts = r
-                        .row_segments
+                        .costs.row_segments
                         .as_deref()
                         .filter(|_| k == 0 && by_segment)
                         .map(|c| {
-                            let total = r.unit_seconds();
-                            r.segment_band_rows(c, (row, height, width), &shapes, total)
+                            let total = r.costs.unit_seconds();
+                            r.costs.segment_band_rows(c, (row, height, width), &shapes, total)
                         });
                     let rows = by_counts
-                        .unwrap_or_else(|| r.bands[k].rows(row, height, budget, guess, prior));
-                    r.bands[k].last = rows;
+                        .unwrap_or_else(|| r.costs.bands[k].rows(row, height, budget, guess, prior));
+                    r.costs.bands[k].last = rows;
                     rows
                 };
-                r.shade_done += rows as f64 * r.light_row_cost(slot) * lights;
+                r.shade_done += rows as f64 * r.costs.light_row_cost(slot) * lights;
                 let next_band = |batch| Stage::Shade {
                     batch,
                     row: 0,
@@ -1653,12 +1232,12 @@ impl Renderer {
                 // bands' before one is made (the stroke's first unit, with a quarter over them:
                 // 462 segments under 16 lights in 55 ms at 35 ms units, lavapipe on two cores).
                 let per = r
-                    .repaint_cost
-                    .or(r.segment_cost.map(|c| 2.0 * c))
+                    .costs.repaint_cost
+                    .or(r.costs.segment_cost.map(|c| 2.0 * c))
                     .map(|c| c * lights);
                 let remaining = total.saturating_sub(first);
                 let count = r
-                    .items(per, GUESS_SEGMENT_LIGHT_S * lights, u32::MAX / 2, remaining)
+                    .costs.items(per, GUESS_SEGMENT_LIGHT_S * lights, u32::MAX / 2, remaining)
                     .max(MIN_MEASURED_SEGMENTS as u32)
                     .min(remaining);
                 r.stage = if first + count < total {
@@ -1689,8 +1268,8 @@ impl Renderer {
                 let r = &mut self.refinement;
                 let width = self.settings.width.max(1) as f64;
                 let rows = r
-                    .items(
-                        r.gather_cost.map(|c| c * width),
+                    .costs.items(
+                        r.costs.gather_cost.map(|c| c * width),
                         GUESS_GATHER_PIXEL_S * width,
                         u32::MAX / 2,
                         end - row,
@@ -1717,8 +1296,8 @@ impl Renderer {
                     // that waited for the next camera move (the redraw would have cost the next
                     // preview more than it saves) applies now, the redraw costing no preview.
                     let r = &mut self.refinement;
-                    if let Some(f) = r.preview_deferred_factor.take() {
-                        r.preview_auto_factor = Some(f);
+                    if let Some(f) = r.preview_state.deferred_factor.take() {
+                        r.preview_state.auto_factor = Some(f);
                     }
                     if self.prepare_preview(device).is_some() && !self.preview_visible() {
                         self.refinement.stage = Stage::PreparePreview { first: 0 };
@@ -1741,7 +1320,7 @@ impl Renderer {
                 let slot = self.batch_shape(batch).map_or(0, |b| b.0);
                 let counts = self
                     .refinement
-                    .row_segments
+                    .costs.row_segments
                     .as_deref()
                     .filter(|_| slot == 0)?;
                 (counts, row0, rows, self.settings.width)
@@ -1777,7 +1356,7 @@ impl Renderer {
         let width = self.settings.width as f64 / factor;
         let r = &mut self.refinement;
         let lights = self.light_count as f64;
-        let guess = r.bands[0].cost.map_or(
+        let guess = r.costs.bands[0].cost.map_or(
             GUESS_SHADE_ROW_S * light_batches * width / GUESS_ROW_PIXELS,
             |c| {
                 if by_segment {
@@ -1789,7 +1368,7 @@ impl Renderer {
         );
         // The preview in one unit where its divisor fits it to its target (one UI frame sooner per
         // unit saved), even past a shorter unit budget.
-        let budget = preview_target(r.budget).as_secs_f64();
+        let budget = preview_target(r.costs.budget).as_secs_f64();
         let counts = self
             .preview
             .as_ref()
@@ -1802,11 +1381,11 @@ impl Renderer {
                     lights: lights as u32,
                     gathers: true,
                 };
-                r.segment_band_rows(c, size, &[shape], r.budget.as_secs_f64())
+                r.costs.segment_band_rows(c, size, &[shape], r.costs.budget.as_secs_f64())
             }
-            None => r.preview_bands.rows(row, height, budget, guess, &[]),
+            None => r.costs.preview_bands.rows(row, height, budget, guess, &[]),
         };
-        r.preview_bands.last = rows;
+        r.costs.preview_bands.last = rows;
         rows
     }
 
@@ -1836,8 +1415,8 @@ impl Renderer {
                     .encode(device, enc, &self.volume, &self.pyramid, None);
                 self.volume_dirty = false;
                 self.shadow_grid_dirty = true;
-                self.refinement.grid_done = 0;
-                self.refinement.samples_done = 0;
+                self.refinement.grid.done = 0;
+                self.refinement.grid.samples_done = 0;
             }
             WorkUnit::GridSamples { first, count } => {
                 let inputs = self.shadow_grid_inputs();
@@ -1863,7 +1442,7 @@ impl Renderer {
                 );
                 let total = self.shadow_grid.entry_count();
                 let group = inputs.light_group * SWEEP_SLOTS;
-                self.refinement.grid_built(first, count, group, total);
+                self.refinement.grid.built(first, count, group, total);
                 if first + count >= total {
                     self.shadow_grid_dirty = false;
                 }
@@ -2003,66 +1582,5 @@ impl Renderer {
             (background, normalise),
             None,
         );
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A unit of few segments measures the cost per pixel only where the segments' part is small:
-    /// S1's preview rows (42 segments under 40 lights, 45 pixels, 10 ms) once made a pixel 400
-    /// times dearer than it is.
-    #[test]
-    fn few_segments_under_many_lights_do_not_price_the_pixels() {
-        let mut r = Refinement {
-            segment_cost: Some(6e-6),
-            pixel_cost: Some(0.5e-6),
-            ..Default::default()
-        };
-        r.segments_measured(0.010, 40, Some((42, 45)), true);
-        assert_eq!((r.pixel_cost, r.batch_gather_cost), (Some(0.5e-6), None));
-        // No segments: the pixels' cost, and the gather's past it for a unit that gathers.
-        r.segments_measured(0.012, 16, Some((0, 40_000)), false);
-        assert!((r.pixel_cost.unwrap_or(0.0) - 0.4e-6).abs() < 1e-12);
-        r.pixel_cost = Some(0.5e-6);
-        r.segments_measured(0.060, 8, Some((0, 40_000)), true);
-        let gather = r.batch_gather_cost.unwrap_or(0.0);
-        assert!((gather - 1.0e-6).abs() < 1e-9, "gather {gather}");
-        // Up at once, down slowly.
-        r.segments_measured(0.030, 8, Some((0, 40_000)), true);
-        let lower = r.batch_gather_cost.unwrap_or(0.0);
-        assert!(lower < gather && lower > 0.8 * gather, "gather {lower}");
-        // Many segments: the cost per segment and light past the pixels (and the gather).
-        r.batch_gather_cost = Some(1e-6);
-        r.segments_measured(0.080 + 0.060, 8, Some((1000, 40_000)), true);
-        // (0.140 - 40 000 x 1.5 us) / (8 x 1000) = 10 us, averaged with the 6 us before.
-        let segment = r.segment_cost.unwrap_or(0.0);
-        assert!((segment - 8e-6).abs() < 1e-12, "segment {segment}");
-    }
-
-    /// A band of the first pass fits the dearest of its light batches: rows without segments under
-    /// the last batch, which gathers, hold fewer rows than the claim alone would.
-    #[test]
-    fn first_pass_bands_fit_the_batch_that_gathers() {
-        let r = Refinement {
-            segment_cost: Some(5e-6),
-            pixel_cost: Some(0.5e-6),
-            batch_gather_cost: Some(1e-6),
-            ..Default::default()
-        };
-        let counts = vec![0u32; 480];
-        let shape = |lights, gathers| BandShape { lights, gathers };
-        let size = (0, 480, 720);
-        let claim = r.segment_band_rows(&counts, size, &[shape(16, false)], 0.035);
-        let batches = [shape(16, false), shape(16, false), shape(8, true)];
-        let gathered = r.segment_band_rows(&counts, size, &batches, 0.035);
-        println!("rows of a band: {claim} claimed, {gathered} with the gather");
-        // 720 pixels at 0.5 us (0.36 ms a row), at 1.5 us with the gather (1.08 ms).
-        assert_eq!((claim, gathered), (96, 32));
-        // With segments, the first batch's 16 lights are the dearer: a row of 100 segments costs
-        // 8.36 ms under them (5.08 ms under the last batch), four fit 35 ms.
-        let dense = vec![100u32; 480];
-        assert_eq!(r.segment_band_rows(&dense, size, &batches, 0.035), 4);
     }
 }

@@ -93,10 +93,10 @@ impl Renderer {
     pub(in crate::render) fn resized_preview(&mut self, width: u32, height: u32) {
         self.preview = None;
         // Adapted at the old size.
-        self.refinement.preview_deferred_factor = None;
+        self.refinement.preview_state.deferred_factor = None;
         let old = self.settings.width as f64 * self.settings.height as f64;
         let new = width as f64 * height as f64;
-        if let Some(f) = &mut self.refinement.preview_auto_factor {
+        if let Some(f) = &mut self.refinement.preview_state.auto_factor {
             let scaled = (*f as f64 * (new / old.max(1.0)).sqrt()).round() as u32;
             *f = scaled.clamp(2, MAX_PREVIEW_FACTOR);
         }
@@ -115,7 +115,7 @@ impl Renderer {
             PreviewMode::Auto if first < 2 => 1,
             PreviewMode::Auto => self
                 .refinement
-                .preview_auto_factor
+                .preview_state.auto_factor
                 .unwrap_or(first)
                 .clamp(2, MAX_PREVIEW_FACTOR),
         }
@@ -154,7 +154,7 @@ impl Renderer {
                 row_segments: None,
                 row_readback: None,
             });
-            self.refinement.preview_bands_reset();
+            self.refinement.costs.preview_bands_reset();
         }
         Some(h)
     }
@@ -204,8 +204,8 @@ impl Renderer {
         self.visibility_valid = false;
         self.forget_row_segments();
         // The preview draws its visibility anyway: a divisor that waited for it applies.
-        if let Some(f) = self.refinement.preview_deferred_factor.take() {
-            self.refinement.preview_auto_factor = Some(f);
+        if let Some(f) = self.refinement.preview_state.deferred_factor.take() {
+            self.refinement.preview_state.auto_factor = Some(f);
         }
         if let Some(p) = &mut self.preview {
             p.visible = false;
@@ -277,7 +277,7 @@ impl Renderer {
         for (b, (first, count)) in batches.into_iter().enumerate() {
             let partial = self
                 .refinement
-                .grid_partial
+                .grid.partial
                 .get(b)
                 .copied()
                 .unwrap_or(false);
@@ -334,7 +334,7 @@ impl Renderer {
         if f < 2 {
             return;
         }
-        let target = preview_target(self.refinement.budget()).as_secs_f64();
+        let target = preview_target(self.refinement.costs.budget()).as_secs_f64();
         let ideal = f as f64 * (preview_time.as_secs_f64() / target).sqrt();
         let next = if ideal > 1.25 * f as f64 || ideal < 0.7 * f as f64 {
             (ideal.ceil() as u32).clamp(2, MAX_PREVIEW_FACTOR)
@@ -348,14 +348,14 @@ impl Renderer {
         let visible = self.preview.as_ref().is_some_and(|p| p.visible);
         let r = &self.refinement;
         let redraw =
-            r.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draws_at(next) as f64;
+            r.costs.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draws_at(next) as f64;
         let seconds = preview_time.as_secs_f64();
         let saving = seconds * (1.0 - (f as f64 / next as f64).powi(2));
         if next != f && visible && saving <= redraw && seconds <= 1.5 * target {
-            self.refinement.preview_deferred_factor = Some(next);
+            self.refinement.preview_state.deferred_factor = Some(next);
         } else {
-            self.refinement.preview_auto_factor = Some(next);
-            self.refinement.preview_deferred_factor = None;
+            self.refinement.preview_state.auto_factor = Some(next);
+            self.refinement.preview_state.deferred_factor = None;
         }
     }
 

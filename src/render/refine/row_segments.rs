@@ -203,7 +203,7 @@ impl crate::render::Renderer {
     /// The frame's visible segments per row (topmost row) as refinement holds them: None until they
     /// are read back after the view's visibility pass (shading by segment only).
     pub fn row_segments(&self) -> Option<&[u32]> {
-        self.refinement.row_segments.as_deref()
+        self.refinement.costs.row_segments.as_deref()
     }
 
     /// The same for the preview's K-buffer.
@@ -233,7 +233,7 @@ impl crate::render::Renderer {
         let Some(segments) = self.segment_targets.as_ref().filter(|_| self.by_segment) else {
             return;
         };
-        if self.refinement.row_segments.is_some() {
+        if self.refinement.costs.row_segments.is_some() {
             return;
         }
         let r = ready_readback(device, readback, self.targets.height);
@@ -279,7 +279,7 @@ impl crate::render::Renderer {
         if let Some(counts) = self.row_readback.as_mut().and_then(|r| r.take())
             && counts.len() == height
         {
-            self.refinement.row_segments = Some(counts);
+            self.refinement.costs.row_segments = Some(counts);
         }
         if let Some(p) = &mut self.preview
             && let Some(counts) = p.row_readback.as_mut().and_then(|r| r.take())
@@ -291,7 +291,7 @@ impl crate::render::Renderer {
 
     /// The view changed: the counts (and read-backs under way) no longer describe it.
     pub(in crate::render) fn forget_row_segments(&mut self) {
-        self.refinement.row_segments = None;
+        self.refinement.costs.row_segments = None;
         if let Some(r) = &mut self.row_readback {
             r.cancel();
         }

@@ -202,7 +202,7 @@ impl Renderer {
             .clamp(1, crate::render::passes::shading::MAX_LIGHTS_PER_PASS)
             * crate::render::passes::shadow_grid::SWEEP_SLOTS;
         self.refinement
-            .grid_unbuilt(group, self.shadow_grid.entry_count());
+            .grid.unbuilt(group, self.shadow_grid.entry_count());
     }
 
     /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
@@ -285,7 +285,7 @@ impl Renderer {
     pub fn mark_volume_dirty(&mut self) {
         self.volume_dirty = true;
         // The sweeps' samples read the pyramid the volume makes.
-        self.refinement.samples_done = 0;
+        self.refinement.grid.samples_done = 0;
         self.volume_stale = false;
         self.volume_stale_density = false;
         self.volume_absorption_old = false;
@@ -295,7 +295,7 @@ impl Renderer {
     /// The next frame rebuilds the per-light transmittance grid (benchmarks time it).
     pub fn mark_shadow_grid_dirty(&mut self) {
         self.shadow_grid_dirty = true;
-        self.refinement.grid_done = 0;
+        self.refinement.grid.done = 0;
         self.restart_refinement();
     }
 }

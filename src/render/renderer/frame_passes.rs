@@ -138,14 +138,14 @@ impl Renderer {
             self.last_ran.extend(["fiber_density", "density_pyramid"]);
             self.volume_dirty = false;
             self.shadow_grid_dirty = true;
-            self.refinement.grid_done = 0;
-            self.refinement.samples_done = 0;
+            self.refinement.grid.done = 0;
+            self.refinement.grid.samples_done = 0;
         }
         if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
             let count = self.shadow_grid.entry_count();
             let inputs = self.shadow_grid_inputs();
             let samples = self.shadow_grid.sample_count();
-            let samples_stale = self.refinement.samples_done < samples;
+            let samples_stale = self.refinement.grid.samples_done < samples;
             if samples_stale {
                 self.shadow_grid_pass.encode_samples(
                     device,
@@ -169,9 +169,9 @@ impl Renderer {
                 self.last_ran.push("grid_samples");
             }
             self.last_ran.push("shadow_grid");
-            self.refinement.samples_done = samples;
+            self.refinement.grid.samples_done = samples;
             self.shadow_grid_dirty = false;
-            self.refinement.grid_complete(count);
+            self.refinement.grid.complete(count);
         }
         self.visibility_pass.encode(
             device,
@@ -254,13 +254,13 @@ impl Renderer {
             self.shadow_grid.entry_count(),
             None,
         );
-        self.refinement.samples_done = samples;
+        self.refinement.grid.samples_done = samples;
         ctx.queue.submit([enc.finish()]);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Gpu(e.to_string()))?;
         self.refinement
-            .grid_complete(self.shadow_grid.entry_count());
+            .grid.complete(self.shadow_grid.entry_count());
         Ok(t.elapsed().as_secs_f64())
     }
 

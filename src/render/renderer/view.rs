@@ -113,7 +113,7 @@ impl Renderer {
             });
         }
         self.refinement
-            .resized(width as f64 / self.settings.width.max(1) as f64);
+            .costs.resized(width as f64 / self.settings.width.max(1) as f64);
         self.resized_preview(width, height);
         self.settings.width = width;
         self.settings.height = height;
@@ -156,7 +156,7 @@ impl Renderer {
             );
             self.grid_buffer_made();
             self.shadow_grid_dirty = true;
-            self.refinement.grid_done = 0;
+            self.refinement.grid.done = 0;
         }
         self.settings.shadows = shadows;
         self.settings.multiple_scattering = multiple_scattering;
