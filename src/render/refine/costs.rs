@@ -71,7 +71,14 @@ impl Bands {
     /// costs (else the `prior` ones: an upper bound, the front slot's for the others; else the mean
     /// row's, or `guess`, and then at most twice the last band); at least one; whole workgroups (8
     /// rows) where the budget allows.
-    pub(super) fn rows(&self, row: u32, height: u32, budget: f64, guess: f64, prior: &[f64]) -> u32 {
+    pub(super) fn rows(
+        &self,
+        row: u32,
+        height: u32,
+        budget: f64,
+        guess: f64,
+        prior: &[f64],
+    ) -> u32 {
         let fallback = self.cost.unwrap_or(guess).max(1e-12);
         let (mut t, mut n, mut unknown) = (0.0, 0u32, false);
         for r in row..height {
@@ -226,7 +233,13 @@ impl CostModel {
     /// the previous unit of the kind (`last`: costs are uneven, empty rows and empty sweep slots cost
     /// almost nothing, so one cheap unit must not size a huge next one); at least one, at most what
     /// remains.
-    pub(super) fn items(&self, per_item: Option<f64>, guess: f64, last: u32, remaining: u32) -> u32 {
+    pub(super) fn items(
+        &self,
+        per_item: Option<f64>,
+        guess: f64,
+        last: u32,
+        remaining: u32,
+    ) -> u32 {
         let per_item = per_item.unwrap_or(guess).max(1e-12);
         let n = (self.unit_seconds() / per_item)
             .floor()

@@ -115,7 +115,8 @@ impl Renderer {
             PreviewMode::Auto if first < 2 => 1,
             PreviewMode::Auto => self
                 .refinement
-                .preview_state.auto_factor
+                .preview_state
+                .auto_factor
                 .unwrap_or(first)
                 .clamp(2, MAX_PREVIEW_FACTOR),
         }
@@ -277,7 +278,8 @@ impl Renderer {
         for (b, (first, count)) in batches.into_iter().enumerate() {
             let partial = self
                 .refinement
-                .grid.partial
+                .grid
+                .partial
                 .get(b)
                 .copied()
                 .unwrap_or(false);
@@ -347,8 +349,8 @@ impl Renderer {
         // more, waits).
         let visible = self.preview.as_ref().is_some_and(|p| p.visible);
         let r = &self.refinement;
-        let redraw =
-            r.costs.preview_visibility_cost.unwrap_or(f64::INFINITY) * self.preview_draws_at(next) as f64;
+        let redraw = r.costs.preview_visibility_cost.unwrap_or(f64::INFINITY)
+            * self.preview_draws_at(next) as f64;
         let seconds = preview_time.as_secs_f64();
         let saving = seconds * (1.0 - (f as f64 / next as f64).powi(2));
         if next != f && visible && saving <= redraw && seconds <= 1.5 * target {

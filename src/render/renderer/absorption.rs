@@ -202,7 +202,8 @@ impl Renderer {
             .clamp(1, crate::render::passes::shading::MAX_LIGHTS_PER_PASS)
             * crate::render::passes::shadow_grid::SWEEP_SLOTS;
         self.refinement
-            .grid.unbuilt(group, self.shadow_grid.entry_count());
+            .grid
+            .unbuilt(group, self.shadow_grid.entry_count());
     }
 
     /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`

@@ -260,7 +260,8 @@ impl Renderer {
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Gpu(e.to_string()))?;
         self.refinement
-            .grid.complete(self.shadow_grid.entry_count());
+            .grid
+            .complete(self.shadow_grid.entry_count());
         Ok(t.elapsed().as_secs_f64())
     }
 

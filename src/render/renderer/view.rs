@@ -113,7 +113,8 @@ impl Renderer {
             });
         }
         self.refinement
-            .costs.resized(width as f64 / self.settings.width.max(1) as f64);
+            .costs
+            .resized(width as f64 / self.settings.width.max(1) as f64);
         self.resized_preview(width, height);
         self.settings.width = width;
         self.settings.height = height;
