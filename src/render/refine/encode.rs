@@ -24,78 +24,88 @@ impl Renderer {
             }
             WorkUnit::Preview { row0, rows } => self.encode_preview(ctx, enc, row0, rows),
             WorkUnit::Volume { first, count } => {
-                self.density_pass.encode_deposit(
+                self.passes.density_pass.encode_deposit(
                     device,
                     enc,
-                    &self.hair,
-                    &self.volume,
+                    &self.scene.hair,
+                    &self.scene.volume,
                     first..first + count,
                 );
             }
             WorkUnit::VolumeResolve { first, count } => {
                 let voxels = first..first + count;
-                self.density_pass
-                    .encode_resolve(device, enc, &self.hair, &self.volume, voxels);
+                self.passes.density_pass.encode_resolve(
+                    device,
+                    enc,
+                    &self.scene.hair,
+                    &self.scene.volume,
+                    voxels,
+                );
             }
             WorkUnit::DensityPyramid => {
-                self.pyramid_pass
-                    .encode(device, enc, &self.volume, &self.pyramid, None);
-                self.volume_dirty = false;
-                self.shadow_grid_dirty = true;
+                self.passes.pyramid_pass.encode(
+                    device,
+                    enc,
+                    &self.scene.volume,
+                    &self.scene.pyramid,
+                    None,
+                );
+                self.stale.volume_dirty = false;
+                self.stale.shadow_grid_dirty = true;
                 self.refinement.grid.done = 0;
                 self.refinement.grid.samples_done = 0;
             }
             WorkUnit::GridSamples { first, count } => {
                 let inputs = self.shadow_grid_inputs();
-                self.shadow_grid_pass.encode_samples(
+                self.passes.shadow_grid_pass.encode_samples(
                     device,
                     enc,
                     &inputs,
-                    &self.shadow_grid,
+                    &self.scene.shadow_grid,
                     first..first + count,
                     None,
                 );
             }
             WorkUnit::ShadowGrid { first, count } => {
                 let inputs = self.shadow_grid_inputs();
-                self.shadow_grid_pass.encode(
+                self.passes.shadow_grid_pass.encode(
                     device,
                     enc,
                     &inputs,
-                    &self.shadow_grid,
+                    &self.scene.shadow_grid,
                     first,
                     count,
                     None,
                 );
-                let total = self.shadow_grid.entry_count();
+                let total = self.scene.shadow_grid.entry_count();
                 let group = inputs.light_group * SWEEP_SLOTS;
                 self.refinement.grid.built(first, count, group, total);
                 if first + count >= total {
-                    self.shadow_grid_dirty = false;
+                    self.stale.shadow_grid_dirty = false;
                 }
             }
             WorkUnit::Visibility { first, count } => {
                 if count > 0 {
-                    self.visibility_pass.encode(
+                    self.passes.visibility_pass.encode(
                         device,
                         enc,
-                        &self.camera,
-                        &self.hair,
-                        self.occluder.as_ref().map(|o| &o.gpu),
-                        &self.targets,
+                        &self.view.camera,
+                        &self.scene.hair,
+                        self.scene.occluder.as_ref().map(|o| &o.gpu),
+                        &self.view.targets,
                         first..first + count,
                         None,
                         None,
                     );
                 }
-                if first + count < self.hair.segment_count {
+                if first + count < self.scene.hair.segment_count {
                     return;
                 }
                 // The last part: the image's visibility is whole; the components restart.
-                self.visibility_valid = true;
+                self.stale.visibility_valid = true;
                 self.encode_row_segments(device, enc);
-                ShadingPass::clear(enc, &self.targets, self.segment_targets.as_ref());
-                self.converged_rows = 0;
+                ShadingPass::clear(enc, &self.view.targets, self.view.segment_targets.as_ref());
+                self.stale.converged_rows = 0;
             }
             WorkUnit::Backdrop { row0, rows } => {
                 self.encode_resolve(device, enc, row0..row0 + rows, (true, true));
@@ -105,14 +115,14 @@ impl Renderer {
                 first,
                 segments,
             } => {
-                let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
+                let Some(b) = self.passes.shading_pass.frame_batches().nth(batch as usize) else {
                     return;
                 };
-                let end = (first + segments).min(self.repaint.len() as u32);
+                let end = (first + segments).min(self.repaint.segments.len() as u32);
                 let start = first.min(end) as usize;
-                let part = &self.repaint[start..end as usize];
+                let part = &self.repaint.segments[start..end as usize];
                 let mut candidates = Vec::new();
-                if let Some(s) = &self.segment_targets {
+                if let Some(s) = &self.view.segment_targets {
                     ctx.queue
                         .write_buffer(&s.work_list, 0, bytemuck::cast_slice(part));
                     // Multiple scattering's candidates: the part's segments and the partners of the
@@ -125,7 +135,7 @@ impl Renderer {
                     candidates = part.to_vec();
                     candidates.extend(part.iter().filter_map(|&s| {
                         self.repaint_partner(s)
-                            .filter(|p| self.repaint.binary_search(p).is_err())
+                            .filter(|p| self.repaint.segments.binary_search(p).is_err())
                     }));
                     if !candidates.is_empty() {
                         ctx.queue.write_buffer(
@@ -139,12 +149,17 @@ impl Renderer {
                         .write_buffer(&s.work_count, 0, bytemuck::cast_slice(&count));
                 }
                 let inputs = self.shading_inputs();
-                self.shading_pass
-                    .encode_repaint(device, enc, &inputs, b, candidates.len() as u32);
+                self.passes.shading_pass.encode_repaint(
+                    device,
+                    enc,
+                    &inputs,
+                    b,
+                    candidates.len() as u32,
+                );
             }
             WorkUnit::RepaintGather { row0, rows } => {
                 // The last batch's flags (what the segments hold) over the band.
-                let Some(last) = self.shading_pass.frame_batches().last() else {
+                let Some(last) = self.passes.shading_pass.frame_batches().last() else {
                     return;
                 };
                 if rows == 0 {
@@ -156,15 +171,20 @@ impl Renderer {
                     ..*last
                 };
                 let inputs = self.shading_inputs();
-                self.shading_pass
-                    .encode_repaint_gather(device, enc, &inputs, &self.targets, &b);
+                self.passes.shading_pass.encode_repaint_gather(
+                    device,
+                    enc,
+                    &inputs,
+                    &self.view.targets,
+                    &b,
+                );
                 self.encode_resolve(device, enc, row0..row0 + rows, (false, false));
             }
             WorkUnit::Shade { batch, row0, rows } => {
-                let Some(b) = self.shading_pass.frame_batches().nth(batch as usize) else {
+                let Some(b) = self.passes.shading_pass.frame_batches().nth(batch as usize) else {
                     return;
                 };
-                let kept = if self.single_kept && b.flags & FLAG_SEGMENTS != 0 {
+                let kept = if self.stale.single_kept && b.flags & FLAG_SEGMENTS != 0 {
                     FLAG_SINGLE_KEPT
                 } else {
                     0
@@ -176,13 +196,19 @@ impl Renderer {
                     ..*b
                 };
                 let inputs = self.shading_inputs();
-                self.shading_pass
-                    .encode_batch(device, enc, &inputs, &self.targets, &b, None);
+                self.passes.shading_pass.encode_batch(
+                    device,
+                    enc,
+                    &inputs,
+                    &self.view.targets,
+                    &b,
+                    None,
+                );
                 // The last batch leaves its rows converged: resolved as render_frame resolves them.
                 // (Shaded by segment, rows have no image before it: their pixels gather then.)
-                let last = batch + 1 >= self.shading_pass.frame_batches().count() as u32;
+                let last = batch + 1 >= self.passes.shading_pass.frame_batches().count() as u32;
                 if last {
-                    self.converged_rows = self.converged_rows.max(row0 + rows);
+                    self.stale.converged_rows = self.stale.converged_rows.max(row0 + rows);
                 }
                 if last || b.flags & FLAG_SEGMENTS == 0 {
                     self.encode_resolve(device, enc, row0..row0 + rows, (false, !last));
@@ -198,13 +224,13 @@ impl Renderer {
         rows: std::ops::Range<u32>,
         (background, normalise): (bool, bool),
     ) {
-        self.resolve_pass.encode(
+        self.passes.resolve_pass.encode(
             device,
             enc,
-            &self.camera,
-            &self.resolve_info,
-            &self.background_map,
-            &self.targets,
+            &self.view.camera,
+            &self.view.resolve_info,
+            &self.scene.background_map,
+            &self.view.targets,
             rows,
             (background, normalise),
             None,

@@ -382,14 +382,14 @@ impl Renderer {
     /// Whether the refinement will rebuild (some of) the shadow grid before it shades: the volume or
     /// the grid is stale.
     pub fn shadow_grid_stale(&self) -> bool {
-        self.grid_used() && (self.volume_dirty || self.shadow_grid_dirty)
+        self.grid_used() && (self.stale.volume_dirty || self.stale.shadow_grid_dirty)
     }
 
     /// A change the image on screen does not show yet: the frame's plan starts again from the first
     /// stage the change made stale, with a preview first.
     pub(in crate::render) fn restart_refinement(&mut self) {
         self.refinement.preview_state.owed = true;
-        self.single_kept = false;
+        self.stale.single_kept = false;
         self.replan();
     }
 
@@ -405,13 +405,13 @@ impl Renderer {
                 self.by_segment
                     && self.settings.multiple_scattering
                     && !self.refinement.preview_state.owed
-                    && self.repaint_pending.is_empty()
+                    && self.repaint.pending.is_empty()
             }
             Stage::Repaint { .. } | Stage::RepaintGather { .. } => false,
-            _ => self.single_kept,
+            _ => self.stale.single_kept,
         };
         self.restart_as_refinement(change);
-        self.single_kept = keep;
+        self.stale.single_kept = keep;
     }
 
     /// Runs `change` (which restarts the plan) as a refinement of the change already on screen:
@@ -453,7 +453,7 @@ impl Renderer {
             WorkUnit::Shade { batch, .. } | WorkUnit::Repaint { batch, .. } => {
                 self.batch_shape(batch)
             }
-            WorkUnit::Preview { .. } => Some((0, self.light_count)),
+            WorkUnit::Preview { .. } => Some((0, self.scene.light_count)),
             _ => None,
         };
         let listed = self.listed_segments(unit);
@@ -497,7 +497,7 @@ impl Renderer {
                     let factor = self.preview.as_ref().map_or(1, |p| p.factor);
                     let by_segment = self.by_segment;
                     let new_view = r.preview_state.new_view;
-                    let size = (factor, self.light_count, self.settings.height);
+                    let size = (factor, self.scene.light_count, self.settings.height);
                     r.costs.seed_from_preview(size, by_segment, new_view);
                     self.adapt_preview(shading);
                 }
@@ -556,7 +556,7 @@ impl Renderer {
             done,
             restart: self.refinement.restarts,
             repaint_end: matches!(unit, WorkUnit::RepaintGather { row0, rows }
-                if row0 + rows >= self.repaint_rows.end),
+                if row0 + rows >= self.repaint.rows.end),
         });
         self.refinement.stats.units += 1;
         Ok(self.progress(Some(unit), false, ready))
@@ -594,7 +594,7 @@ impl Renderer {
     /// picks hair from it).
     pub fn view_depth_ready(&self) -> bool {
         let r = &self.refinement;
-        self.visibility_valid
+        self.stale.visibility_valid
             && !matches!(r.stage, Stage::Backdrop { .. })
             && !r.in_flight.as_ref().is_some_and(|f| {
                 matches!(
@@ -614,14 +614,14 @@ impl Renderer {
         crate::render::camera::CameraUniform,
     ) {
         (
-            ctx.start_read(&[&self.targets.view_depth]),
+            ctx.start_read(&[&self.view.targets.view_depth]),
             self.view_camera(),
         )
     }
 
     /// The camera uniform of the whole image as the frame is drawn now.
     pub fn view_camera(&self) -> crate::render::camera::CameraUniform {
-        self.camera_view.uniform(
+        self.view.camera_view.uniform(
             self.settings.width,
             self.settings.height,
             self.settings.min_width_px,
@@ -662,7 +662,7 @@ impl Renderer {
             _ => None,
         };
         DisplayImage {
-            full: &self.targets,
+            full: &self.view.targets,
             preview,
         }
     }

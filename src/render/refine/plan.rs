@@ -15,17 +15,17 @@ use std::time::Instant;
 impl Renderer {
     /// Whether frames read the shadow grid at all.
     pub(super) fn grid_used(&self) -> bool {
-        self.settings.shadows && self.light_count > 0
+        self.settings.shadows && self.scene.light_count > 0
     }
 
     /// Whether the grid frames read is stale.
     pub(super) fn grid_needed(&self) -> bool {
-        self.grid_used() && self.shadow_grid_dirty
+        self.grid_used() && self.stale.shadow_grid_dirty
     }
 
     /// The first stage of the frame's plan after the preview.
     pub(super) fn main_stage(&self) -> Stage {
-        if self.volume_dirty {
+        if self.stale.volume_dirty {
             Stage::Volume { first: 0 }
         } else if self.grid_needed() {
             Stage::ShadowGrid
@@ -41,9 +41,9 @@ impl Renderer {
             self.main_stage()
         };
         // Whatever the new plan shades, it shades whole: no repaint waits.
-        self.repaint_pending.clear();
-        self.flips_pending.clear();
-        self.repaint_flips.clear();
+        self.repaint.pending.clear();
+        self.repaint.flips_pending.clear();
+        self.repaint.flips.clear();
         let r = &mut self.refinement;
         r.preview_state.started = false;
         r.preview_state.new_view = false;
@@ -65,6 +65,7 @@ impl Renderer {
     pub(super) fn unit_gathers(&self, unit: WorkUnit) -> bool {
         match unit {
             WorkUnit::Shade { batch, .. } => self
+                .passes
                 .shading_pass
                 .frame_batches()
                 .nth(batch as usize)
@@ -76,7 +77,8 @@ impl Renderer {
 
     /// The first pass's light batches as its bands' sizing sees them.
     pub(super) fn first_pass_shapes(&self) -> Vec<BandShape> {
-        self.shading_pass
+        self.passes
+            .shading_pass
             .frame_batches()
             .take_while(|b| b.slot == 0)
             .map(|b| BandShape {
@@ -88,7 +90,8 @@ impl Renderer {
 
     /// Frame batch `batch`'s K-buffer slot and light count.
     pub(super) fn batch_shape(&self, batch: u32) -> Option<(u32, u32)> {
-        self.shading_pass
+        self.passes
+            .shading_pass
             .frame_batches()
             .nth(batch as usize)
             .map(|b| (b.slot, b.count))
@@ -96,7 +99,8 @@ impl Renderer {
 
     /// Shading batches of the first pass: every light batch at the front K-buffer slot.
     pub(super) fn first_pass_batches(&self) -> u32 {
-        self.shading_pass
+        self.passes
+            .shading_pass
             .frame_batches()
             .take_while(|b| b.slot == 0)
             .count() as u32
@@ -111,8 +115,8 @@ impl Renderer {
         let r = &self.refinement;
         let grid_cost = r.costs.grid_cost.unwrap_or(GUESS_GRID_ENTRY_S);
         let samples_cost = r.costs.samples_cost.unwrap_or(GUESS_GRID_SAMPLE_S);
-        let entries = self.shadow_grid.entry_count() as f64;
-        let samples = self.shadow_grid.sample_count() as f64;
+        let entries = self.scene.shadow_grid.entry_count() as f64;
+        let samples = self.scene.shadow_grid.sample_count() as f64;
         // The grid's sweeps and the samples they read (rebuilt with the pyramid: done when the
         // grid is not stale).
         let grid_total = if self.grid_used() {
@@ -128,6 +132,7 @@ impl Renderer {
         };
         let height = self.settings.height as f64;
         let shade_total: f64 = self
+            .passes
             .shading_pass
             .frame_batches()
             .map(|b| height * r.costs.light_row_cost(b.slot) * b.count as f64)
@@ -151,8 +156,8 @@ impl Renderer {
 
     /// Shadow-grid entries that shading batch `batch` reads: the lights' up to the batch's last.
     pub(super) fn grid_entries_for(&self, batch: u32) -> u32 {
-        let total = self.shadow_grid.entry_count();
-        match self.shading_pass.frame_batches().nth(batch as usize) {
+        let total = self.scene.shadow_grid.entry_count();
+        match self.passes.shading_pass.frame_batches().nth(batch as usize) {
             Some(b) => ((b.first + b.count) * SWEEP_SLOTS).min(total),
             None => total,
         }
@@ -161,7 +166,7 @@ impl Renderer {
     /// A shadow-grid unit towards `target` entries (after the sweeps' samples), or None when they
     /// are built.
     pub(super) fn grid_unit(&mut self, target: u32) -> Option<WorkUnit> {
-        let samples = self.shadow_grid.sample_count();
+        let samples = self.scene.shadow_grid.sample_count();
         let group = self.shadow_grid_inputs().light_group;
         let r = &mut self.refinement;
         if r.grid.done >= target {
@@ -204,7 +209,7 @@ impl Renderer {
         let r = &self.refinement;
         let drawn = match preview {
             true => self.preview_draw_count(),
-            false => self.hair.segment_count,
+            false => self.scene.hair.segment_count,
         };
         let remaining = drawn.saturating_sub(first);
         // Before the frame's first part is measured: the preview's cost per segment times its
@@ -227,7 +232,7 @@ impl Renderer {
     /// screen meanwhile), the others between shading batches.
     pub(super) fn next_unit(&mut self, device: &wgpu::Device) -> Option<WorkUnit> {
         let height = self.settings.height;
-        let batches = self.shading_pass.frame_batches().count() as u32;
+        let batches = self.passes.shading_pass.frame_batches().count() as u32;
         let grid_needed = self.grid_needed();
         match self.refinement.stage {
             Stage::PreviewVisibility { first } => {
@@ -279,7 +284,7 @@ impl Renderer {
                 Some(WorkUnit::Preview { row0: row, rows })
             }
             Stage::Volume { first } => {
-                let segments = self.hair.segment_count;
+                let segments = self.scene.hair.segment_count;
                 let r = &mut self.refinement;
                 if first >= segments && first > 0 {
                     r.stage = Stage::Resolve { first: 0 };
@@ -299,7 +304,7 @@ impl Renderer {
                 Some(WorkUnit::Volume { first, count })
             }
             Stage::Resolve { first } => {
-                let voxels = self.volume.grid.voxel_count() as u32;
+                let voxels = self.scene.volume.grid.voxel_count() as u32;
                 let r = &mut self.refinement;
                 let count = r
                     .costs
@@ -333,8 +338,8 @@ impl Renderer {
             }
             Stage::Visibility { first } => {
                 // A parameter change keeps the camera's visibility: one unit clears the components.
-                let segments = self.hair.segment_count;
-                let (first, count) = if self.visibility_valid {
+                let segments = self.scene.hair.segment_count;
+                let (first, count) = if self.stale.visibility_valid {
                     (segments, 0)
                 } else {
                     (first, self.visibility_part(first, false))
@@ -470,7 +475,7 @@ impl Renderer {
                 })
             }
             Stage::Repaint { batch, first } => {
-                let total = self.repaint.len() as u32;
+                let total = self.repaint.segments.len() as u32;
                 let lights = self.batch_shape(batch).map_or(1, |b| b.1).max(1) as f64;
                 let r = &mut self.refinement;
                 // A dab's scattered segments cost more each than a band's (S1: 5.7-6.3 us a
@@ -500,7 +505,7 @@ impl Renderer {
                     }
                 } else {
                     Stage::RepaintGather {
-                        row: self.repaint_rows.start,
+                        row: self.repaint.rows.start,
                     }
                 };
                 Some(WorkUnit::Repaint {
@@ -512,7 +517,7 @@ impl Renderer {
             Stage::RepaintGather { row } => {
                 // Bands of the rows at the measured cost per pixel (one unit of no rows when the
                 // segments leave none on screen: it still ends the repaint).
-                let end = self.repaint_rows.end.max(row);
+                let end = self.repaint.rows.end.max(row);
                 let r = &mut self.refinement;
                 let width = self.settings.width.max(1) as f64;
                 let rows = r
@@ -539,7 +544,7 @@ impl Renderer {
             }
             Stage::Converged => {
                 // Dabs that came during a repaint.
-                if self.repaint_pending.is_empty() {
+                if self.repaint.pending.is_empty() {
                     // The first preview's time changed its divisor: its visibility at the new one
                     // now (S1 on lavapipe: 140 ms of a first edit's 300 ms preview). A divisor
                     // that waited for the next camera move (the redraw would have cost the next
@@ -554,7 +559,7 @@ impl Renderer {
                     }
                     return None;
                 }
-                let pending = std::mem::take(&mut self.repaint_pending);
+                let pending = std::mem::take(&mut self.repaint.pending);
                 self.start_repaint(pending);
                 self.next_unit(device)
             }
@@ -565,7 +570,7 @@ impl Renderer {
     /// not by segment; a kept single scattering's units cost less and are not counted either).
     pub(super) fn listed_segments(&self, unit: WorkUnit) -> Option<(u64, u64)> {
         let (counts, row0, rows, width) = match unit {
-            WorkUnit::Shade { batch, row0, rows } if !self.single_kept => {
+            WorkUnit::Shade { batch, row0, rows } if !self.stale.single_kept => {
                 let slot = self.batch_shape(batch).map_or(0, |b| b.0);
                 let counts = self
                     .refinement
@@ -579,7 +584,7 @@ impl Renderer {
                 let p = self.preview.as_ref()?;
                 (p.row_segments.as_deref()?, row0, rows, p.targets.width)
             }
-            WorkUnit::Repaint { segments, .. } if !self.single_kept => {
+            WorkUnit::Repaint { segments, .. } if !self.stale.single_kept => {
                 return Some((segments as u64, 0));
             }
             WorkUnit::RepaintGather { rows, .. } => {
@@ -605,7 +610,7 @@ impl Renderer {
         let light_batches = self.first_pass_batches().max(1) as f64;
         let width = self.settings.width as f64 / factor;
         let r = &mut self.refinement;
-        let lights = self.light_count as f64;
+        let lights = self.scene.light_count as f64;
         let guess = r.costs.bands[0].cost.map_or(
             GUESS_SHADE_ROW_S * light_batches * width / GUESS_ROW_PIXELS,
             |c| {

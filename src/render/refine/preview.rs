@@ -104,7 +104,7 @@ impl Renderer {
 
     /// The preview's resolution divisor now (1: none; tiles of a still are never previewed).
     pub fn preview_factor(&self) -> u32 {
-        if self.tile.is_some() {
+        if self.view.tile.is_some() {
             return 1;
         }
         let pixels = self.settings.width as f64 * self.settings.height as f64;
@@ -166,6 +166,7 @@ impl Renderer {
     fn preview_camera(&self, factor: u32) -> CameraUniform {
         let (w, h) = Preview::size(self.settings.width, self.settings.height, factor);
         let mut c = self
+            .view
             .camera_view
             .uniform(w, h, self.settings.min_width_px / factor as f32);
         if let Some(s) = self.preview_subset(factor) {
@@ -179,7 +180,8 @@ impl Renderer {
     /// [`THIN_PREVIEW_STRANDS`] strands. A preview pixel then spans 8 x 8 or more of the frame's and
     /// its visibility pass (nearly all of a new view's preview time) draws a quarter of the segments.
     pub(in crate::render) fn preview_subset(&self, factor: u32) -> Option<&SegmentSubset> {
-        self.preview_strands
+        self.scene
+            .preview_strands
             .as_ref()
             .filter(|_| factor >= THIN_PREVIEW_FACTOR)
     }
@@ -192,7 +194,7 @@ impl Renderer {
     /// The segments a preview at divisor `factor` draws.
     fn preview_draws_at(&self, factor: u32) -> u32 {
         self.preview_subset(factor)
-            .map_or(self.hair.segment_count, |s| s.count)
+            .map_or(self.scene.hair.segment_count, |s| s.count)
     }
 
     /// Whether the preview's visibility shows the current camera.
@@ -202,7 +204,7 @@ impl Renderer {
 
     /// The camera, the image size or the fibres' width changed: both visibility passes must run again.
     pub(in crate::render) fn invalidate_visibility(&mut self) {
-        self.visibility_valid = false;
+        self.stale.visibility_valid = false;
         self.forget_row_segments();
         // The preview draws its visibility anyway: a divisor that waited for it applies.
         if let Some(f) = self.refinement.preview_state.deferred_factor.take() {
@@ -229,12 +231,12 @@ impl Renderer {
                 .write_buffer(&p.camera, 0, bytemuck::bytes_of(&camera));
         }
         let last = range.end >= self.preview_draw_count();
-        self.visibility_pass.encode(
+        self.passes.visibility_pass.encode(
             &ctx.device,
             enc,
             &p.camera,
-            &self.hair,
-            self.occluder.as_ref().map(|o| &o.gpu),
+            &self.scene.hair,
+            self.scene.occluder.as_ref().map(|o| &o.gpu),
             &p.targets,
             range,
             self.preview_subset(p.factor),
@@ -265,7 +267,11 @@ impl Renderer {
             return;
         };
         let device = &ctx.device;
-        let segments = self.segment_targets.as_ref().filter(|_| self.by_segment);
+        let segments = self
+            .view
+            .segment_targets
+            .as_ref()
+            .filter(|_| self.by_segment);
         if row0 == 0 {
             ShadingPass::clear(enc, &p.targets, segments);
         }
@@ -274,7 +280,7 @@ impl Renderer {
             segment_targets: segments,
             ..self.shading_inputs()
         };
-        let batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
+        let batches = ShadingPass::batches(self.scene.light_count, self.settings.lights_per_pass);
         for (b, (first, count)) in batches.into_iter().enumerate() {
             let partial = self
                 .refinement
@@ -307,18 +313,19 @@ impl Renderer {
                     slot,
                     row0,
                     rows,
-                    lights: self.light_count,
+                    lights: self.scene.light_count,
                 };
-                self.shading_pass
+                self.passes
+                    .shading_pass
                     .encode_batch(device, enc, &inputs, &p.targets, &batch, None);
             }
         }
-        self.resolve_pass.encode(
+        self.passes.resolve_pass.encode(
             device,
             enc,
             &p.camera,
-            &self.resolve_info,
-            &self.background_map,
+            &self.view.resolve_info,
+            &self.scene.background_map,
             &p.targets,
             row0..row0 + rows,
             (true, false),

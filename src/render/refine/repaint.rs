@@ -6,6 +6,23 @@ use super::Stage;
 use crate::render::reference::shade::strand_partner;
 use crate::render::renderer::Renderer;
 
+/// A brush dab's repaint: the segments it shades again, and the dabs that came while it ran.
+pub(in crate::render) struct RepaintState {
+    /// The segments a planned repaint shades again (sorted), and the image rows they cover.
+    pub(in crate::render) segments: Vec<u32>,
+    pub(in crate::render) rows: std::ops::Range<u32>,
+    /// Segments of dabs that came while a repaint was under way: repainted after it.
+    pub(in crate::render) pending: Vec<u32>,
+    /// Whether each pair of segments 2k, 2k + 1 shares its multiple-scattering sample (index k:
+    /// [`crate::render::reference::shade::ms_paired`] at the absorption on the GPU), kept to notice a dab that changes it.
+    pub(in crate::render) ms_pairs: Vec<bool>,
+    /// The pairs (their even segments) whose sharing dabs changed since the last repaint started:
+    /// their partners' multiple scattering moved ([`Renderer::repaint_points`]).
+    pub(in crate::render) flips_pending: Vec<u32>,
+    /// The pairs whose sharing changed for the repaint under way (sorted even segments).
+    pub(in crate::render) flips: Vec<u32>,
+}
+
 impl Renderer {
     /// A brush dab on an image converged by segment: the segments that join the changed points
     /// `changed` are shaded again under every light, with the multiple scattering of their partners
@@ -20,8 +37,8 @@ impl Renderer {
     pub fn repaint_points(&mut self, changed: &[u32]) -> bool {
         let r = &self.refinement;
         let ready = self.by_segment
-            && self.segment_targets.is_some()
-            && self.visibility_valid
+            && self.view.segment_targets.is_some()
+            && self.stale.visibility_valid
             && !r.preview_state.owed
             && matches!(
                 r.stage,
@@ -30,7 +47,7 @@ impl Renderer {
                     | Stage::Repaint { .. }
                     | Stage::RepaintGather { .. }
             )
-            && self.shading_pass.frame_batches().next().is_some();
+            && self.passes.shading_pass.frame_batches().next().is_some();
         if !ready {
             return false;
         }
@@ -42,21 +59,21 @@ impl Renderer {
             return true;
         }
         // The repaint writes its segments' single scattering: nothing is kept across it.
-        self.single_kept = false;
+        self.stale.single_kept = false;
         match self.refinement.stage {
             Stage::Repaint { batch, first } if batch > 0 || first > 0 => {
                 // Under way: these follow once it ends (starting it again at every dab would never
                 // let it finish while the pointer moves).
-                self.repaint_pending.extend(segments);
+                self.repaint.pending.extend(segments);
             }
-            Stage::RepaintGather { .. } => self.repaint_pending.extend(segments),
+            Stage::RepaintGather { .. } => self.repaint.pending.extend(segments),
             stage => {
                 // Converged, or planned and not started: one repaint of them all.
                 if !stage.image_converged() {
-                    segments.append(&mut self.repaint);
-                    self.flips_pending.append(&mut self.repaint_flips);
+                    segments.append(&mut self.repaint.segments);
+                    self.repaint.flips_pending.append(&mut self.repaint.flips);
                 }
-                segments.append(&mut self.repaint_pending);
+                segments.append(&mut self.repaint.pending);
                 self.start_repaint(segments);
             }
         }
@@ -67,18 +84,18 @@ impl Renderer {
     pub(super) fn start_repaint(&mut self, mut segments: Vec<u32>) {
         segments.sort_unstable();
         segments.dedup();
-        let mut flips = std::mem::take(&mut self.flips_pending);
+        let mut flips = std::mem::take(&mut self.repaint.flips_pending);
         flips.sort_unstable();
         flips.dedup();
-        self.repaint_flips = flips;
+        self.repaint.flips = flips;
         // With multiple scattering the partners' is shaded again too where the paint moved their
         // pair's sample, so their rows are gathered.
         let with_partners: Vec<u32> = segments
             .iter()
             .flat_map(|&s| std::iter::once(s).chain(self.repaint_partner(s)))
             .collect();
-        self.repaint_rows = self.rows_covered(&with_partners);
-        self.repaint = segments;
+        self.repaint.rows = self.rows_covered(&with_partners);
+        self.repaint.segments = segments;
         self.refinement.stage = Stage::Repaint { batch: 0, first: 0 };
     }
 
@@ -90,11 +107,11 @@ impl Renderer {
     /// each segment's own.
     pub(super) fn repaint_partner(&self, s: u32) -> Option<u32> {
         if !self.settings.multiple_scattering
-            || self.repaint_flips.binary_search(&(s & !1)).is_err()
+            || self.repaint.flips.binary_search(&(s & !1)).is_err()
         {
             return None;
         }
-        strand_partner(&self.segment_first, s)
+        strand_partner(&self.scene.segment_first, s)
     }
 
     /// The image rows where `segments` may leave fragments: their ends' projections, widened by
@@ -105,11 +122,11 @@ impl Renderer {
         let cam = self.view_camera();
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         for &k in segments {
-            let first = self.segment_first[k as usize] as usize;
-            for p in &self.point_data[first..first + 2] {
+            let first = self.scene.segment_first[k as usize] as usize;
+            for p in &self.scene.point_data[first..first + 2] {
                 let at = glam::Vec3::new(p[0], p[1], p[2]);
                 let Some(q) =
-                    crate::render::camera::project(&cam, at).filter(|_| self.tile.is_none())
+                    crate::render::camera::project(&cam, at).filter(|_| self.view.tile.is_none())
                 else {
                     return 0..height;
                 };
@@ -125,6 +142,6 @@ impl Renderer {
     /// Whether the refinement under way shades multiple scattering alone, keeping the segments'
     /// single scattering ([`Renderer::set_tables`] after the image converged).
     pub fn keeps_single_scattering(&self) -> bool {
-        self.single_kept && !self.refinement.stage.image_converged()
+        self.stale.single_kept && !self.refinement.stage.image_converged()
     }
 }

@@ -230,18 +230,23 @@ impl crate::render::Renderer {
         encoder: &mut wgpu::CommandEncoder,
         readback: &mut Option<RowSegmentsReadback>,
     ) {
-        let Some(segments) = self.segment_targets.as_ref().filter(|_| self.by_segment) else {
+        let Some(segments) = self
+            .view
+            .segment_targets
+            .as_ref()
+            .filter(|_| self.by_segment)
+        else {
             return;
         };
         if self.refinement.costs.row_segments.is_some() {
             return;
         }
-        let r = ready_readback(device, readback, self.targets.height);
-        self.shading_pass.encode_row_segments(
+        let r = ready_readback(device, readback, self.view.targets.height);
+        self.passes.shading_pass.encode_row_segments(
             device,
             encoder,
-            &self.camera,
-            &self.targets,
+            &self.view.camera,
+            &self.view.targets,
             segments,
             r,
         );
@@ -253,7 +258,12 @@ impl crate::render::Renderer {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
     ) {
-        let Some(segments) = self.segment_targets.as_ref().filter(|_| self.by_segment) else {
+        let Some(segments) = self
+            .view
+            .segment_targets
+            .as_ref()
+            .filter(|_| self.by_segment)
+        else {
             return;
         };
         let Some(p) = self.preview.as_mut() else {
@@ -261,7 +271,8 @@ impl crate::render::Renderer {
         };
         p.row_segments = None;
         let r = ready_readback(device, &mut p.row_readback, p.targets.height);
-        self.shading_pass
+        self.passes
+            .shading_pass
             .encode_row_segments(device, encoder, &p.camera, &p.targets, segments, r);
     }
 
@@ -275,7 +286,7 @@ impl crate::render::Renderer {
 
     /// After a device poll: hands counts that have landed to refinement (and the preview).
     pub(in crate::render) fn receive_row_segments(&mut self) {
-        let height = self.targets.height as usize;
+        let height = self.view.targets.height as usize;
         if let Some(counts) = self.row_readback.as_mut().and_then(|r| r.take())
             && counts.len() == height
         {

@@ -50,9 +50,9 @@ impl Renderer {
         sigma_a: &[[f32; 3]],
         changed: &[u32],
     ) -> Result<(), RenderError> {
-        if sigma_a.len() != self.point_count {
+        if sigma_a.len() != self.scene.point_count {
             return Err(RenderError::AbsorptionCount {
-                points: self.point_count,
+                points: self.scene.point_count,
                 absorption: sigma_a.len(),
             });
         }
@@ -72,7 +72,7 @@ impl Renderer {
                 .map(|s| [s[0], s[1], s[2], 0.0])
                 .collect();
             ctx.queue.write_buffer(
-                &self.hair.absorption,
+                &self.scene.hair.absorption,
                 16 * start as u64,
                 bytemuck::cast_slice(&v),
             );
@@ -91,14 +91,17 @@ impl Renderer {
             .collect();
         for k in segments {
             let even = k & !1;
-            let paired =
-                crate::render::reference::shade::ms_paired(&self.segment_first, sigma_a, even);
-            let Some(was) = self.ms_pairs.get_mut(k as usize / 2) else {
+            let paired = crate::render::reference::shade::ms_paired(
+                &self.scene.segment_first,
+                sigma_a,
+                even,
+            );
+            let Some(was) = self.repaint.ms_pairs.get_mut(k as usize / 2) else {
                 continue;
             };
             if *was != paired {
                 *was = paired;
-                self.flips_pending.push(even);
+                self.repaint.flips_pending.push(even);
             }
         }
     }
@@ -109,41 +112,42 @@ impl Renderer {
         [Some(i), i.checked_sub(1)]
             .into_iter()
             .flatten()
-            .filter_map(|p| self.segment_first.binary_search(&p).ok())
+            .filter_map(|p| self.scene.segment_first.binary_search(&p).ok())
             .map(|k| k as u32)
     }
 
     /// The absorption changed (shown at once): the volume and grid that carry it follow later.
     pub(super) fn absorption_deferred(&mut self) {
-        if self.volume_dirty {
+        if self.stale.volume_dirty {
             // A deposit under way holds points or absorption of before: it starts again.
             self.restart_refinement();
             return;
         }
         // Only the grid's forward terms read the volume's absorption.
-        if self.settings.shadows && self.settings.multiple_scattering && self.light_count > 0 {
-            self.volume_stale = true;
+        if self.settings.shadows && self.settings.multiple_scattering && self.scene.light_count > 0
+        {
+            self.stale.volume_stale = true;
         } else {
-            self.volume_absorption_old = true;
+            self.stale.volume_absorption_old = true;
         }
     }
 
     /// Whether a deferred absorption change still waits for its volume and grid.
     pub fn volume_stale(&self) -> bool {
-        self.volume_stale
+        self.stale.volume_stale
     }
 
     /// Rebuilds the volume and grid for a deferred absorption change (restarting the refinement);
     /// false when there was none.
     pub fn rebuild_stale_volume(&mut self) -> bool {
-        if !self.volume_stale {
+        if !self.stale.volume_stale {
             return false;
         }
         // The change itself is on screen (shaded with the old volume): no new preview. After an
         // absorption change the volume's density, and so the grid's transmittance, stays: a converged
         // image keeps its single scattering (shaded at the new absorption already). A thickness
         // change's density shadows single scattering too.
-        if self.volume_stale_density {
+        if self.stale.volume_stale_density {
             self.restart_as_refinement(|r| r.mark_volume_dirty());
         } else {
             self.refine_multiple_only(|r| r.mark_volume_dirty());
@@ -156,18 +160,18 @@ impl Renderer {
         ctx: &GpuContext,
         sigma_a: &[[f32; 3]],
     ) -> Result<(), RenderError> {
-        if sigma_a.len() != self.point_count {
+        if sigma_a.len() != self.scene.point_count {
             return Err(RenderError::AbsorptionCount {
-                points: self.point_count,
+                points: self.scene.point_count,
                 absorption: sigma_a.len(),
             });
         }
         let v: Vec<[f32; 4]> = sigma_a.iter().map(|s| [s[0], s[1], s[2], 0.0]).collect();
         ctx.queue
-            .write_buffer(&self.hair.absorption, 0, bytemuck::cast_slice(&v));
+            .write_buffer(&self.scene.hair.absorption, 0, bytemuck::cast_slice(&v));
         // Every point changes: the refinement restarts, shading every segment whole.
-        self.ms_pairs = all_ms_pairs(&self.segment_first, sigma_a);
-        self.flips_pending.clear();
+        self.repaint.ms_pairs = all_ms_pairs(&self.scene.segment_first, sigma_a);
+        self.repaint.flips_pending.clear();
         Ok(())
     }
 
@@ -178,16 +182,16 @@ impl Renderer {
         hair: &Hair,
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
-        if hair.point_count() != self.point_count {
+        if hair.point_count() != self.scene.point_count {
             return Err(RenderError::HairPoints {
-                renderer: self.point_count,
+                renderer: self.scene.point_count,
                 given: hair.point_count(),
             });
         }
         let points = GpuHair::point_data(hair, thickness_scale);
         ctx.queue
-            .write_buffer(&self.hair.points, 0, bytemuck::cast_slice(&points));
-        self.point_data = points;
+            .write_buffer(&self.scene.hair.points, 0, bytemuck::cast_slice(&points));
+        self.scene.point_data = points;
         // The ribbons' width changed: the visibility passes draw them again.
         self.invalidate_visibility();
         Ok(())
@@ -203,7 +207,7 @@ impl Renderer {
             * crate::render::passes::shadow_grid::SWEEP_SLOTS;
         self.refinement
             .grid
-            .unbuilt(group, self.shadow_grid.entry_count());
+            .unbuilt(group, self.scene.shadow_grid.entry_count());
     }
 
     /// Every fiber's diameter is `hair`'s times `thickness_scale` (the look's fiber thickness, `hair`
@@ -232,14 +236,14 @@ impl Renderer {
         thickness_scale: f32,
     ) -> Result<(), RenderError> {
         self.write_thickness(ctx, hair, thickness_scale)?;
-        if self.volume_dirty {
+        if self.stale.volume_dirty {
             // A deposit under way holds points or absorption of before: it starts again.
             self.restart_refinement();
             return Ok(());
         }
-        if self.settings.shadows && self.light_count > 0 {
-            self.volume_stale = true;
-            self.volume_stale_density = true;
+        if self.settings.shadows && self.scene.light_count > 0 {
+            self.stale.volume_stale = true;
+            self.stale.volume_stale_density = true;
             self.restart_refinement();
         } else {
             self.mark_volume_dirty();
@@ -251,17 +255,17 @@ impl Renderer {
     /// and added to the fiber-density volume as a solid so that it shadows the hair (the volume and the
     /// shadow grid are rebuilt; the voxelisation runs here, on the CPU: ~10 ms for the generated head).
     pub fn set_occluder(&mut self, ctx: &GpuContext, occluder: Option<&Occluder>) {
-        self.occluder = occluder.map(|o| {
-            let offset = SHADOW_OFFSET_SPACINGS * self.shadow_grid.grid.spacing;
+        self.scene.occluder = occluder.map(|o| {
+            let offset = SHADOW_OFFSET_SPACINGS * self.scene.shadow_grid.grid.spacing;
             SceneOccluder {
                 gpu: GpuOccluder::new(&ctx.device, o, offset),
-                solid: solid_fraction(&self.volume.grid, &o.mesh),
+                solid: solid_fraction(&self.scene.volume.grid, &o.mesh),
                 shadow_offset: offset,
             }
         });
-        self.volume.set_solid(
+        self.scene.volume.set_solid(
             &ctx.queue,
-            self.occluder.as_ref().map(|o| o.solid.as_slice()),
+            self.scene.occluder.as_ref().map(|o| o.solid.as_slice()),
         );
         self.invalidate_visibility();
         self.mark_volume_dirty();
@@ -269,7 +273,7 @@ impl Renderer {
 
     /// The occluder's albedo alone changed: its shading restarts, nothing else.
     pub fn set_occluder_albedo(&mut self, ctx: &GpuContext, albedo: [f32; 3]) {
-        if let Some(o) = &self.occluder {
+        if let Some(o) = &self.scene.occluder {
             o.gpu.set_albedo(&ctx.queue, albedo);
             self.restart_refinement();
         }
@@ -277,25 +281,26 @@ impl Renderer {
 
     /// The occluder's voxel fractions and the offset its shadow lookups use (tests: the CPU twins).
     pub fn occluder_solid(&self) -> Option<(&[f32], f32)> {
-        self.occluder
+        self.scene
+            .occluder
             .as_ref()
             .map(|o| (o.solid.as_slice(), o.shadow_offset))
     }
 
     /// The next frame rebuilds the fiber-density volume (geometry moved; benchmarks time it).
     pub fn mark_volume_dirty(&mut self) {
-        self.volume_dirty = true;
+        self.stale.volume_dirty = true;
         // The sweeps' samples read the pyramid the volume makes.
         self.refinement.grid.samples_done = 0;
-        self.volume_stale = false;
-        self.volume_stale_density = false;
-        self.volume_absorption_old = false;
+        self.stale.volume_stale = false;
+        self.stale.volume_stale_density = false;
+        self.stale.volume_absorption_old = false;
         self.mark_shadow_grid_dirty();
     }
 
     /// The next frame rebuilds the per-light transmittance grid (benchmarks time it).
     pub fn mark_shadow_grid_dirty(&mut self) {
-        self.shadow_grid_dirty = true;
+        self.stale.shadow_grid_dirty = true;
         self.refinement.grid.done = 0;
         self.restart_refinement();
     }

@@ -3,6 +3,9 @@
 
 use super::{MAX_SEGMENT_ANGLE, RenderError, Renderer};
 use crate::gpu::GpuContext;
+use crate::gpu::density_pyramid::DensityPyramidPass;
+use crate::gpu::fiber_density::FiberDensityPass;
+use crate::render::passes::resolve::ResolvePass;
 use crate::render::passes::shading::FLAG_MULTIPLE_SCATTERING;
 use crate::render::passes::shading::FLAG_SEGMENTS;
 use crate::render::passes::shading::FLAG_SHADOWS;
@@ -10,18 +13,30 @@ use crate::render::passes::shading::ShadeBatch;
 use crate::render::passes::shading::ShadingInputs;
 use crate::render::passes::shading::ShadingPass;
 use crate::render::passes::shadow_grid::ShadowGridInputs;
+use crate::render::passes::shadow_grid::ShadowGridPass;
+use crate::render::passes::visibility::VisibilityPass;
 use glam::Vec3;
+
+/// The passes of a frame, built once.
+pub(in crate::render) struct FramePasses {
+    pub(in crate::render) density_pass: FiberDensityPass,
+    pub(in crate::render) pyramid_pass: DensityPyramidPass,
+    pub(in crate::render) shadow_grid_pass: ShadowGridPass,
+    pub(in crate::render) visibility_pass: VisibilityPass,
+    pub(in crate::render) shading_pass: ShadingPass,
+    pub(in crate::render) resolve_pass: ResolvePass,
+}
 
 impl Renderer {
     /// Whether the frame can shade each segment once as the eye sees them now: every segment
     /// subtends at most [`MAX_SEGMENT_ANGLE`] (bounded by the longest over the distance from the eye
     /// to the hair's bounds).
     pub(super) fn segments_fit_view(&self) -> bool {
-        let (longest, lo, hi) = self.segment_extent;
+        let (longest, lo, hi) = self.scene.segment_extent;
         let c = self.view_camera();
         let eye = Vec3::from(c.eye);
         let distance = (eye.clamp(lo, hi) - eye).length().max(c.near);
-        self.segment_targets.is_some() && longest / distance <= MAX_SEGMENT_ANGLE
+        self.view.segment_targets.is_some() && longest / distance <= MAX_SEGMENT_ANGLE
     }
 
     /// The camera moved: the frame's batches switch between segments and fragments when the
@@ -43,11 +58,12 @@ impl Renderer {
         }
         let slots = self.settings.fragments;
         let height = self.settings.height;
-        let lights = self.light_count;
+        let lights = self.scene.light_count;
         // Per fragment, slot-major: every light batch at the front fragment (most of every pixel),
         // then at the ones behind it, so a refining image has all its lights early. Per segment: the
         // light batches, each over the segments of all the slots.
-        let light_batches = ShadingPass::batches(self.light_count, self.settings.lights_per_pass);
+        let light_batches =
+            ShadingPass::batches(self.scene.light_count, self.settings.lights_per_pass);
         let slot_passes = if self.by_segment {
             flags |= FLAG_SEGMENTS;
             1
@@ -68,17 +84,17 @@ impl Renderer {
                 })
             })
             .collect();
-        self.shading_pass.set_batches(device, &batches);
+        self.passes.shading_pass.set_batches(device, &batches);
         self.restart_refinement();
     }
 
     /// What the shadow-grid build reads.
     pub(in crate::render) fn shadow_grid_inputs(&self) -> ShadowGridInputs<'_> {
         ShadowGridInputs {
-            pyramid: &self.pyramid,
-            volume: &self.volume,
-            forward_table: &self.forward_table,
-            lights: &self.lights,
+            pyramid: &self.scene.pyramid,
+            volume: &self.scene.volume,
+            forward_table: &self.look.forward_table,
+            lights: &self.scene.lights,
             light_group: self
                 .settings
                 .lights_per_pass
@@ -89,19 +105,19 @@ impl Renderer {
     /// What the shading pass reads.
     pub(in crate::render) fn shading_inputs(&self) -> ShadingInputs<'_> {
         ShadingInputs {
-            camera: &self.camera,
-            params: &self.params,
-            shadow_grid: &self.shadow_grid.info,
-            points: &self.hair.points,
-            segments: &self.hair.segments,
-            absorption: &self.hair.absorption,
-            lights: &self.lights,
-            lut_c: &self.luts.c,
-            shadow_values: &self.shadow_grid.values,
-            dual_tables: &self.dual_tables,
-            azimuthal_table: &self.azimuthal_table,
-            occluder: self.occluder.as_ref().map(|o| &o.gpu),
-            segment_targets: self.segment_targets.as_ref(),
+            camera: &self.view.camera,
+            params: &self.look.params,
+            shadow_grid: &self.scene.shadow_grid.info,
+            points: &self.scene.hair.points,
+            segments: &self.scene.hair.segments,
+            absorption: &self.scene.hair.absorption,
+            lights: &self.scene.lights,
+            lut_c: &self.look.luts.c,
+            shadow_values: &self.scene.shadow_grid.values,
+            dual_tables: &self.look.dual_tables,
+            azimuthal_table: &self.look.azimuthal_table,
+            occluder: self.scene.occluder.as_ref().map(|o| &o.gpu),
+            segment_targets: self.view.segment_targets.as_ref(),
         }
     }
 
@@ -120,47 +136,47 @@ impl Renderer {
             label: Some("frame"),
         });
         self.last_ran.clear();
-        if self.volume_dirty {
-            self.density_pass.encode(
+        if self.stale.volume_dirty {
+            self.passes.density_pass.encode(
                 device,
                 &mut enc,
-                &self.hair,
-                &self.volume,
+                &self.scene.hair,
+                &self.scene.volume,
                 timer.and_then(|t| t.compute_writes("fiber_density")),
             );
-            self.pyramid_pass.encode(
+            self.passes.pyramid_pass.encode(
                 device,
                 &mut enc,
-                &self.volume,
-                &self.pyramid,
+                &self.scene.volume,
+                &self.scene.pyramid,
                 timer.and_then(|t| t.compute_writes("density_pyramid")),
             );
             self.last_ran.extend(["fiber_density", "density_pyramid"]);
-            self.volume_dirty = false;
-            self.shadow_grid_dirty = true;
+            self.stale.volume_dirty = false;
+            self.stale.shadow_grid_dirty = true;
             self.refinement.grid.done = 0;
             self.refinement.grid.samples_done = 0;
         }
-        if self.shadow_grid_dirty && self.settings.shadows && self.light_count > 0 {
-            let count = self.shadow_grid.entry_count();
+        if self.stale.shadow_grid_dirty && self.settings.shadows && self.scene.light_count > 0 {
+            let count = self.scene.shadow_grid.entry_count();
             let inputs = self.shadow_grid_inputs();
-            let samples = self.shadow_grid.sample_count();
+            let samples = self.scene.shadow_grid.sample_count();
             let samples_stale = self.refinement.grid.samples_done < samples;
             if samples_stale {
-                self.shadow_grid_pass.encode_samples(
+                self.passes.shadow_grid_pass.encode_samples(
                     device,
                     &mut enc,
                     &inputs,
-                    &self.shadow_grid,
+                    &self.scene.shadow_grid,
                     0..samples,
                     timer.and_then(|t| t.compute_writes("grid_samples")),
                 );
             }
-            self.shadow_grid_pass.encode(
+            self.passes.shadow_grid_pass.encode(
                 device,
                 &mut enc,
                 &inputs,
-                &self.shadow_grid,
+                &self.scene.shadow_grid,
                 0,
                 count,
                 timer.and_then(|t| t.compute_writes("shadow_grid")),
@@ -170,17 +186,17 @@ impl Renderer {
             }
             self.last_ran.push("shadow_grid");
             self.refinement.grid.samples_done = samples;
-            self.shadow_grid_dirty = false;
+            self.stale.shadow_grid_dirty = false;
             self.refinement.grid.complete(count);
         }
-        self.visibility_pass.encode(
+        self.passes.visibility_pass.encode(
             device,
             &mut enc,
-            &self.camera,
-            &self.hair,
-            self.occluder.as_ref().map(|o| &o.gpu),
-            &self.targets,
-            0..self.hair.segment_count,
+            &self.view.camera,
+            &self.scene.hair,
+            self.scene.occluder.as_ref().map(|o| &o.gpu),
+            &self.view.targets,
+            0..self.scene.hair.segment_count,
             None,
             timer.and_then(|t| t.render_writes("visibility")),
         );
@@ -188,26 +204,26 @@ impl Renderer {
         self.encode_row_segments_into(device, &mut enc, &mut readback);
         self.row_readback = readback;
         let inputs = self.shading_inputs();
-        self.shading_pass.encode(
+        self.passes.shading_pass.encode(
             device,
             &mut enc,
             &inputs,
-            &self.targets,
+            &self.view.targets,
             timer.and_then(|t| t.compute_writes("shading")),
         );
-        self.resolve_pass.encode(
+        self.passes.resolve_pass.encode(
             device,
             &mut enc,
-            &self.camera,
-            &self.resolve_info,
-            &self.background_map,
-            &self.targets,
+            &self.view.camera,
+            &self.view.resolve_info,
+            &self.scene.background_map,
+            &self.view.targets,
             0..self.settings.height,
             (true, false),
             timer.and_then(|t| t.compute_writes("resolve")),
         );
-        self.visibility_valid = true;
-        self.converged_rows = u32::MAX;
+        self.stale.visibility_valid = true;
+        self.stale.converged_rows = u32::MAX;
         self.last_ran.extend(["visibility", "shading", "resolve"]);
         if let Some(t) = timer {
             t.resolve(&mut enc);
@@ -216,9 +232,9 @@ impl Renderer {
         self.request_row_segments();
         self.refinement.complete_frame();
         // The whole frame is shaded: no dab waits for a repaint, nothing is kept.
-        self.repaint_pending.clear();
-        self.flips_pending.clear();
-        self.single_kept = false;
+        self.repaint.pending.clear();
+        self.repaint.flips_pending.clear();
+        self.stale.single_kept = false;
     }
 
     /// Rebuilds the whole shadow grid alone, its sweeps' samples included, and waits for it:
@@ -226,7 +242,7 @@ impl Renderer {
     /// a compute pass's timestamps bracket the dispatch's submission to its thread pool, not its work, so
     /// a pass that no later barrier waits for inside its own bracket (the grid) reads ~0 ms there.
     pub fn time_shadow_grid(&mut self, ctx: &GpuContext) -> Result<f64, RenderError> {
-        if !self.settings.shadows || self.light_count == 0 {
+        if !self.settings.shadows || self.scene.light_count == 0 {
             return Ok(0.0);
         }
         let t = std::time::Instant::now();
@@ -236,22 +252,22 @@ impl Renderer {
                 label: Some("shadow grid alone"),
             });
         let inputs = self.shadow_grid_inputs();
-        let samples = self.shadow_grid.sample_count();
-        self.shadow_grid_pass.encode_samples(
+        let samples = self.scene.shadow_grid.sample_count();
+        self.passes.shadow_grid_pass.encode_samples(
             &ctx.device,
             &mut enc,
             &inputs,
-            &self.shadow_grid,
+            &self.scene.shadow_grid,
             0..samples,
             None,
         );
-        self.shadow_grid_pass.encode(
+        self.passes.shadow_grid_pass.encode(
             &ctx.device,
             &mut enc,
             &inputs,
-            &self.shadow_grid,
+            &self.scene.shadow_grid,
             0,
-            self.shadow_grid.entry_count(),
+            self.scene.shadow_grid.entry_count(),
             None,
         );
         self.refinement.grid.samples_done = samples;
@@ -261,7 +277,7 @@ impl Renderer {
             .map_err(|e| RenderError::Gpu(e.to_string()))?;
         self.refinement
             .grid
-            .complete(self.shadow_grid.entry_count());
+            .complete(self.scene.shadow_grid.entry_count());
         Ok(t.elapsed().as_secs_f64())
     }
 

@@ -5,6 +5,7 @@
 use super::Renderer;
 use crate::gpu::GpuContext;
 use crate::gpu::dual_eval::dual_tables_texels;
+use crate::gpu::fast_eval::GpuLuts;
 use crate::gpu::forward::forward_table_texels;
 use crate::render::reference::REFERENCE_VARIANT;
 use crate::render::renderer::table_cache::with_cache;
@@ -23,6 +24,20 @@ use std::sync::Arc;
 pub struct HairLook {
     pub params: HairParams,
     pub fast: FastHairParams,
+}
+
+/// The look and the tables built for it, on the GPU.
+pub(in crate::render) struct LookTables {
+    pub(in crate::render) luts: GpuLuts,
+    pub(in crate::render) look: HairLook,
+    /// The exact parameters the forward and dual tables were built for.
+    pub(in crate::render) tables_for: HairParams,
+    pub(in crate::render) params: wgpu::Buffer,
+    pub(in crate::render) forward_table: wgpu::Buffer,
+    pub(in crate::render) dual_tables: wgpu::Buffer,
+    /// The azimuthal table the buffer holds (sized for the largest, an elliptical fiber's).
+    pub(in crate::render) azimuthal: Arc<AzimuthalTable>,
+    pub(in crate::render) azimuthal_table: wgpu::Buffer,
 }
 
 impl HairLook {
@@ -180,10 +195,10 @@ impl Renderer {
     /// rebuild.
     pub fn set_params(&mut self, ctx: &GpuContext, look: &HairLook) {
         ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&look.fast));
-        self.look = *look;
+            .write_buffer(&self.look.params, 0, bytemuck::bytes_of(&look.fast));
+        self.look.look = *look;
         if self.tables_needed(&look.params) {
-            let tables = build_tables(&look.params, Some(&self.azimuthal));
+            let tables = build_tables(&look.params, Some(&self.look.azimuthal));
             self.set_tables(ctx, &look.params, &tables);
         }
         self.restart_refinement();
@@ -198,8 +213,8 @@ impl Renderer {
     /// first ([`TableBuild::build`], [`Renderer::set_azimuthal_table`]).
     pub fn set_params_deferred(&mut self, ctx: &GpuContext, look: &HairLook) -> bool {
         let tables_needed = self.tables_needed(&look.params);
-        let (before, index_only) = (self.frame_params(), self.look.index_only_change(look));
-        self.look = *look;
+        let (before, index_only) = (self.frame_params(), self.look.look.index_only_change(look));
+        self.look.look = *look;
         self.write_params(ctx);
         // A new eta or eccentricity alone changes nothing a frame reads until a table made for it
         // arrives: the image stays, and the cores stay free for that table's build. Any other
@@ -214,7 +229,7 @@ impl Renderer {
     /// absorption, or an azimuthal table not made for them (a draft, [`build_draft_table`], or one
     /// shown ahead of its tables for another index: [`Renderer::set_azimuthal_table`]).
     pub fn tables_needed(&self, params: &HairParams) -> bool {
-        !same_tables(params, &self.tables_for) || !self.azimuthal.fits_hair(params)
+        !same_tables(params, &self.look.tables_for) || !self.look.azimuthal.fits_hair(params)
     }
 
     /// Writes the look's fast parameters, with the azimuthal table's eta and eccentricity while the
@@ -225,23 +240,23 @@ impl Renderer {
     pub(super) fn write_params(&self, ctx: &GpuContext) {
         let fast = self.frame_params();
         ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&fast));
+            .write_buffer(&self.look.params, 0, bytemuck::bytes_of(&fast));
     }
 
     /// The fast parameters a frame reads: the look's, with the azimuthal table's eta and
     /// eccentricity while the table for new ones is being built.
     pub(super) fn frame_params(&self) -> FastHairParams {
-        let mut fast = self.look.fast;
-        if !self.azimuthal.for_index(&fast) {
-            fast.eta = self.azimuthal.eta;
-            fast.eccentricity = self.azimuthal.eccentricity;
+        let mut fast = self.look.look.fast;
+        if !self.look.azimuthal.for_index(&fast) {
+            fast.eta = self.look.azimuthal.eta;
+            fast.eccentricity = self.look.azimuthal.eccentricity;
         }
         fast
     }
 
     /// The azimuthal table in use (kept by a rebuild for the same eta and eccentricity).
     pub fn azimuthal_table(&self) -> &Arc<AzimuthalTable> {
-        &self.azimuthal
+        &self.look.azimuthal
     }
 
     /// Takes what a worker built for `params` ([`TableBuild`]); false when ignored (the look has
@@ -270,10 +285,10 @@ impl Renderer {
         params: &HairParams,
         table: &Arc<AzimuthalTable>,
     ) -> bool {
-        if !same_tables(params, &self.look.params) || !table.made_for_hair(params) {
+        if !same_tables(params, &self.look.look.params) || !table.made_for_hair(params) {
             return false;
         }
-        if !Arc::ptr_eq(&self.azimuthal, table) {
+        if !Arc::ptr_eq(&self.look.azimuthal, table) {
             self.upload_azimuthal(ctx, table);
             self.restart_refinement();
         }
@@ -283,8 +298,8 @@ impl Renderer {
     /// The azimuthal table to the GPU, and the parameters a frame reads with it (`write_params`).
     pub(super) fn upload_azimuthal(&mut self, ctx: &GpuContext, table: &Arc<AzimuthalTable>) {
         ctx.queue
-            .write_buffer(&self.azimuthal_table, 0, table.gpu_bytes());
-        self.azimuthal = table.clone();
+            .write_buffer(&self.look.azimuthal_table, 0, table.gpu_bytes());
+        self.look.azimuthal = table.clone();
         self.write_params(ctx);
     }
 
@@ -295,31 +310,31 @@ impl Renderer {
         params: &HairParams,
         tables: &ParamTables,
     ) -> bool {
-        if !same_tables(params, &self.look.params) {
+        if !same_tables(params, &self.look.look.params) {
             return false;
         }
         ctx.queue.write_buffer(
-            &self.forward_table,
+            &self.look.forward_table,
             0,
             bytemuck::cast_slice(&forward_table_texels(&tables.forward)),
         );
         ctx.queue.write_buffer(
-            &self.dual_tables,
+            &self.look.dual_tables,
             0,
             bytemuck::cast_slice(&dual_tables_texels(&tables.dual)),
         );
-        let azimuthal_changed = !Arc::ptr_eq(&self.azimuthal, &tables.azimuthal);
+        let azimuthal_changed = !Arc::ptr_eq(&self.look.azimuthal, &tables.azimuthal);
         // The table after its draft (or after a kept table for its index, shown ahead of its
         // tables): the index is on screen, and the refinement goes on as a refinement. Tables for
         // another index (an undo while a draft shows) owe a preview.
-        let after_draft = azimuthal_changed && self.azimuthal.made_for_hair(params);
+        let after_draft = azimuthal_changed && self.look.azimuthal.made_for_hair(params);
         // Whether the forward and dual tables are new (the grid's forward terms read the forward
         // table): not for tables of the parameters these were built for.
-        let others_changed = !same_tables(params, &self.tables_for);
+        let others_changed = !same_tables(params, &self.look.tables_for);
         if azimuthal_changed {
             self.upload_azimuthal(ctx, &tables.azimuthal);
         }
-        self.tables_for = *params;
+        self.look.tables_for = *params;
         // The forward and dual tables are read only with multiple scattering (the grid's forward
         // terms, the shading's dual terms); without it only a new azimuthal table changes the image.
         // A new azimuthal table shows a change not on screen yet (an eta or eccentricity change waits
@@ -348,7 +363,7 @@ impl Renderer {
 
     /// The hair parameters the renderer holds.
     pub fn look(&self) -> &HairLook {
-        &self.look
+        &self.look.look
     }
 }
 

@@ -7,7 +7,9 @@ pub mod absorption;
 pub mod frame_passes;
 pub mod look;
 pub mod readback;
+pub mod scene_buffers;
 pub mod settings;
+pub mod stale;
 pub mod table_cache;
 pub mod view;
 
@@ -24,10 +26,9 @@ use crate::gpu::fast_eval::GpuLuts;
 use crate::gpu::fiber_density::{FiberDensityPass, GpuFiberDensity, GpuHair};
 use crate::gpu::forward::upload_forward_table;
 use crate::hair::Hair;
-use crate::render::camera::{Camera, Tile};
+use crate::render::camera::Camera;
 use crate::render::passes::background::BackgroundMap;
 use crate::render::passes::kbuffer::{KBufferTargets, MAX_FRAGMENTS};
-use crate::render::passes::occluder::GpuOccluder;
 use crate::render::passes::resolve::{ResolveInfo, ResolvePass};
 use crate::render::passes::segment_shading::SegmentTargets;
 use crate::render::passes::shading::{GpuLight, ShadingPass};
@@ -36,12 +37,16 @@ use crate::render::passes::targets::{FrameTargets, MAX_SEGMENTS};
 use crate::render::passes::visibility::VisibilityPass;
 use crate::render::refine::Refinement;
 use crate::render::refine::preview::{Preview, PreviewMode};
+use crate::render::refine::repaint::RepaintState;
 use crate::render::timing::PassTimer;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
-use crate::scattering::params::HairParams;
+use frame_passes::FramePasses;
 use glam::Vec3;
-use std::sync::Arc;
+use look::LookTables;
+use scene_buffers::{SceneBuffers, SceneOccluder};
+use stale::Staleness;
+use view::ViewTargets;
 use wgpu::util::DeviceExt;
 
 /// The passes, in the order `render_frame` runs them (timestamp names).
@@ -99,95 +104,11 @@ fn segment_extent(hair: &Hair) -> (f32, Vec3, Vec3) {
 
 pub struct Renderer {
     pub settings: RenderSettings,
-    pub(in crate::render) hair: GpuHair,
-    pub(in crate::render) point_count: usize,
-    pub(in crate::render) skip: f32,
-    pub(in crate::render) volume: GpuFiberDensity,
-    pub(in crate::render) pyramid: GpuDensityPyramid,
-    pub(in crate::render) shadow_grid: GpuShadowGrid,
-    pub(in crate::render) luts: GpuLuts,
-    pub(in crate::render) look: HairLook,
-    /// The exact parameters the forward and dual tables were built for.
-    pub(in crate::render) tables_for: HairParams,
-    pub(in crate::render) params: wgpu::Buffer,
-    pub(in crate::render) forward_table: wgpu::Buffer,
-    pub(in crate::render) dual_tables: wgpu::Buffer,
-    /// The azimuthal table the buffer holds (sized for the largest, an elliptical fiber's).
-    pub(in crate::render) azimuthal: Arc<AzimuthalTable>,
-    pub(in crate::render) azimuthal_table: wgpu::Buffer,
-    pub(in crate::render) camera: wgpu::Buffer,
-    /// The camera the uniform was made from (rewritten when the image size changes).
-    pub(in crate::render) camera_view: Camera,
-    /// The tile of a larger still the camera renders (None: the whole image).
-    pub(in crate::render) tile: Option<Tile>,
-    pub(in crate::render) lights: wgpu::Buffer,
-    pub(in crate::render) light_count: u32,
-    pub(in crate::render) resolve_info: wgpu::Buffer,
-    /// What `resolve_info` holds.
-    pub(in crate::render) resolve_params: ResolveInfo,
-    /// The background's map texels (one zero texel without one).
-    pub(in crate::render) background_map: wgpu::Buffer,
-    /// The occluder (the head) drawn, shaded and held in the volume as a solid.
-    pub(in crate::render) occluder: Option<SceneOccluder>,
-    pub(in crate::render) targets: FrameTargets,
-    pub(in crate::render) density_pass: FiberDensityPass,
-    pub(in crate::render) pyramid_pass: DensityPyramidPass,
-    pub(in crate::render) shadow_grid_pass: ShadowGridPass,
-    pub(in crate::render) visibility_pass: VisibilityPass,
-    pub(in crate::render) shading_pass: ShadingPass,
-    /// The frame's per-segment radiance (None: the frame shades per fragment).
-    pub(in crate::render) segment_targets: Option<SegmentTargets>,
-    /// The hair's longest segment and its bounds (whether segments are short enough, as the eye sees
-    /// them, to be shaded once each: [`MAX_SEGMENT_ANGLE`]).
-    pub(in crate::render) segment_extent: (f32, Vec3, Vec3),
     /// The frame's batches shade segments (else fragments).
     pub(in crate::render) by_segment: bool,
-    pub(in crate::render) resolve_pass: ResolvePass,
-    /// The fragments per pixel asked for (`settings.fragments` is fewer when the K-buffer would not
-    /// fit one binding at this size).
-    pub(in crate::render) requested_fragments: u32,
-    pub(in crate::render) volume_dirty: bool,
-    /// The rows [0, converged_rows) whose every fragment is shaded (the others, part-way through
-    /// progressive refinement, resolve normalised); u32::MAX after `render_frame`.
-    pub(in crate::render) converged_rows: u32,
-    /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
-    /// one ([`Renderer::set_absorption_deferred`]).
-    pub(in crate::render) volume_stale: bool,
-    /// The stale volume's density changed too (a deferred thickness change): its rebuild changes the
-    /// grid's transmittance, which single scattering reads.
-    pub(in crate::render) volume_stale_density: bool,
-    /// The volume holds an old absorption that nothing reads now (multiple scattering off): rebuilt
-    /// when multiple scattering is turned on.
-    pub(in crate::render) volume_absorption_old: bool,
-    pub(in crate::render) shadow_grid_dirty: bool,
-    /// The refinement's plan re-shades multiple scattering alone: the segments' single scattering
-    /// from the last converged pass still holds (a change that reaches only the forward and
-    /// dual-scattering terms: new tables, a deferred absorption's volume).
-    pub(in crate::render) single_kept: bool,
-    /// Each segment's first point, in segment order (the brush's repaint finds the segments at the
-    /// points a dab changed: [`Renderer::repaint_points`]).
-    pub(in crate::render) segment_first: Vec<u32>,
-    /// The segments a planned repaint shades again (sorted), and the image rows they cover.
-    pub(in crate::render) repaint: Vec<u32>,
-    pub(in crate::render) repaint_rows: std::ops::Range<u32>,
-    /// Segments of dabs that came while a repaint was under way: repainted after it.
-    pub(in crate::render) repaint_pending: Vec<u32>,
-    /// Whether each pair of segments 2k, 2k + 1 shares its multiple-scattering sample (index k:
-    /// [`crate::render::reference::shade::ms_paired`] at the absorption on the GPU), kept to notice a dab that changes it.
-    pub(in crate::render) ms_pairs: Vec<bool>,
-    /// The pairs (their even segments) whose sharing dabs changed since the last repaint started:
-    /// their partners' multiple scattering moved ([`Renderer::repaint_points`]).
-    pub(in crate::render) flips_pending: Vec<u32>,
-    /// The pairs whose sharing changed for the repaint under way (sorted even segments).
-    pub(in crate::render) repaint_flips: Vec<u32>,
-    /// Every [`crate::render::refine::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
-    /// preview draws (None for a hair of few strands).
-    pub(in crate::render) preview_strands: Option<crate::render::passes::kbuffer::SegmentSubset>,
     /// The visible segments per row, read back after the frame's visibility (band sizes).
     pub(in crate::render) row_readback:
         Option<crate::render::refine::row_segments::RowSegmentsReadback>,
-    /// The points as the GPU holds them (position, diameter), for the rows a repaint covers.
-    pub(in crate::render) point_data: Vec<[f32; 4]>,
     pub(in crate::render) timer: Option<PassTimer>,
     pub(in crate::render) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
@@ -195,17 +116,18 @@ pub struct Renderer {
     /// Whether and how refinement previews a change, and the preview's targets.
     pub(in crate::render) preview_mode: PreviewMode,
     pub(in crate::render) preview: Option<Preview>,
-    /// The frame's visibility pass has drawn the current camera and fibres (refinement reuses it
-    /// after a parameter change).
-    pub(in crate::render) visibility_valid: bool,
-}
-
-/// The occluder as the renderer holds it.
-pub(in crate::render) struct SceneOccluder {
-    pub(in crate::render) gpu: GpuOccluder,
-    /// Its fraction of each voxel of the volume.
-    solid: Vec<f32>,
-    shadow_offset: f32,
+    /// The look and its tables on the GPU.
+    pub(in crate::render) look: LookTables,
+    /// The hair, head, lights and the volumes built from them.
+    pub(in crate::render) scene: SceneBuffers,
+    /// The camera and the targets the frame renders into.
+    pub(in crate::render) view: ViewTargets,
+    /// The passes, built once.
+    pub(in crate::render) passes: FramePasses,
+    /// What is out of date.
+    pub(in crate::render) stale: Staleness,
+    /// A brush dab's repaint under way and those waiting.
+    pub(in crate::render) repaint: RepaintState,
 }
 
 /// The background map's texels as a storage buffer (one zero texel for none: a binding cannot be
@@ -397,98 +319,110 @@ impl Renderer {
         let segment_first = crate::render::reference::shade::segment_starts(hair);
         let ms_pairs = all_ms_pairs(&segment_first, sigma_a);
         let mut renderer = Self {
-            hair: gpu_hair,
-            point_count: hair.point_count(),
-            skip,
-            volume,
-            pyramid,
-            shadow_grid,
-            luts: GpuLuts::new(device, luts),
-            look: *look,
-            tables_for: look.params,
-            params: uniform("hair params", bytemuck::bytes_of(&look.fast)),
-            forward_table: upload_forward_table(device, &forward),
-            dual_tables: storage(
-                "dual tables",
-                bytemuck::cast_slice(&dual_tables_texels(&dual)),
-            ),
-            azimuthal,
-            azimuthal_table,
-            camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
-            camera_view: *camera,
-            tile: None,
-            lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lights"),
-                contents: bytemuck::cast_slice(&gpu_lights(lights)),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            }),
-            light_count: lights.len() as u32,
-            resolve_info: uniform("resolve", bytemuck::bytes_of(&resolve_info)),
-            resolve_params: resolve_info,
-            background_map: environment_buffer(device, None),
-            occluder: None,
-            targets: FrameTargets::new(
-                device,
-                settings.width,
-                settings.height,
-                settings.samples,
-                settings.kbuffer(),
-            ),
-            density_pass: FiberDensityPass::new(device),
-            pyramid_pass: DensityPyramidPass::new(device),
-            shadow_grid_pass: ShadowGridPass::new(device),
-            visibility_pass: VisibilityPass::new(device, settings.samples),
-            shading_pass: ShadingPass::new(device),
-            segment_targets: settings
-                .segment_shading
-                .then(|| {
-                    SegmentTargets::new(
-                        device,
-                        gpu_hair_segments,
-                        crate::gpu::context::binding_limit(device),
-                    )
-                })
-                .flatten(),
-            resolve_pass: ResolvePass::new(device),
-            segment_extent: segment_extent(hair),
             by_segment: false,
-            volume_dirty: true,
-            requested_fragments,
-            converged_rows: u32::MAX,
-            volume_stale: false,
-            volume_stale_density: false,
-            volume_absorption_old: false,
-            shadow_grid_dirty: true,
-            single_kept: false,
-            segment_first,
-            repaint: Vec::new(),
-            repaint_rows: 0..0,
-            repaint_pending: Vec::new(),
-            ms_pairs,
-            flips_pending: Vec::new(),
-            repaint_flips: Vec::new(),
             row_readback: None,
-            preview_strands: (hair.strand_count()
-                >= crate::render::refine::preview::THIN_PREVIEW_STRANDS)
-                .then(|| {
-                    let segments: Vec<u32> = (0..hair.strand_count())
-                        .map(|s| hair.strand_range(s).len().saturating_sub(1) as u32)
-                        .collect();
-                    let stride = crate::render::refine::preview::PREVIEW_STRAND_STRIDE;
-                    crate::render::passes::kbuffer::SegmentSubset::new(
-                        &ctx.device,
-                        &segments,
-                        stride,
-                    )
-                })
-                .flatten(),
-            point_data: GpuHair::point_data(hair, 1.0),
             timer: PassTimer::new(ctx, &PASSES),
             last_ran: Vec::new(),
             refinement: Refinement::for_device(ctx),
             preview_mode: PreviewMode::Off,
             preview: None,
-            visibility_valid: false,
+            look: LookTables {
+                luts: GpuLuts::new(device, luts),
+                look: *look,
+                tables_for: look.params,
+                params: uniform("hair params", bytemuck::bytes_of(&look.fast)),
+                forward_table: upload_forward_table(device, &forward),
+                dual_tables: storage(
+                    "dual tables",
+                    bytemuck::cast_slice(&dual_tables_texels(&dual)),
+                ),
+                azimuthal,
+                azimuthal_table,
+            },
+            scene: SceneBuffers {
+                hair: gpu_hair,
+                point_count: hair.point_count(),
+                skip,
+                volume,
+                pyramid,
+                shadow_grid,
+                lights: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("lights"),
+                    contents: bytemuck::cast_slice(&gpu_lights(lights)),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                }),
+                light_count: lights.len() as u32,
+                background_map: environment_buffer(device, None),
+                occluder: None,
+                segment_extent: segment_extent(hair),
+                segment_first,
+                preview_strands: (hair.strand_count()
+                    >= crate::render::refine::preview::THIN_PREVIEW_STRANDS)
+                    .then(|| {
+                        let segments: Vec<u32> = (0..hair.strand_count())
+                            .map(|s| hair.strand_range(s).len().saturating_sub(1) as u32)
+                            .collect();
+                        let stride = crate::render::refine::preview::PREVIEW_STRAND_STRIDE;
+                        crate::render::passes::kbuffer::SegmentSubset::new(
+                            &ctx.device,
+                            &segments,
+                            stride,
+                        )
+                    })
+                    .flatten(),
+                point_data: GpuHair::point_data(hair, 1.0),
+            },
+            view: ViewTargets {
+                camera: uniform("camera", bytemuck::bytes_of(&camera_u)),
+                camera_view: *camera,
+                tile: None,
+                resolve_info: uniform("resolve", bytemuck::bytes_of(&resolve_info)),
+                resolve_params: resolve_info,
+                targets: FrameTargets::new(
+                    device,
+                    settings.width,
+                    settings.height,
+                    settings.samples,
+                    settings.kbuffer(),
+                ),
+                segment_targets: settings
+                    .segment_shading
+                    .then(|| {
+                        SegmentTargets::new(
+                            device,
+                            gpu_hair_segments,
+                            crate::gpu::context::binding_limit(device),
+                        )
+                    })
+                    .flatten(),
+                requested_fragments,
+            },
+            passes: FramePasses {
+                density_pass: FiberDensityPass::new(device),
+                pyramid_pass: DensityPyramidPass::new(device),
+                shadow_grid_pass: ShadowGridPass::new(device),
+                visibility_pass: VisibilityPass::new(device, settings.samples),
+                shading_pass: ShadingPass::new(device),
+                resolve_pass: ResolvePass::new(device),
+            },
+            stale: Staleness {
+                volume_dirty: true,
+                converged_rows: u32::MAX,
+                volume_stale: false,
+                volume_stale_density: false,
+                volume_absorption_old: false,
+                shadow_grid_dirty: true,
+                single_kept: false,
+                visibility_valid: false,
+            },
+            repaint: RepaintState {
+                segments: Vec::new(),
+                rows: 0..0,
+                pending: Vec::new(),
+                ms_pairs,
+                flips_pending: Vec::new(),
+                flips: Vec::new(),
+            },
             settings,
         };
         renderer.update_batches(device);

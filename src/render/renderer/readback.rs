@@ -109,14 +109,14 @@ impl Renderer {
     pub(super) fn extras(&self) -> Extras {
         Extras {
             background: self.has_background(),
-            occluder: self.occluder.is_some(),
+            occluder: self.scene.occluder.is_some(),
             fragments: true,
         }
     }
 
     /// Waits for the last frame and reads every output back.
     pub fn read_frame(&self, ctx: &GpuContext) -> Result<Frame, RenderError> {
-        self.read_targets(ctx, &self.targets)
+        self.read_targets(ctx, &self.view.targets)
     }
 
     /// [`Renderer::read_frame`] without the K-buffer (a tile of a still).
@@ -125,7 +125,7 @@ impl Renderer {
             fragments: false,
             ..self.extras()
         };
-        self.read_with(ctx, &self.targets, extras)
+        self.read_with(ctx, &self.view.targets, extras)
     }
 
     /// Reads every output of `t` (the frame's targets or the preview's) back, waiting for the GPU.
@@ -172,7 +172,7 @@ impl Renderer {
     }
 
     pub(super) fn start_read(&self, ctx: &GpuContext, extras: Extras) -> FrameReadBack {
-        let t = &self.targets;
+        let t = &self.view.targets;
         FrameReadBack {
             pending: ctx.start_read(&frame_buffers(t, extras)),
             shape: shape(t),
@@ -188,7 +188,7 @@ impl Renderer {
         ctx: &GpuContext,
     ) -> Result<Vec<crate::shadow::grid::GridShadow>, RenderError> {
         let v = ctx
-            .read_buffer::<[f32; 8]>(&self.shadow_grid.values)
+            .read_buffer::<[f32; 8]>(&self.scene.shadow_grid.values)
             .map_err(RenderError::Gpu)?;
         Ok(v.into_iter()
             .map(|e| crate::shadow::grid::GridShadow {

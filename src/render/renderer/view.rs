@@ -9,7 +9,27 @@ use crate::render::camera::Camera;
 use crate::render::camera::Tile;
 use crate::render::passes::background::BackgroundMap;
 use crate::render::passes::kbuffer::KBufferTargets;
+use crate::render::passes::resolve::ResolveInfo;
+use crate::render::passes::segment_shading::SegmentTargets;
 use crate::render::passes::targets::FrameTargets;
+
+/// What the frame sees and the targets it renders into.
+pub(in crate::render) struct ViewTargets {
+    pub(in crate::render) camera: wgpu::Buffer,
+    /// The camera the uniform was made from (rewritten when the image size changes).
+    pub(in crate::render) camera_view: Camera,
+    /// The tile of a larger still the camera renders (None: the whole image).
+    pub(in crate::render) tile: Option<Tile>,
+    pub(in crate::render) resolve_info: wgpu::Buffer,
+    /// What `resolve_info` holds.
+    pub(in crate::render) resolve_params: ResolveInfo,
+    pub(in crate::render) targets: FrameTargets,
+    /// The frame's per-segment radiance (None: the frame shades per fragment).
+    pub(in crate::render) segment_targets: Option<SegmentTargets>,
+    /// The fragments per pixel asked for (`settings.fragments` is fewer when the K-buffer would not
+    /// fit one binding at this size).
+    pub(in crate::render) requested_fragments: u32,
+}
 
 impl Renderer {
     /// Renders one tile of a larger still with `camera` (the image size becomes the tile's; the
@@ -22,11 +42,11 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         self.set_size(ctx, tile.size[0], tile.size[1])?;
         self.invalidate_visibility();
-        self.camera_view = *camera;
-        self.tile = Some(tile);
+        self.view.camera_view = *camera;
+        self.view.tile = Some(tile);
         let u = camera.tile_uniform(&tile, self.settings.min_width_px);
         ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&u));
+            .write_buffer(&self.view.camera, 0, bytemuck::bytes_of(&u));
         self.update_shading_mode(&ctx.device);
         self.restart_refinement();
         Ok(())
@@ -34,15 +54,15 @@ impl Renderer {
 
     pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) {
         self.invalidate_visibility();
-        self.camera_view = *camera;
-        self.tile = None;
+        self.view.camera_view = *camera;
+        self.view.tile = None;
         let u = camera.uniform(
             self.settings.width,
             self.settings.height,
             self.settings.min_width_px,
         );
         ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&u));
+            .write_buffer(&self.view.camera, 0, bytemuck::bytes_of(&u));
         self.update_shading_mode(&ctx.device);
         self.restart_refinement();
     }
@@ -50,32 +70,32 @@ impl Renderer {
     pub fn set_lights(&mut self, ctx: &GpuContext, lights: &[SrbfLight]) {
         let v = gpu_lights(lights);
         let bytes: &[u8] = bytemuck::cast_slice(&v);
-        if bytes.len() as u64 > self.lights.size() {
-            self.lights = crate::gpu::context::buffer_init(
+        if bytes.len() as u64 > self.scene.lights.size() {
+            self.scene.lights = crate::gpu::context::buffer_init(
                 &ctx.device,
                 "lights",
                 bytes,
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             );
         } else {
-            ctx.queue.write_buffer(&self.lights, 0, bytes);
+            ctx.queue.write_buffer(&self.scene.lights, 0, bytes);
         }
-        self.light_count = lights.len() as u32;
-        if self.light_count != self.shadow_grid.light_count {
-            self.shadow_grid = self.shadow_grid.with_lights(
+        self.scene.light_count = lights.len() as u32;
+        if self.scene.light_count != self.scene.shadow_grid.light_count {
+            self.scene.shadow_grid = self.scene.shadow_grid.with_lights(
                 &ctx.device,
-                self.light_count,
-                self.skip,
+                self.scene.light_count,
+                self.scene.skip,
                 self.settings.multiple_scattering,
             );
             self.grid_buffer_made();
         }
         // An absorption change made while no grid read it (no lights) waits in the volume: the
         // grid's forward terms read it now.
-        if self.volume_absorption_old
+        if self.stale.volume_absorption_old
             && self.settings.shadows
             && self.settings.multiple_scattering
-            && self.light_count > 0
+            && self.scene.light_count > 0
         {
             self.mark_volume_dirty();
         } else {
@@ -85,7 +105,7 @@ impl Renderer {
     }
 
     pub fn light_count(&self) -> u32 {
-        self.light_count
+        self.scene.light_count
     }
 
     /// The image size changed (the editor's viewport): new frame targets and shading bands; the
@@ -122,9 +142,9 @@ impl Renderer {
             binding_limit(&ctx.device),
             width,
             height,
-            self.requested_fragments,
+            self.view.requested_fragments,
         );
-        self.targets = FrameTargets::new(
+        self.view.targets = FrameTargets::new(
             &ctx.device,
             width,
             height,
@@ -133,7 +153,7 @@ impl Renderer {
         );
         // The camera uniform holds the image size (projection aspect, pixel rays); a tile's is written
         // by set_camera_tile after this.
-        let camera = self.camera_view;
+        let camera = self.view.camera_view;
         self.set_camera(ctx, &camera);
         self.update_batches(&ctx.device);
         Ok(())
@@ -149,14 +169,14 @@ impl Renderer {
         }
         if multiple_scattering != self.settings.multiple_scattering {
             // The grid's layout (and what it holds) depends on multiple scattering.
-            self.shadow_grid = self.shadow_grid.with_lights(
+            self.scene.shadow_grid = self.scene.shadow_grid.with_lights(
                 &ctx.device,
-                self.light_count,
-                self.skip,
+                self.scene.light_count,
+                self.scene.skip,
                 multiple_scattering,
             );
             self.grid_buffer_made();
-            self.shadow_grid_dirty = true;
+            self.stale.shadow_grid_dirty = true;
             self.refinement.grid.done = 0;
         }
         self.settings.shadows = shadows;
@@ -164,7 +184,7 @@ impl Renderer {
         self.update_batches(&ctx.device);
         // The grid's forward terms read the volume's absorption, and the grid is rebuilt now: the
         // volume first, so that it is rebuilt once.
-        if self.volume_absorption_old && shadows && multiple_scattering {
+        if self.stale.volume_absorption_old && shadows && multiple_scattering {
             self.mark_volume_dirty();
         }
     }
@@ -172,7 +192,7 @@ impl Renderer {
     /// Exposure in stops applied by the resolve pass (and by `read_frame`).
     pub fn set_exposure(&mut self, ctx: &GpuContext, exposure: f32) {
         self.settings.exposure = exposure;
-        self.resolve_params.exposure_scale = exposure.exp2();
+        self.view.resolve_params.exposure_scale = exposure.exp2();
         self.resolve_again(ctx, "exposure");
     }
 
@@ -180,18 +200,18 @@ impl Renderer {
     /// by `yaw` radians about +Y (world = rotate_yaw(map direction, yaw); a map made for turned lights
     /// gives its own `yaw`). The resolve writes it with every image; here once more for the current one.
     pub fn set_background(&mut self, ctx: &GpuContext, map: Option<&BackgroundMap>, yaw: f32) {
-        let r = &mut self.resolve_params;
+        let r = &mut self.view.resolve_params;
         r.env_width = map.map_or(0, |m| m.width);
         r.env_height = map.map_or(0, |m| m.height);
         r.env_yaw = yaw;
-        self.background_map = environment_buffer(&ctx.device, map);
+        self.scene.background_map = environment_buffer(&ctx.device, map);
         self.resolve_again(ctx, "background");
     }
 
     /// Turns the background (the environment's yaw changed; no upload).
     pub fn set_background_yaw(&mut self, ctx: &GpuContext, yaw: f32) {
-        if self.resolve_params.env_yaw != yaw {
-            self.resolve_params.env_yaw = yaw;
+        if self.view.resolve_params.env_yaw != yaw {
+            self.view.resolve_params.env_yaw = yaw;
             self.resolve_again(ctx, "background yaw");
         }
     }
@@ -200,9 +220,9 @@ impl Renderer {
     /// resolve changed, which runs after every unit anyway.
     pub(super) fn resolve_again(&mut self, ctx: &GpuContext, label: &str) {
         ctx.queue.write_buffer(
-            &self.resolve_info,
+            &self.view.resolve_info,
             0,
-            bytemuck::bytes_of(&self.resolve_params),
+            bytemuck::bytes_of(&self.view.resolve_params),
         );
         let mut enc = ctx
             .device
@@ -210,30 +230,30 @@ impl Renderer {
         // Rows the last shading batch has finished resolve as render_frame's; the others normalised
         // while refinement runs.
         let height = self.settings.height;
-        let done = self.converged_rows.min(height);
+        let done = self.stale.converged_rows.min(height);
         for (rows, normalise) in [(0..done, false), (done..height, true)] {
             if rows.is_empty() {
                 continue;
             }
-            self.resolve_pass.encode(
+            self.passes.resolve_pass.encode(
                 &ctx.device,
                 &mut enc,
-                &self.camera,
-                &self.resolve_info,
-                &self.background_map,
-                &self.targets,
+                &self.view.camera,
+                &self.view.resolve_info,
+                &self.scene.background_map,
+                &self.view.targets,
                 rows,
                 (true, normalise),
                 None,
             );
         }
         if let Some(p) = &self.preview {
-            self.resolve_pass.encode(
+            self.passes.resolve_pass.encode(
                 &ctx.device,
                 &mut enc,
                 &p.camera,
-                &self.resolve_info,
-                &self.background_map,
+                &self.view.resolve_info,
+                &self.scene.background_map,
                 &p.targets,
                 0..p.targets.height,
                 (true, false),
@@ -245,11 +265,11 @@ impl Renderer {
 
     /// Whether the resolve writes a background (a map was given to [`Renderer::set_background`]).
     pub fn has_background(&self) -> bool {
-        self.resolve_params.env_width > 0
+        self.view.resolve_params.env_width > 0
     }
 
     /// The frame's targets (the display pass reads the beauty).
     pub fn targets(&self) -> &FrameTargets {
-        &self.targets
+        &self.view.targets
     }
 }
