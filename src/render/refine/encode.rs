@@ -3,10 +3,7 @@
 
 use super::WorkUnit;
 use crate::gpu::GpuContext;
-use crate::render::passes::shading::FLAG_SEGMENTS;
-use crate::render::passes::shading::FLAG_SINGLE_KEPT;
-use crate::render::passes::shading::ShadeBatch;
-use crate::render::passes::shading::ShadingPass;
+use crate::render::passes::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
 use crate::render::passes::shadow_grid::SWEEP_SLOTS;
 use crate::render::renderer::Renderer;
 

@@ -5,9 +5,7 @@ use super::{RenderError, Renderer, SceneOccluder, all_ms_pairs};
 use crate::gpu::GpuContext;
 use crate::gpu::fiber_density::GpuHair;
 use crate::hair::Hair;
-use crate::render::passes::occluder::GpuOccluder;
-use crate::render::passes::occluder::Occluder;
-use crate::render::passes::occluder::SHADOW_OFFSET_SPACINGS;
+use crate::render::passes::occluder::{GpuOccluder, Occluder, SHADOW_OFFSET_SPACINGS};
 use crate::shadow::solid::solid_fraction;
 
 impl Renderer {

@@ -6,14 +6,10 @@ use crate::gpu::GpuContext;
 use crate::gpu::density_pyramid::DensityPyramidPass;
 use crate::gpu::fiber_density::FiberDensityPass;
 use crate::render::passes::resolve::ResolvePass;
-use crate::render::passes::shading::FLAG_MULTIPLE_SCATTERING;
-use crate::render::passes::shading::FLAG_SEGMENTS;
-use crate::render::passes::shading::FLAG_SHADOWS;
-use crate::render::passes::shading::ShadeBatch;
-use crate::render::passes::shading::ShadingInputs;
-use crate::render::passes::shading::ShadingPass;
-use crate::render::passes::shadow_grid::ShadowGridInputs;
-use crate::render::passes::shadow_grid::ShadowGridPass;
+use crate::render::passes::shading::{
+    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
+};
+use crate::render::passes::shadow_grid::{ShadowGridInputs, ShadowGridPass};
 use crate::render::passes::visibility::VisibilityPass;
 use glam::Vec3;
 

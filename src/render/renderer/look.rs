@@ -11,10 +11,8 @@ use crate::render::reference::REFERENCE_VARIANT;
 use crate::render::renderer::table_cache::with_cache;
 use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::dual_terms::DualTables;
-use crate::scattering::fast_params::DEFAULT_QUADRATURE_SEGMENTS;
-use crate::scattering::fast_params::FastHairParams;
-use crate::scattering::params::HairParams;
-use crate::scattering::params::LongitudinalModel;
+use crate::scattering::fast_params::{DEFAULT_QUADRATURE_SEGMENTS, FastHairParams};
+use crate::scattering::params::{HairParams, LongitudinalModel};
 use crate::shadow::forward::ForwardTable;
 use std::sync::Arc;
 

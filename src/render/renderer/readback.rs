@@ -3,8 +3,7 @@
 use super::{RenderError, Renderer};
 use crate::gpu::GpuContext;
 use crate::render::frame::Frame;
-use crate::render::passes::targets::COMPONENTS;
-use crate::render::passes::targets::FrameTargets;
+use crate::render::passes::targets::{COMPONENTS, FrameTargets};
 
 /// (width, height, occluder samples, K-buffer slots) of a frame's targets.
 type Shape = (u32, u32, u32, u32);

@@ -1,11 +1,9 @@
 //! What a render is asked for besides the scene: image, K-buffer, volume and shadow-grid settings.
 
 use crate::hair::Hair;
-use crate::render::passes::kbuffer::DEFAULT_FRAGMENTS;
-use crate::render::passes::kbuffer::Tail;
+use crate::render::passes::kbuffer::{DEFAULT_FRAGMENTS, Tail};
 use crate::shadow::grid::ShadowGrid;
-use crate::shadow::voxels::MAX_DIM;
-use crate::shadow::voxels::VolumeGrid;
+use crate::shadow::voxels::{MAX_DIM, VolumeGrid};
 
 /// What does not change from frame to frame without rebuilding targets.
 #[derive(Clone, Debug, PartialEq)]
