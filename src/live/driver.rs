@@ -6,7 +6,7 @@
 //! shows what a finished unit left. It knows no UI: the editor wraps it (texture upload, repaints),
 //! and `bench` and the tests drive the same driver, on the same render thread ([`super::pump`]).
 
-use super::jobs::Job;
+use super::tables::{HandedOver, TableWork};
 use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
 use crate::hair::Hair;
@@ -19,11 +19,9 @@ use crate::render::passes::background::{Background, BackgroundMap};
 use crate::render::passes::occluder::Occluder;
 use crate::render::refine::preview::PreviewMode;
 use crate::render::refine::{ImageReady, Progress};
-use crate::render::renderer::{ParamTables, TableBuild, build_tables};
+use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
-use crate::scattering::HairParams;
-use crate::scattering::azimuthal_table::AzimuthalTable;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{
     LoadedHairSource, base_absorption, mean_absorption, occluder_mesh, renderer_look,
@@ -90,8 +88,6 @@ pub enum LiveError {
     #[error(transparent)]
     Assemble(#[from] AssembleError),
 }
-
-type Tables = (HairParams, TableBuild);
 
 /// The least time between two UI frames for refinement's progress on a software GPU: there a UI
 /// frame (egui's 1280x800 window rasterised and presented by lavapipe) costs ~75 ms of the same two
@@ -306,19 +302,12 @@ pub struct LiveDriver {
     /// the last one.
     shown_count: u64,
     shown_restart: u64,
-    tables: Option<Job<Tables>>,
-    /// The parameters of the tables being built.
-    tables_building: Option<HairParams>,
+    /// The tables on their way to the renderer.
+    tables: TableWork,
     /// A camera held back while a preview is under way.
     wanted_camera: Option<Camera>,
-    /// Tables to build (for these parameters, reusing this azimuthal table when it fits).
-    wanted_tables: Option<(HairParams, Arc<AzimuthalTable>)>,
-    /// Tables built but not yet handed to the renderer (see `step`).
-    held_tables: Option<Tables>,
     /// The budget's share for units while tables are wanted or built ([`budget_share`], found once).
     building_share: f64,
-    /// The last table build died (a draft in the renderer then stays).
-    tables_failed: bool,
     pub progress: Option<Progress>,
     /// When the current refinement started, and how long it took to converge.
     pub refine_started: Instant,
@@ -435,13 +424,9 @@ impl LiveDriver {
             warning_announced: false,
             shown_count: 0,
             shown_restart: 0,
-            tables: None,
-            tables_building: None,
+            tables: TableWork::new(),
             wanted_camera: None,
-            wanted_tables: None,
-            held_tables: None,
             building_share: budget_share(&ctx, true),
-            tables_failed: false,
             progress: None,
             refine_started: Instant::now(),
             converged_in: None,
@@ -613,33 +598,8 @@ impl LiveDriver {
     /// The look in the renderer's form goes to the renderer now (single scattering shows it at
     /// once); its tables are built off the UI thread when the parameters they depend on changed.
     pub(super) fn set_look_deferred(&mut self, look: HairLook) {
-        let fits = |p: &HairParams| crate::render::renderer::same_tables(p, &look.params);
-        // Tables built or being built for parameters that differ only in the absorption serve (a
-        // draft's table follows it).
-        let held_fits = self
-            .held_tables
-            .as_ref()
-            .is_some_and(|(p, t)| fits(p) && !t.azimuthal_only())
-            || (self.tables.is_some() && self.tables_building.as_ref().is_some_and(fits));
-        if self.renderer.set_params_deferred(&self.ctx, &look) && !held_fits {
-            let params = look.params;
-            // The azimuthal table of the held tables when it fits (an eta change in the works),
-            // else the renderer's: rebuilt only for a new eta or eccentricity.
-            let azimuthal = self
-                .held_tables
-                .as_ref()
-                .map(|(_, t)| t.azimuthal().clone())
-                .filter(|t| t.fits_hair(&params))
-                .unwrap_or_else(|| self.renderer.azimuthal_table().clone());
-            // A newer build replaces an older one; take_tables ignores stale tables anyway. It
-            // starts once the change's preview is on screen (`step`): on two cores the build
-            // would slow the preview, and a slider drag would start one per frame.
-            self.held_tables = None;
-            self.wanted_tables = Some((params, azimuthal));
-        } else {
-            // The renderer's or the held tables fit: an intermediate look's build is not wanted.
-            self.wanted_tables = None;
-        }
+        let needs = self.renderer.set_params_deferred(&self.ctx, &look);
+        self.tables.look_changed(&look, needs, &self.renderer);
     }
 
     /// A new environment (already loaded, with the map shown behind the hair), turned by the
@@ -744,85 +704,29 @@ impl LiveDriver {
         }
         // The tables' build starts once the change shows (or the image is converged: a change the
         // frame does not read before its tables), at once without a preview, or for a new eta or
-        // eccentricity, which shows only with an azimuthal table made for it: its draft at once, the
-        // table once the draft's preview shows.
-        let start = self
-            .wanted_tables
-            .as_ref()
-            .is_some_and(|(params, azimuthal)| {
-                // One build at a time (a slider drag would pile them up on the GPU's cores), but
-                // tables the process keeps (an undo after a new eta's draft) need none.
-                (self.tables.is_none() || crate::render::renderer::table_cache::holds(params))
-                    && (self.first_image_in().is_some()
-                        || self.progress.is_some_and(|p| p.converged)
-                        || self.renderer.preview_factor() < 2
-                        || !azimuthal.made_for_hair(params))
-            });
-        if start && let Some((params, azimuthal)) = self.wanted_tables.take() {
-            // A build under way (only when the process keeps these tables) is for parameters left
-            // behind: its result is dropped.
-            self.tables = None;
-            self.tables_building = Some(params);
-            // A new eta or eccentricity shows first with a draft of its azimuthal table alone (a
-            // twelfth of the build), then with the tables, built next.
-            let draft = !azimuthal.made_for_hair(&params);
-            self.tables = Some(Job::spawn(
-                "hair tables",
-                || {},
-                move |_| (params, TableBuild::build(&params, Some(&azimuthal), draft)),
-            ));
-        }
-        let finished = self.tables.as_mut().and_then(|job| job.poll());
-        match finished {
-            Some(Ok(tables)) => {
-                self.tables = None;
-                self.tables_failed = false;
-                self.held_tables = Some(tables);
-            }
-            // A table build that died leaves the old tables (the shading still follows the look), or
-            // the draft: then the image is as final as it gets (`tables_pending`).
-            Some(Err(_)) => {
-                self.tables = None;
-                self.tables_failed = true;
-            }
-            None => {}
-        }
+        // eccentricity: its draft at once, the table once the draft's preview shows.
+        let change_shown = self.first_image_in().is_some()
+            || self.progress.is_some_and(|p| p.converged)
+            || self.renderer.preview_factor() < 2;
+        self.tables.start(change_shown);
+        self.tables.poll();
         // New tables restart the refinement (with dual scattering, from the shadow grid, whose forward
         // terms read them), and so does a deferred absorption change (from the volume). Right after a
         // change the refinement shows a preview, then the full image with the old grid: rebuild once
-        // that full image is on screen, so the change shows sharp in about one pass's time and its
-        // multiple scattering follows. Tables go over at once when the grid is being rebuilt anyway
-        // (one rebuild, not two) or when the azimuthal table is new (an eta or eccentricity change
-        // shows only with a table made for it: its draft, then the table); anything waiting goes over
-        // when the refinement has nothing left to show.
+        // that full image is on screen ([`TableWork::hand_over`]); anything waiting goes over when the
+        // refinement has nothing left to show.
         let shown = self.full_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
-        let hand_over = self.held_tables.as_ref().is_some_and(|(_, t)| {
-            shown
-                || self.renderer.shadow_grid_stale()
-                || !Arc::ptr_eq(t.azimuthal(), self.renderer.azimuthal_table())
-        });
-        if hand_over
-            && let Some((params, tables)) = self.held_tables.take()
-            && self.renderer.take_tables(&self.ctx, &params, &tables)
-        {
-            if tables.azimuthal_only() {
-                // A new eta or eccentricity shows from here (its preview); the tables are built once
-                // that preview shows, unless a newer change asked for other tables meanwhile.
-                if self.wanted_tables.is_none() {
-                    self.wanted_tables = Some((params, tables.azimuthal().clone()));
-                }
-                self.showing_anew();
-            } else {
-                self.restarted_as_refinement();
-            }
+        match self.tables.hand_over(&self.ctx, &mut self.renderer, shown) {
+            Some(HandedOver::Draft) => self.showing_anew(),
+            Some(HandedOver::Tables) => self.restarted_as_refinement(),
+            None => {}
         }
         // With tables on the way, the volume waits for them: they rebuild the grid too.
-        let tables_waiting =
-            self.wanted_tables.is_some() || self.tables.is_some() || self.held_tables.is_some();
-        if shown && !tables_waiting && !self.painting && self.renderer.rebuild_stale_volume() {
+        if shown && !self.tables.waiting() && !self.painting && self.renderer.rebuild_stale_volume()
+        {
             self.restarted_as_refinement();
         }
-        let building = self.wanted_tables.is_some() || self.tables.is_some();
+        let building = self.tables.building();
         self.renderer
             .set_budget_share(if building { self.building_share } else { 1.0 });
         let progress = self.renderer.refine(&self.ctx)?;
@@ -1018,10 +922,6 @@ impl LiveDriver {
     /// Whether tables are still being built or not yet handed to the renderer, or a deferred
     /// absorption change still waits for its volume: the image is not the session's final one yet.
     pub fn tables_pending(&self) -> bool {
-        self.wanted_tables.is_some()
-            || self.tables.is_some()
-            || self.held_tables.is_some()
-            || (self.renderer.azimuthal_table().draft && !self.tables_failed)
-            || self.renderer.volume_stale()
+        self.tables.pending(&self.renderer) || self.renderer.volume_stale()
     }
 }

@@ -10,6 +10,7 @@ pub mod jobs;
 pub mod load;
 pub mod picking;
 pub mod pump;
+pub mod tables;
 
 pub use dab::{Dab, DabError};
 pub use driver::{LiveDriver, LiveError, Prepared, StepOutcome, ViewSettings, prepare};
