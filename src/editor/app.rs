@@ -2,18 +2,18 @@
 //! (camera, view, messages), the live scene and the background jobs. Panels read a per-frame view of
 //! this and return [`Edit`]s; [`EditorApp::perform`] is the one place edits are applied.
 
-use super::autosave::Autosave;
 use super::export::ExportJob;
 use super::live::{LiveScene, ViewSettings};
 use super::navigation;
 use super::panels;
 use crate::gpu::GpuContext;
 use crate::live::LiveDriver;
-use crate::live::jobs::Job;
+use crate::jobs::{Job, Wake};
 use crate::render::Camera;
 use crate::render::scene::Environment;
 use crate::scattering::lut::Luts;
 use crate::session::assemble::{load_environment_source, load_hair_source};
+use crate::session::autosave::{self, Autosave};
 use crate::session::{Edit, EnvironmentSource, HairSource, History, Session, ViewCamera};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -191,6 +191,8 @@ pub struct EditorApp {
     logged: Option<(u64, Duration)>,
     frames_since_change: usize,
     ctx: egui::Context,
+    /// Asks egui for a frame (what background jobs call when they are done).
+    wake: Wake,
 }
 
 impl EditorApp {
@@ -299,9 +301,13 @@ impl EditorApp {
             logged: None,
             frames_since_change: 0,
             ctx: cc.egui_ctx.clone(),
+            wake: {
+                let ctx = cc.egui_ctx.clone();
+                Arc::new(move || ctx.request_repaint())
+            },
         };
         if let Some(file) = &options.recover {
-            match super::autosave::read_recovery(file) {
+            match autosave::read_recovery(file) {
                 Ok((path, session, warning)) => {
                     app.adopt_recovery(file, path, session);
                     app.message(
@@ -312,7 +318,7 @@ impl EditorApp {
                         app.message(Level::Warning, w);
                     }
                 }
-                Err(e) => app.message(Level::Error, e),
+                Err(e) => app.message(Level::Error, e.to_string()),
             }
         }
         if let Some(g) = &app.gpu {
@@ -431,9 +437,9 @@ impl EditorApp {
         self.failed = None;
         self.autosave.changed();
         if let Err(e) = self.autosave.on_exit(&self.session.clone(), true) {
-            self.message(Level::Warning, e);
+            self.message(Level::Warning, e.to_string());
         } else if file != self.autosave.path {
-            super::autosave::remove_recovery(file);
+            autosave::remove_recovery(file);
         }
     }
 
@@ -650,7 +656,7 @@ impl EditorApp {
                 if self.modified() {
                     // The unsaved work stays in its recovery file (offered at the next start).
                     if let Err(e) = self.autosave.on_exit(&self.session, true) {
-                        self.message(Level::Warning, e);
+                        self.message(Level::Warning, e.to_string());
                     } else {
                         let kept = self.autosave.path.display().to_string();
                         self.message(
@@ -859,8 +865,10 @@ impl EditorApp {
                 Err(e) => self.message(Level::Error, e),
             }
         }
-        if let Some(err) = self.autosave.tick(&self.session, &self.ctx) {
-            self.message(Level::Warning, err);
+        match self.autosave.tick(&self.session, &self.wake) {
+            Ok(Some(due)) => self.ctx.request_repaint_after(due),
+            Ok(None) => {}
+            Err(e) => self.message(Level::Warning, e.to_string()),
         }
     }
 

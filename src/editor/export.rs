@@ -6,7 +6,7 @@
 use super::app::Level;
 use crate::gpu::GpuContext;
 use crate::live::LiveDriver;
-use crate::live::jobs::Job;
+use crate::jobs::Job;
 use crate::render::Renderer;
 use crate::render::background::Background;
 use crate::render::camera::Tile;

@@ -1,10 +1,9 @@
 //! The editor (eframe + egui on wgpu): a session edited live in a window. The session model, scene
 //! assembly and renderer live in the library and serve the CLI too; this module holds the app state and
 //! frame loop ([`app`]), the live driver's image in egui ([`live`]), navigation, background jobs,
-//! autosave, export and one module per panel.
+//! export and one module per panel (autosave and recovery are the session's: `session::autosave`).
 
 pub mod app;
-pub mod autosave;
 pub mod brush_tool;
 pub mod env_preview;
 pub mod export;

@@ -4,7 +4,6 @@
 
 use super::model::{SESSION_VERSION, Session};
 use crate::files::write_atomic;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]

@@ -78,7 +78,7 @@ fn recovery_prompt(app: &mut EditorApp, ctx: &egui::Context) {
         app.load_scene();
         app.message(Level::Info, "recovered the unsaved session");
     } else {
-        crate::editor::autosave::remove_recovery(&file);
+        crate::session::autosave::remove_recovery(&file);
     }
 }
 
