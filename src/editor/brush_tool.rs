@@ -1,10 +1,11 @@
 //! The brush tool (B; V or Esc back to navigation): left-drag paints absorption onto the strands under
-//! the cursor. Dabs are spaced along the pointer path at a fraction of the radius; each changes the
-//! session's paint layer at the points it touches and sends only those to the renderer. A stroke is
-//! one undo step holding the touched points' previous values.
+//! the cursor. Dabs are spaced along the pointer path at a fraction of the radius; each is an edit of
+//! the session's paint layer at the points it touches, applied through the history as part of the
+//! stroke's gesture, and only those points go to the renderer. A stroke is one undo step holding the
+//! touched points' previous values.
 
 use super::app::{EditorApp, Level};
-use crate::live::{Dab, DabError};
+use crate::live::{Dab, DabEdit, DabError};
 use crate::paint::PaintDelta;
 use crate::paint::brush::Stroke;
 use crate::paint::pick::dabs_along;
@@ -27,8 +28,6 @@ pub struct StrokeState {
     /// Dabs found no picker for the view yet (they are dropped: the stroke paints from where the
     /// picker is ready); reported once.
     waiting: bool,
-    /// The session had no paint layer before this stroke: its undo step removes the layer again.
-    created_layer: bool,
 }
 
 /// What the brush measured (the status bar and the benchmark).
@@ -68,7 +67,6 @@ impl EditorApp {
                 last: p,
                 carry: 0.0,
                 waiting: false,
-                created_layer: false,
             });
             self.dab_at(&[p], pressure);
         } else if let (Some(p), Some(s)) = (to, &self.stroke) {
@@ -108,14 +106,25 @@ impl EditorApp {
         };
         let (result, restarts) = {
             let mut d = live.lock();
-            let r = d.dab(
-                &mut self.session,
-                &mut stroke.stroke,
-                &self.brush,
-                centres,
-                radius,
-                pressure,
-            );
+            let r = d
+                .dab_edit(
+                    &self.session,
+                    &mut stroke.stroke,
+                    &self.brush,
+                    centres,
+                    radius,
+                    pressure,
+                )
+                .and_then(|DabEdit { dab, edit, changed }| {
+                    // The dab is an edit of the stroke's gesture: one undo step for the stroke.
+                    if let Some(edit) = edit
+                        && self.history.perform(&mut self.session, edit, true)
+                    {
+                        self.autosave.changed();
+                        d.paint_points(&self.session, &changed)?;
+                    }
+                    Ok(dab)
+                });
             (r, d.restarts())
         };
         live.kick();
@@ -125,13 +134,7 @@ impl EditorApp {
             self.pending_dab = Some((self.frame_started.unwrap_or(t), restarts));
         }
         let n = match result {
-            Ok(Dab::Painted {
-                points,
-                created_layer,
-            }) => {
-                stroke.created_layer |= created_layer;
-                points
-            }
+            Ok(Dab::Painted { points, .. }) => points,
             Ok(Dab::Waiting) => {
                 if !stroke.waiting {
                     stroke.waiting = true;
@@ -161,36 +164,18 @@ impl EditorApp {
         st.last_points = n;
     }
 
-    /// The stroke ends: it becomes one undo step (one that removes the layer again when the stroke
-    /// made it).
+    /// The stroke ends: its gesture closes, so its dabs are one undo step (one that removes the layer
+    /// again when the stroke made it).
     pub fn end_stroke(&mut self) {
-        let Some(s) = self.stroke.take() else {
+        if self.stroke.take().is_none() {
             return;
-        };
+        }
         if let Some(live) = &self.live {
             // The volume and grid may follow now, whatever the stroke left.
             live.lock().end_painting();
             live.kick();
         }
-        let Some(layer) = &self.session.paint_layer else {
-            return;
-        };
-        let delta = s.stroke.finish(&layer.get().points);
-        match (delta, s.created_layer) {
-            (None, true) => self.session.paint_layer = None,
-            (None, false) => {}
-            (Some(_), true) => {
-                self.history.record(Edit::PaintLayer(Box::new((
-                    None,
-                    self.session.paint.clone(),
-                ))));
-                self.autosave.changed();
-            }
-            (Some(delta), false) => {
-                self.history.record(Edit::Paint(Box::new(delta)));
-                self.autosave.changed();
-            }
-        }
+        self.history.end_gesture(&self.session);
         let finished = self
             .live
             .as_ref()
@@ -221,7 +206,7 @@ impl EditorApp {
         let look = self.session.look;
         let scale = look.thickness_scale;
         let wake = self.egui_ctx();
-        self.hair_export = Some(crate::live::jobs::Job::spawn(
+        self.hair_export = Some(crate::jobs::Job::spawn(
             "exporting the hair",
             move || wake.request_repaint(),
             move |_| {

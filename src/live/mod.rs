@@ -11,6 +11,6 @@ pub mod load;
 pub mod picking;
 pub mod pump;
 
-pub use dab::{Dab, DabError};
+pub use dab::{Dab, DabEdit, DabError};
 pub use driver::{LiveDriver, LiveError, Prepared, StepOutcome, ViewSettings, prepare};
 pub use pump::LiveHandle;
