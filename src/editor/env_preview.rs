@@ -11,6 +11,8 @@ use std::sync::Arc;
 pub const PREVIEW_WIDTH: usize = 192;
 pub const PREVIEW_HEIGHT: usize = 96;
 
+/// The textures are handles: a clone shares them (the scene panel keeps one in egui's memory).
+#[derive(Clone)]
 pub struct EnvPreview {
     /// The environment it was made for (its name and light count).
     pub key: (String, usize),
