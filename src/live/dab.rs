@@ -102,8 +102,9 @@ impl LiveDriver {
         let layer: &PaintLayer = match &session.paint_layer {
             Some(l) => l.get(),
             None => made.insert(match &session.paint {
-                Some(path) => PaintLayer::read(path)
-                    .map_err(|e| DabError::UnreadablePaint(e.to_string()))?,
+                Some(path) => {
+                    PaintLayer::read(path).map_err(|e| DabError::UnreadablePaint(e.to_string()))?
+                }
                 None => PaintLayer::empty(points, strands),
             }),
         };

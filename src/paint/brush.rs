@@ -400,7 +400,11 @@ impl PaintDelta {
     /// it was before the stroke). Both are sorted by index, and so is the result.
     pub fn keep_earliest(&mut self, later: PaintDelta) {
         let mut merged = Vec::with_capacity(self.indices.len() + later.indices.len());
-        let mut mine = self.indices.iter().copied().zip(self.values.iter().copied());
+        let mut mine = self
+            .indices
+            .iter()
+            .copied()
+            .zip(self.values.iter().copied());
         let mut theirs = later.indices.into_iter().zip(later.values).peekable();
         for (i, v) in mine.by_ref() {
             while let Some(&(j, w)) = theirs.peek()
@@ -553,8 +557,14 @@ mod tests {
         let changed = Stroke::new().dab(&brush, under, &mut over, &base, |_| 0..5, [0.4, 0.8, 1.6]);
         let mut delta = over.into_delta().expect("a change");
         assert_eq!(delta.indices, changed);
-        let changed_direct =
-            Stroke::new().dab(&brush, under, &mut direct[..], &base, |_| 0..5, [0.4, 0.8, 1.6]);
+        let changed_direct = Stroke::new().dab(
+            &brush,
+            under,
+            &mut direct[..],
+            &base,
+            |_| 0..5,
+            [0.4, 0.8, 1.6],
+        );
         assert_eq!(changed, changed_direct);
         let mut layer = before.clone();
         delta.swap(&mut layer);

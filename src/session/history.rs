@@ -255,7 +255,11 @@ mod tests {
             }
             h.end_gesture(&s);
         }
-        assert_eq!(h.undo.last().map(Edit::bytes), Some(step), "20 bytes a point");
+        assert_eq!(
+            h.undo.last().map(Edit::bytes),
+            Some(step),
+            "20 bytes a point"
+        );
         assert!(h.bytes() <= 2 * step + 10, "{}", h.bytes());
         let painted = s.clone();
         assert!(h.undo(&mut s).is_some() && h.undo(&mut s).is_some());
