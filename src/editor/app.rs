@@ -2,7 +2,10 @@
 //! jobs and the messages, each a small struct of its own; once a frame it polls the jobs and the
 //! device, reads the shortcuts, tells the live driver what changed, shows the panels with a
 //! read-only [`PanelContext`], and handles the commands they sent ([`EditorApp::handle`], in
-//! `handling.rs`), edits among them, in one place.
+//! `app/handling.rs`), edits among them, in one place. The app's parts are private to it (and to
+//! its handling, a child module).
+
+mod handling;
 
 use super::command::{AppCommand, DEFAULT_LIGHTS, Dialog};
 use super::context::{JobsView, PanelContext};
@@ -30,24 +33,24 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub struct EditorApp {
-    pub(super) doc: Document,
-    pub(super) viewport: Viewport,
-    pub(super) tools: Tools,
-    pub(super) loader: Loader,
-    pub(super) exports: Exports,
-    pub(super) device: DeviceWatch,
-    pub(super) gpu: Option<GpuContext>,
-    pub(super) luts: Arc<Luts>,
-    pub(super) messages: Messages,
-    pub(super) recent: RecentFiles,
+    doc: Document,
+    viewport: Viewport,
+    tools: Tools,
+    loader: Loader,
+    exports: Exports,
+    device: DeviceWatch,
+    gpu: Option<GpuContext>,
+    luts: Arc<Luts>,
+    messages: Messages,
+    recent: RecentFiles,
     /// A recovery file of an earlier run: the file, the session file it belonged to, the session.
-    pub(super) recovery_offer: Option<(PathBuf, PathBuf, Session)>,
-    pub(super) timing: FrameTiming,
-    pub(super) options: EditorOptions,
-    pub(super) started: Instant,
-    pub(super) ctx: egui::Context,
+    recovery_offer: Option<(PathBuf, PathBuf, Session)>,
+    timing: FrameTiming,
+    options: EditorOptions,
+    started: Instant,
+    ctx: egui::Context,
     /// Asks egui for a frame (what background jobs call when they are done).
-    pub(super) wake: Wake,
+    wake: Wake,
 }
 
 impl EditorApp {
@@ -304,20 +307,20 @@ impl EditorApp {
     }
 
     pub fn brush(&self) -> &Brush {
-        self.tools.brush.settings()
+        self.tools.brush().settings()
     }
 
     pub fn set_brush(&mut self, brush: Brush) {
-        *self.tools.brush.settings_mut() = brush;
+        *self.tools.brush_mut().settings_mut() = brush;
     }
 
     pub fn brush_stats(&self) -> super::tools::brush::BrushStats {
-        self.tools.brush.stats()
+        self.tools.brush().stats()
     }
 
     /// The brush radius in render pixels (the panel's radius is in screen points).
     pub fn brush_radius_render_px(&self) -> f32 {
-        self.tools.brush.radius_render_px(&self.viewport)
+        self.tools.brush().radius_render_px(&self.viewport)
     }
 
     /// A scene or a hair, head or environment file is loading.

@@ -5,7 +5,7 @@
 //! [`live_scene`]), the tools ([`tools`]), loads and exports on workers ([`loading`], [`export`]),
 //! the device's health ([`device`]), messages, recent files and frame timing; the panels
 //! ([`panels`]) see a per-frame [`context`] and send [`command`]s, which the app handles in one
-//! place ([`handling`]).
+//! place (`app/handling.rs`).
 
 pub mod app;
 pub mod command;
@@ -14,7 +14,6 @@ pub mod device;
 pub mod document;
 pub mod env_preview;
 pub mod export;
-mod handling;
 pub mod live_scene;
 pub mod loading;
 pub mod messages;

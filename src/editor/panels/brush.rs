@@ -66,7 +66,7 @@ pub fn tools(ctx: &PanelContext, tools: &mut Tools, ui: &mut egui::Ui) {
     });
     tools.select(tool);
     if tool == Tool::Brush {
-        panel(ctx, &mut tools.brush, ui);
+        panel(ctx, tools.brush_mut(), ui);
     }
 }
 

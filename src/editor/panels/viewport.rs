@@ -45,8 +45,10 @@ pub fn show(ctx: &PanelContext, tools: &mut Tools, ui: &mut egui::Ui) {
         tools.keys(ctx, ui.ctx(), pointer);
     }
     if tools.active() == Tool::Brush {
-        tools.brush.viewport_input(ctx, ui, &response, rect, px);
+        tools
+            .brush_mut()
+            .viewport_input(ctx, ui, &response, rect, px);
     } else {
-        tools.brush.drop_adjustment();
+        tools.brush_mut().drop_adjustment();
     }
 }

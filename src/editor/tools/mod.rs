@@ -20,10 +20,18 @@ pub enum Tool {
 #[derive(Default)]
 pub struct Tools {
     active: Tool,
-    pub brush: BrushTool,
+    brush: BrushTool,
 }
 
 impl Tools {
+    pub fn brush(&self) -> &BrushTool {
+        &self.brush
+    }
+
+    pub fn brush_mut(&mut self) -> &mut BrushTool {
+        &mut self.brush
+    }
+
     pub fn active(&self) -> Tool {
         self.active
     }

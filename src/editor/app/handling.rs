@@ -2,11 +2,11 @@
 //! document, the viewport and the jobs change (as rerun's `command_handling.rs`). Edits go through
 //! the document's history, so undo, autosave and the tests replay the same values.
 
-use super::app::EditorApp;
-use super::command::{AppCommand, Dialog};
-use super::device::{DeviceEvent, Restart};
-use super::loading::Loaded;
-use super::messages::Level;
+use super::EditorApp;
+use crate::editor::command::{AppCommand, Dialog};
+use crate::editor::device::{DeviceEvent, Restart};
+use crate::editor::loading::Loaded;
+use crate::editor::messages::Level;
 use crate::paint::PaintDelta;
 use crate::render::Camera;
 use crate::session::{Edit, OccluderOptions, Session, ViewCamera};
@@ -71,7 +71,7 @@ impl EditorApp {
             AppCommand::SetCamera(c) => self.set_camera(c),
             AppCommand::SetView(v) => self.viewport.set_view(v),
             AppCommand::ViewportLaidOut { rect, px } => self.viewport.laid_out(rect, px),
-            AppCommand::Stroke(input) => self.tools.brush.stroke_input(
+            AppCommand::Stroke(input) => self.tools.brush_mut().stroke_input(
                 input,
                 &mut self.doc,
                 &self.viewport,
@@ -124,7 +124,7 @@ impl EditorApp {
 
     fn end_stroke(&mut self) {
         self.tools
-            .brush
+            .brush_mut()
             .end_stroke(&mut self.doc, &self.viewport, &mut self.messages);
     }
 
