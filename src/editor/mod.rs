@@ -11,6 +11,7 @@ pub mod app;
 pub mod command;
 pub mod context;
 pub mod device;
+pub mod dialogs;
 pub mod document;
 pub mod env_preview;
 pub mod export;

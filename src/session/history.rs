@@ -298,6 +298,45 @@ mod tests {
     }
 
     #[test]
+    fn a_stroke_replays_from_its_edits_as_data() {
+        use crate::paint::{PaintDelta, PaintLayer, SharedLayer};
+        let start = Session::default();
+        let mut layer = PaintLayer::empty(8, 2);
+        layer.points[0] = [0.5; 4];
+        let dabs = vec![
+            Edit::PaintLayer(Box::new((Some(SharedLayer::new(layer)), None))),
+            Edit::Paint(Box::new(PaintDelta {
+                indices: vec![0, 5],
+                values: vec![[1.0; 4], [2.0; 4]],
+            })),
+            Edit::Paint(Box::new(PaintDelta {
+                indices: vec![5, 6],
+                values: vec![[3.0; 4], [4.0; 4]],
+            })),
+        ];
+        let mut s = start.clone();
+        let mut h = History::default();
+        for e in &dabs {
+            assert!(h.perform(&mut s, e.clone(), true));
+        }
+        h.end_gesture(&s);
+        // What autosave or a test would keep: the edits as text, applied to the same start.
+        let text = serde_json::to_string(&dabs).unwrap();
+        let mut replayed = start.clone();
+        for e in serde_json::from_str::<Vec<Edit>>(&text).unwrap() {
+            apply(&mut replayed, e);
+        }
+        assert!(replayed == s, "the replay paints the same layer");
+        let points = &replayed.paint_layer.as_ref().unwrap().get().points;
+        assert_eq!(
+            (points[0], points[5], points[6]),
+            ([1.0; 4], [3.0; 4], [4.0; 4])
+        );
+        h.undo(&mut s);
+        assert!(s == start && !h.can_undo(), "one undo step for the stroke");
+    }
+
+    #[test]
     fn clearing_the_paint_layer_is_one_step_that_undoes() {
         use crate::paint::{PaintLayer, SharedLayer};
         let mut layer = PaintLayer::empty(4, 1);
