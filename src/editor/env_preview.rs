@@ -97,6 +97,12 @@ pub fn pictures(env: &Environment, background: Arc<BackgroundMap>) -> EnvPicture
     }
 }
 
+/// The pictures of an environment loaded on its own (a file opened for an edit), with the
+/// background map made from it.
+pub fn pictures_of(env: &Environment) -> EnvPictures {
+    pictures(env, Arc::new(BackgroundMap::from_environment(env)))
+}
+
 /// The pictures as egui textures (the UI thread's part: an upload).
 pub fn upload(ctx: &egui::Context, p: &EnvPictures) -> EnvPreview {
     let name = &p.key.0;

@@ -195,12 +195,7 @@ impl Loader {
                     fitted: Some(Box::new(environment.lights.clone())),
                 };
                 Ok(Loaded::Environment {
-                    pictures: Box::new(env_preview::pictures(
-                        &environment,
-                        Arc::new(crate::render::background::BackgroundMap::from_environment(
-                            &environment,
-                        )),
-                    )),
+                    pictures: Box::new(env_preview::pictures_of(&environment)),
                     environment: Box::new(environment),
                     source,
                 })
