@@ -10,6 +10,7 @@ pub mod envmap;
 pub mod files;
 pub mod gpu;
 pub mod hair;
+pub mod jobs;
 pub mod live;
 pub mod paint;
 pub mod render;

@@ -10,8 +10,9 @@ use egui_kittest::kittest::Queryable;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
-use strandlight::editor::{EditorApp, EditorOptions};
+use strandlight::editor::{AppCommand, EditorApp, EditorOptions};
 use strandlight::hair::procedural::Style;
+use strandlight::live::ViewSettings;
 use strandlight::render::Frame;
 use strandlight::render::refine::WorkUnit;
 use strandlight::session::{HairSource, Session};
@@ -57,14 +58,18 @@ fn harness_with(options: EditorOptions) -> Harness<'static, EditorApp> {
         .with_size(egui::vec2(1100.0, 640.0))
         .wgpu_setup(strandlight::editor::wgpu_setup())
         .build_eframe(move |cc| EditorApp::new(cc, options));
-    h.state_mut().view.scale = 0.25;
+    let view = ViewSettings {
+        scale: 0.25,
+        ..h.state().view()
+    };
+    h.state_mut().handle(AppCommand::SetView(view));
     h
 }
 
 /// Steps the UI until the export under way is written.
 fn wait_for_export(h: &mut Harness<'static, EditorApp>) {
     let t = Instant::now();
-    while h.state().export.is_some() {
+    while h.state().exporting() {
         h.step();
         std::thread::sleep(Duration::from_millis(2));
         assert!(t.elapsed() < Duration::from_secs(300), "the export hangs");
@@ -89,13 +94,13 @@ fn converge(h: &mut Harness<'static, EditorApp>) {
     let t = Instant::now();
     loop {
         h.step();
-        if h.state().converged().is_some() && h.state().loading.is_none() {
+        if h.state().converged().is_some() && !h.state().loading_scene() {
             // One more frame: the display pass of the last unit.
             h.step();
             // The editor shows GPU validation errors instead of panicking: none may have happened.
             assert!(
                 !h.state()
-                    .messages
+                    .messages()
                     .iter()
                     .any(|m| m.text.starts_with("GPU error")),
                 "a GPU error"
@@ -112,17 +117,12 @@ fn converge(h: &mut Harness<'static, EditorApp>) {
 
 /// When the viewport's current refinement started (the last change).
 fn refine_started(h: &Harness<'static, EditorApp>) -> Instant {
-    h.state()
-        .live
-        .as_ref()
-        .expect("a scene")
-        .lock()
-        .refine_started
+    h.state().live().expect("a scene").lock().refine_started
 }
 
 /// The viewport's converged image, read back from the renderer.
 fn image(h: &Harness<'static, EditorApp>) -> Frame {
-    let live = h.state().live.as_ref().expect("a live scene").lock();
+    let live = h.state().live().expect("a live scene").lock();
     live.renderer.read_frame(&live.ctx).expect("read back")
 }
 
@@ -185,15 +185,15 @@ fn refinement_proceeds_without_ui_frames_and_converges() {
     // UI frames until the loaded scene is installed (a frame takes the load job's result), and
     // one more that tells the driver the viewport's size and camera.
     let t = Instant::now();
-    while h.state().live.is_none() {
+    while h.state().live().is_none() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(300), "the scene loads");
     }
     h.step();
     // From here no UI frame runs: the render thread alone refines the image.
-    let frames = h.state().frame_costs.len();
-    let live = h.state().live.as_ref().expect("a scene");
+    let frames = h.state().frames_measured();
+    let live = h.state().live().expect("a scene");
     assert!(
         live.handle().wait_idle(Duration::from_secs(300)),
         "the viewport converged without UI frames"
@@ -207,7 +207,7 @@ fn refinement_proceeds_without_ui_frames_and_converges() {
             d.first_image_in().is_some() && d.full_image_in.is_some(),
         )
     };
-    assert_eq!(h.state().frame_costs.len(), frames, "no UI frame ran");
+    assert_eq!(h.state().frames_measured(), frames, "no UI frame ran");
     println!("converged in {units} units with no UI frame");
     assert!(shown && units > 1);
     // The next frame shows it converged.
@@ -220,7 +220,7 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
     let dir = tmp("equal");
     let mut h = harness(small_session(), &dir, false);
     converge(&mut h);
-    let adapter = h.state().gpu.as_ref().expect("a GPU").summary.name.clone();
+    let adapter = h.state().gpu().expect("a GPU").summary.name.clone();
     assert!(
         h.query_by_label_contains(&adapter).is_some(),
         "the status bar names {adapter}"
@@ -235,7 +235,7 @@ fn the_viewport_equals_render_session_and_the_status_bar_names_the_adapter() {
         (before.width, before.height),
         (image(&h).width, image(&h).height)
     );
-    let centre = h.state().viewport_rect.expect("a viewport").center();
+    let centre = h.state().viewport_rect().expect("a viewport").center();
     middle_drag(&mut h, centre, egui::vec2(30.0, 0.0), egui::Modifiers::NONE);
     converge(&mut h);
     let viewport = image(&h);
@@ -257,7 +257,7 @@ fn against_render_session(
     name: &str,
     got: &Frame,
 ) -> f32 {
-    let mut session = h.state().session.clone();
+    let mut session = h.state().session().clone();
     session.render.width = got.width;
     session.render.height = got.height;
     max_relative_difference(got, &render_session(dir, name, &session))
@@ -339,7 +339,7 @@ fn rebuilds_before_first_image(
     let (mut rebuilds, t) = (0, Instant::now());
     loop {
         h.step();
-        let live = h.state().live.as_ref().expect("a scene").lock();
+        let live = h.state().live().expect("a scene").lock();
         // A rebuild submitted in the step that showed the full image came after it.
         if live.refine_started > before
             && let Some(full) = live.full_image_in
@@ -378,7 +378,7 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     let dir = tmp("edits");
     let mut h = harness(small_session(), &dir, false);
     converge(&mut h);
-    let before_session = h.state().session.clone();
+    let before_session = h.state().session().clone();
     let before = image(&h);
     let brown = mean_luminance(&before);
 
@@ -400,23 +400,20 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
     // The environment's yaw changes the image without a refit (no job starts).
     slider(&h, "yaw").set_value_accesskit(90.0);
     h.step();
-    assert!(
-        h.state().loading.is_none() && h.state().source_job.is_none(),
-        "yaw must not refit"
-    );
+    assert!(!h.state().loading(), "yaw must not refit");
     converge(&mut h);
     let turned = image(&h);
     let yawed = mean_luminance(&turned);
     println!("yaw 90: {yawed:.4}");
     assert!((yawed - blond).abs() > 1e-3 * blond);
-    assert_eq!(h.state().session.env_yaw, 90.0);
+    assert_eq!(h.state().session().env_yaw, 90.0);
 
     // Three edits (dark brown, blond, yaw), three Ctrl+Z: the session and the image as before.
     for _ in 0..3 {
         h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
         h.step();
     }
-    assert_eq!(h.state().session, before_session);
+    assert_eq!(*h.state().session(), before_session);
     converge(&mut h);
     let restored = image(&h);
     let d = max_relative_difference(&before, &restored);
@@ -430,9 +427,9 @@ fn panel_edits_change_the_image_and_three_undos_restore_it() {
         );
         h.step();
     }
-    assert_eq!(h.state().session.env_yaw, 90.0);
+    assert_eq!(h.state().session().env_yaw, 90.0);
     assert_eq!(
-        h.state().session.look.root,
+        h.state().session().look.root,
         strandlight::session::Absorption::from_preset(strandlight::scattering::Preset::Blond)
     );
 }
@@ -465,7 +462,7 @@ fn a_narrower_highlight_is_sharper() {
     converge(&mut h);
     let narrow = r_peak(&image(&h));
     println!("R lobe p99.9: beta_R 7.5 deg {wide:.4}, 3 deg {narrow:.4}");
-    assert!((h.state().session.look.params.beta_r.to_degrees() - 3.0).abs() < 1e-9);
+    assert!((h.state().session().look.params.beta_r.to_degrees() - 3.0).abs() < 1e-9);
     assert!(narrow > 1.3 * wide);
 }
 
@@ -483,7 +480,7 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
     let got = image(&h);
     let thick = mean_luminance(&got);
     println!("mean luminance: thickness x1 {thin:.4}, x3 {thick:.4}");
-    assert_eq!(h.state().session.look.thickness_scale, 3.0);
+    assert_eq!(h.state().session().look.thickness_scale, 3.0);
     assert!(thick < thin, "thicker fibres shadow more");
     // The same session rendered headless (the scene assembly scales the hair itself; the editor
     // rewrote the renderer's points).
@@ -492,7 +489,7 @@ fn thicker_fibres_darken_the_hair_as_a_headless_render_does() {
     assert!(d < 1e-4, "{d}");
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    assert_eq!(h.state().session.look.thickness_scale, 1.0);
+    assert_eq!(h.state().session().look.thickness_scale, 1.0);
     converge(&mut h);
     assert_eq!(
         mean_luminance(&image(&h)),
@@ -516,7 +513,7 @@ fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
     let (mut draft_in, mut table_in) = (None, None);
     while table_in.is_none() {
         h.step();
-        let live = h.state().live.as_ref().expect("a scene").lock();
+        let live = h.state().live().expect("a scene").lock();
         let table = live.renderer.azimuthal_table();
         if table.eta == 1.62 {
             if table.draft {
@@ -539,7 +536,7 @@ fn a_new_eta_shows_with_a_draft_and_converges_to_the_render() {
     );
     converge(&mut h);
     let got = image(&h);
-    assert_eq!(h.state().session.look.params.eta, 1.62);
+    assert_eq!(h.state().session().look.params.eta, 1.62);
     let d = against_render_session(&h, &dir, "eta", &got);
     println!(
         "editor against render --session: max difference {d:.2e} of the peak; mean luminance {before:.4} -> {:.4}",
@@ -579,7 +576,7 @@ fn the_head_and_the_environment_show_and_the_panel_changes_them() {
     assert!(shown > 50 && behind == with_head.pixel_count());
     // The head hidden: no head pixels, and the hair it hid shows.
     click(&mut h, "Head");
-    assert!(!h.state().session.occluder.show);
+    assert!(!h.state().session().occluder.show);
     converge(&mut h);
     let without = image(&h);
     assert_eq!(head_pixels(&without), 0);
@@ -600,7 +597,7 @@ fn the_head_and_the_environment_show_and_the_panel_changes_them() {
     // Undo brings it back as it was.
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    assert!(h.state().session.occluder.show);
+    assert!(h.state().session().occluder.show);
     converge(&mut h);
     assert_eq!(
         image(&h).beauty,
@@ -612,7 +609,7 @@ fn the_head_and_the_environment_show_and_the_panel_changes_them() {
     h.get_by_label("transparent").click_accesskit();
     h.step();
     assert_eq!(
-        h.state().session.render.background,
+        h.state().session().render.background,
         strandlight::render::passes::background::Background::Transparent
     );
     converge(&mut h);
@@ -624,22 +621,22 @@ fn navigation_orbits_zooms_and_frames() {
     let dir = tmp("nav");
     let mut h = harness(small_session(), &dir, false);
     converge(&mut h);
-    let start = h.state().camera.expect("a camera");
-    let centre = h.state().viewport_rect.expect("a viewport").center();
+    let start = h.state().camera().expect("a camera");
+    let centre = h.state().viewport_rect().expect("a viewport").center();
     middle_drag(
         &mut h,
         centre,
         egui::vec2(50.0, 20.0),
         egui::Modifiers::NONE,
     );
-    let orbited = h.state().camera.expect("a camera");
+    let orbited = h.state().camera().expect("a camera");
     println!(
         "orbit: yaw {} -> {}, pitch {} -> {}",
         start.yaw, orbited.yaw, start.pitch, orbited.pitch
     );
     assert!(orbited.yaw != start.yaw && orbited.pitch != start.pitch);
     assert!((orbited.distance - start.distance).abs() < 1e-4);
-    assert_eq!(h.state().session.camera.yaw, orbited.yaw);
+    assert_eq!(h.state().session().camera.yaw, orbited.yaw);
     // Shift+middle pans: the target moves, the distance stays.
     middle_drag(
         &mut h,
@@ -647,7 +644,7 @@ fn navigation_orbits_zooms_and_frames() {
         egui::vec2(40.0, 0.0),
         egui::Modifiers::SHIFT,
     );
-    let panned = h.state().camera.expect("a camera");
+    let panned = h.state().camera().expect("a camera");
     assert!(panned.target != orbited.target);
     // The wheel zooms in.
     h.hover_at(centre);
@@ -661,26 +658,26 @@ fn navigation_orbits_zooms_and_frames() {
         });
         h.step();
     }
-    let zoomed = h.state().camera.expect("a camera");
+    let zoomed = h.state().camera().expect("a camera");
     println!("zoom: distance {} -> {}", panned.distance, zoomed.distance);
     assert!(zoomed.distance < 0.9 * panned.distance);
     // Home frames the hair again: the target is the hair's centre.
     h.hover_at(centre);
     h.key_press(egui::Key::Home);
     h.step();
-    let framed = h.state().camera.expect("a camera");
-    let hair = h.state().live.as_ref().expect("live").lock().hair.clone();
+    let framed = h.state().camera().expect("a camera");
+    let hair = h.state().live().expect("live").lock().hair.clone();
     let (lo, hi) = hair.bounds();
     let mid = 0.5 * (lo + hi);
     assert!((glam::Vec3::from(framed.target) - mid).length() < 1e-4);
-    assert!(h.state().session.camera.target.is_none());
+    assert!(h.state().session().camera.target.is_none());
     // Camera moves are not edits.
-    assert!(!h.state().history.can_undo());
+    assert!(!h.state().history().can_undo());
 
     // A slow orbit (a move per UI frame) shows previews while the button is held: each move waits
     // for the preview under way instead of restarting it.
     converge(&mut h);
-    let shown = h.state().live.as_ref().expect("live").lock().previews_shown;
+    let shown = h.state().live().expect("live").lock().previews_shown;
     h.hover_at(centre);
     h.step();
     h.event(egui::Event::PointerButton {
@@ -697,7 +694,7 @@ fn navigation_orbits_zooms_and_frames() {
         h.step();
         std::thread::sleep(Duration::from_millis(10));
     }
-    let during = h.state().live.as_ref().expect("live").lock().previews_shown - shown;
+    let during = h.state().live().expect("live").lock().previews_shown - shown;
     h.event(egui::Event::PointerButton {
         pos: centre + egui::vec2(60.0, 0.0),
         button: egui::PointerButton::Middle,
@@ -705,7 +702,7 @@ fn navigation_orbits_zooms_and_frames() {
         modifiers: egui::Modifiers::NONE,
     });
     h.step();
-    let live = h.state().live.as_ref().expect("live").lock();
+    let live = h.state().live().expect("live").lock();
     println!(
         "previews shown during a 60-frame orbit: {during} ({}x{}, preview divisor {})",
         live.display.width,
@@ -729,13 +726,13 @@ fn sessions_save_reopen_autosave_and_recover() {
     let path = dir.join("look.slsession");
     h.state_mut().save_session(&path);
     assert!(!h.state().modified());
-    let saved = h.state().session.clone();
+    let saved = h.state().session().clone();
 
     // Reopen in a new editor: same model, equal image.
     let mut h2 = harness(Session::default(), &dir.join("other"), false);
     h2.state_mut().open_session(&path);
     converge(&mut h2);
-    assert_eq!(h2.state().session, saved);
+    assert_eq!(*h2.state().session(), saved);
     // The same viewport size and camera: the same image.
     let d = max_relative_difference(&first, &image(&h2));
     println!("reopened: max difference {d:.2e} of the peak");
@@ -743,29 +740,29 @@ fn sessions_save_reopen_autosave_and_recover() {
     drop(h2);
 
     // A change produces the autosave file (the interval shortened for the test).
-    h.state_mut().autosave.interval = Duration::from_millis(10);
+    h.state_mut().autosave_mut().interval = Duration::from_millis(10);
     click(&mut h, "platinum");
-    let recovery = h.state().autosave.path.clone();
+    let recovery = h.state().autosave().path.clone();
     let t = Instant::now();
-    while h.state().autosave.writes == 0 {
+    while h.state().autosave().writes == 0 {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(20), "no autosave");
     }
     assert!(recovery.is_file());
-    let changed = h.state().session.clone();
+    let changed = h.state().session().clone();
     // "Kill" the editor: no on_exit.
     std::mem::forget(h);
 
     // The next start offers the recovery, which restores the model.
     let mut h3 = harness_as(Session::default(), &dir, true, Some(4_000_000_002));
     h3.step();
-    assert!(h3.state().recovery_offer.is_some());
+    assert!(h3.state().recovery_offered());
     click(&mut h3, "Recover");
-    assert_eq!(h3.state().session.look, changed.look);
-    assert_eq!(h3.state().session_path.as_deref(), Some(path.as_path()));
+    assert_eq!(h3.state().session().look, changed.look);
+    assert_eq!(h3.state().session_path(), Some(path.as_path()));
     // The recovered work is now the new editor's own recovery file; the old one is gone.
-    assert!(!recovery.exists() && h3.state().autosave.path.is_file());
+    assert!(!recovery.exists() && h3.state().autosave().path.is_file());
     drop(h3);
 
     // A recovery file of an editor that is still running (this process) is not offered.
@@ -777,7 +774,7 @@ fn sessions_save_reopen_autosave_and_recover() {
     )
     .expect("copied");
     let h4 = harness_as(Session::default(), &dir2, true, Some(4_000_000_003));
-    assert!(h4.state().recovery_offer.is_none());
+    assert!(!h4.state().recovery_offered());
 }
 
 #[test]
@@ -785,26 +782,26 @@ fn corrupt_files_show_an_error_and_leave_the_scene() {
     let dir = tmp("corrupt");
     let mut h = harness(small_session(), &dir, false);
     converge(&mut h);
-    let before = h.state().session.clone();
+    let before = h.state().session().clone();
     let bad_hair = dir.join("broken.hair");
     std::fs::write(&bad_hair, b"HAIR\x01\x00\x00\x00garbage").expect("written");
     h.state_mut().open_hair(bad_hair.clone());
     wait_for_loading(&mut h);
-    let msg = h.state().messages.last().expect("a message").text.clone();
+    let msg = h.state().messages().last().expect("a message").text.clone();
     println!("{msg}");
     assert!(msg.contains("broken.hair"));
-    assert_eq!(h.state().session, before);
+    assert_eq!(*h.state().session(), before);
     assert!(h.query_by_label_contains("broken.hair").is_some());
 
     let bad_env = dir.join("broken.exr");
     std::fs::write(&bad_env, b"not an exr at all").expect("written");
     h.state_mut().load_environment(bad_env, 8);
     wait_for_loading(&mut h);
-    let msg = h.state().messages.last().expect("a message").text.clone();
+    let msg = h.state().messages().last().expect("a message").text.clone();
     println!("{msg}");
     assert!(msg.contains("broken.exr"));
-    assert_eq!(h.state().session, before);
-    assert!(h.state().live.is_some());
+    assert_eq!(*h.state().session(), before);
+    assert!(h.state().live().is_some());
 
     // A session whose hair file has gone opens the rest, says so, and keeps pointing at the file.
     let mut gone = before.clone();
@@ -821,16 +818,16 @@ fn corrupt_files_show_an_error_and_leave_the_scene() {
     converge(&mut h);
     let warned = h
         .state()
-        .messages
+        .messages()
         .iter()
         .any(|m| m.text.contains("moved-away.hair"));
     assert!(warned, "the missing file is reported");
-    assert_eq!(h.state().session, gone);
+    assert_eq!(*h.state().session(), gone);
 }
 
 fn wait_for_loading(h: &mut Harness<'static, EditorApp>) {
     let t = Instant::now();
-    while h.state().loading.is_some() || h.state().source_job.is_some() {
+    while h.state().loading() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(60), "loading hangs");
@@ -848,11 +845,14 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
     let mut h = harness(session, &dir, false);
     converge(&mut h);
     let exr = dir.join("export.exr");
-    strandlight::editor::panels::menu::start_export(h.state_mut(), exr.clone());
+    h.state_mut().handle(AppCommand::ExportStill {
+        exr: exr.clone(),
+        tile: None,
+    });
     wait_for_export(&mut h);
     assert!(exr.is_file() && exr.with_extension("png").is_file());
     let path = dir.join("export.slsession");
-    h.state().session.write(&path).expect("saved");
+    h.state().session().write(&path).expect("saved");
     let cli_exr = dir.join("cli.exr");
     run_cli(&[
         "render".as_ref(),
@@ -871,7 +871,10 @@ fn export_equals_render_session_and_the_screenshot_is_made() {
 
     // The same still exported in 40-pixel tiles (3 x 2, with partial tiles at the edges).
     let tiled = dir.join("tiled.exr");
-    strandlight::editor::panels::menu::start_export_tiled(h.state_mut(), tiled.clone(), Some(40));
+    h.state_mut().handle(AppCommand::ExportStill {
+        exr: tiled.clone(),
+        tile: Some(40),
+    });
     wait_for_export(&mut h);
     let c = read_exr_beauty(&tiled, 96, 64);
     let (d, mean) = (
@@ -897,8 +900,8 @@ fn the_default_scene_in_the_default_window() {
         .with_size(egui::vec2(1280.0, 800.0))
         .wgpu_setup(strandlight::editor::wgpu_setup())
         .build_eframe(move |cc| EditorApp::new(cc, options));
-    let software = h.state().gpu.as_ref().expect("a GPU").summary.device_type == "Cpu";
-    assert_eq!(h.state().view.scale, if software { 0.5 } else { 1.0 });
+    let software = h.state().gpu().expect("a GPU").summary.device_type == "Cpu";
+    assert_eq!(h.state().view().scale, if software { 0.5 } else { 1.0 });
     converge(&mut h);
     // The status bar's times of the launch (each query panics when no label matches).
     h.get_by_label_contains("first ");
@@ -923,10 +926,10 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
     let mut h = harness(small_session(), &dir, false);
     converge(&mut h);
     click(&mut h, "auburn");
-    let device = h.state().gpu.as_ref().expect("a GPU").device.clone();
+    let device = h.state().gpu().expect("a GPU").device.clone();
     device.destroy();
     let t = Instant::now();
-    while h.state().gpu.is_some() {
+    while h.state().gpu().is_some() {
         // wgpu reports the loss when the device is next polled (the renderer polls every frame).
         let _ = device.poll(wgpu::PollType::Poll);
         h.step();
@@ -936,23 +939,23 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
             "the loss was not reported"
         );
     }
-    let msg = h.state().messages.last().expect("a message").text.clone();
+    let msg = h.state().messages().last().expect("a message").text.clone();
     println!("{msg}");
     assert!(msg.contains("GPU device was lost"));
-    assert!(h.state().live.is_none() && h.state().gpu.is_none());
+    assert!(h.state().live().is_none() && h.state().gpu().is_none());
     // The session with the edit is in the recovery file.
-    let text = std::fs::read_to_string(&h.state().autosave.path).expect("a recovery file");
+    let text = std::fs::read_to_string(&h.state().autosave().path).expect("a recovery file");
     assert!(
         text.contains("0.6") && text.contains("1.2"),
         "auburn's melanin"
     );
     // A new editor takes the session over on a new device (`edit --recover FILE`).
-    let args = h.state().relaunch.clone().expect("a restart");
+    let args = h.state().relaunch().map(<[_]>::to_vec).expect("a restart");
     assert_eq!(args[0], "edit");
     assert_eq!(args[1], "--recover");
     let file = std::path::PathBuf::from(&args[2]);
-    assert_eq!(file, h.state().autosave.path);
-    let session = h.state().session.clone();
+    assert_eq!(file, h.state().autosave().path);
+    let session = h.state().session().clone();
     drop(h);
     let mut again = harness_with(EditorOptions {
         recover: Some(file.clone()),
@@ -960,10 +963,10 @@ fn a_lost_gpu_device_is_reported_and_the_session_kept() {
         instance: Some(4_000_000_002),
         ..Default::default()
     });
-    assert!(again.state().session == session, "the recovered session");
+    assert!(*again.state().session() == session, "the recovered session");
     assert!(again.state().modified(), "recovered work is unsaved work");
     assert!(!file.exists(), "the old recovery file was taken over");
-    assert!(again.state().autosave.path.exists(), "kept in its own");
+    assert!(again.state().autosave().path.exists(), "kept in its own");
     converge(&mut again);
     assert!(mean_luminance(&image(&again)) > 0.0, "it renders");
 }
@@ -1020,29 +1023,29 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     let mut h = harness(session, &dir, false);
     converge(&mut h);
     let before = image(&h);
-    let sigma_before = h.state().live.as_ref().unwrap().lock().sigma_a.clone();
+    let sigma_before = h.state().live().unwrap().lock().sigma_a.clone();
     // B over the viewport takes the brush; the picker follows the view's depth.
-    let rect = h.state().viewport_rect.expect("a viewport");
+    let rect = h.state().viewport_rect().expect("a viewport");
     h.hover_at(rect.center());
     h.step();
     h.key_press(egui::Key::B);
     h.step();
-    assert_eq!(h.state().tool, strandlight::editor::brush_tool::Tool::Brush);
+    assert_eq!(h.state().tool(), strandlight::editor::tools::Tool::Brush);
     let t = Instant::now();
-    while h.state().live.as_ref().unwrap().lock().picker().is_none() {
+    while h.state().live().unwrap().lock().picker().is_none() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(30), "no picker");
     }
     // A blue dye at full strength, constant falloff, across the hair's middle.
     let dye = strandlight::paint::sigma_a_from_colour([0.05, 0.25, 0.8], 0.3).map(|x| x as f32);
-    h.state_mut().brush = strandlight::paint::Brush {
+    h.state_mut().set_brush(strandlight::paint::Brush {
         radius_px: 40.0,
         strength: 1.0,
         falloff: Falloff::Constant,
         dye,
         ..Default::default()
-    };
+    });
     let (w, hh) = (before.width as f32, before.height as f32);
     let covered: Vec<usize> = (0..before.beauty.len())
         .filter(|&i| before.beauty[i][3] > 0.0)
@@ -1062,18 +1065,18 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     let (a, b) = (to_screen(cx - 10.0, cy), to_screen(cx + 10.0, cy));
     brush_stroke(&mut h, a, b, 8);
     let app = h.state();
-    let layer = app.session.paint_layer.clone().expect("a paint layer");
+    let layer = app.session().paint_layer.clone().expect("a paint layer");
     let painted: Vec<u32> = (0..layer.get().points.len() as u32)
         .filter(|&i| layer.get().points[i as usize][3] > 0.0)
         .collect();
     println!(
         "stroke: {} dabs, {} points painted",
-        app.brush_stats.dabs,
+        app.brush_stats().dabs,
         painted.len()
     );
     assert!(painted.len() > 10, "the stroke painted the hair");
     // The points painted are the picker's selection for the dabs along the path, at full strength.
-    let live = app.live.as_ref().unwrap().lock();
+    let live = app.live().unwrap().lock();
     let picker = live.picker().expect("picker");
     let radius = app.brush_radius_render_px();
     let to_render = |p: egui::Pos2| {
@@ -1083,11 +1086,11 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
         ]
     };
     let (ra, rb) = (to_render(a), to_render(b));
-    let (mut centres, _) = dabs_along(ra, rb, radius * app.brush.spacing, 0.0);
+    let (mut centres, _) = dabs_along(ra, rb, radius * app.brush().spacing, 0.0);
     centres.insert(0, ra);
     let mut want: Vec<u32> = centres
         .iter()
-        .flat_map(|c| picker.dab(&app.brush, *c, radius, 1.0))
+        .flat_map(|c| picker.dab(app.brush(), *c, radius, 1.0))
         .map(|t| t.0)
         .collect();
     want.sort_unstable();
@@ -1130,12 +1133,12 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
         assert_eq!(*s1, want, "point {i}");
     }
     drop(live);
-    let session_after = h.state().session.clone();
+    let session_after = h.state().session().clone();
     converge(&mut h);
     let after = image(&h);
     // Pixels showing a painted segment move toward the dye (bluer); the others do not change
     // (single scattering: the shadows' transmittance does not read absorption).
-    let hair = h.state().live.as_ref().unwrap().lock().hair.clone();
+    let hair = h.state().live().unwrap().lock().hair.clone();
     let painted_point = |p: u32| layer.get().points[p as usize][3] > 0.0;
     let segment_start: Vec<u32> = (0..hair.strand_count())
         .flat_map(|s| {
@@ -1194,13 +1197,13 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     // Undo restores the absorption bit for bit and the image; redo reapplies the stroke.
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    let sigma_now = h.state().live.as_ref().unwrap().lock().sigma_a.clone();
+    let sigma_now = h.state().live().unwrap().lock().sigma_a.clone();
     assert!(
         sigma_now == sigma_before,
         "undo restores the absorption bit for bit"
     );
     assert!(
-        h.state().session.paint_layer.is_none(),
+        h.state().session().paint_layer.is_none(),
         "the stroke made the layer: its undo removes it"
     );
     converge(&mut h);
@@ -1214,7 +1217,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     );
     h.step();
     assert!(
-        h.state().session == session_after,
+        *h.state().session() == session_after,
         "redo reapplies the stroke"
     );
     converge(&mut h);
@@ -1226,7 +1229,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     // passes on: far less than the dyed hair itself.
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    let mut render = h.state().session.render;
+    let mut render = h.state().session().render;
     render.multiple_scattering = true;
     h.state_mut()
         .perform(strandlight::session::Edit::Render(render), false);
@@ -1256,18 +1259,18 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
 
 /// The brush on, a stroke across the hair's middle with `brush`; returns the points painted.
 fn paint_stroke(h: &mut Harness<'static, EditorApp>, brush: strandlight::paint::Brush) -> usize {
-    let rect = h.state().viewport_rect.expect("a viewport");
+    let rect = h.state().viewport_rect().expect("a viewport");
     h.hover_at(rect.center());
     h.step();
     h.key_press(egui::Key::B);
     h.step();
     let t = Instant::now();
-    while h.state().live.as_ref().unwrap().lock().picker().is_none() {
+    while h.state().live().unwrap().lock().picker().is_none() {
         h.step();
         std::thread::sleep(Duration::from_millis(5));
         assert!(t.elapsed() < Duration::from_secs(30), "no picker");
     }
-    h.state_mut().brush = brush;
+    h.state_mut().set_brush(brush);
     let f = image(h);
     let covered: Vec<usize> = (0..f.beauty.len())
         .filter(|&i| f.beauty[i][3] > 0.0)
@@ -1291,7 +1294,7 @@ fn paint_stroke(h: &mut Harness<'static, EditorApp>, brush: strandlight::paint::
             )
     };
     brush_stroke(h, at(cx - 10.0, cy), at(cx + 10.0, cy), 8);
-    let layer = h.state().session.paint_layer.clone().expect("a layer");
+    let layer = h.state().session().paint_layer.clone().expect("a layer");
     layer.get().points.iter().filter(|v| v[3] > 0.0).count()
 }
 
@@ -1326,7 +1329,7 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     assert!(!h.state().modified());
     converge(&mut h);
     let edited = image(&h);
-    let session = h.state().session.clone();
+    let session = h.state().session().clone();
     // Reopened: the same model (layer included) and the same image.
     let mut again = harness_with(EditorOptions {
         session_path: Some(path.clone()),
@@ -1336,7 +1339,7 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     });
     converge(&mut again);
     assert!(
-        again.state().session == session,
+        *again.state().session() == session,
         "the same session, paint included"
     );
     assert!(!again.state().modified());
@@ -1345,7 +1348,10 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
     assert!(d < 1e-6);
     // The editor's export equals `render --session --paint` of the saved layer.
     let exr = dir.join("painted.exr");
-    strandlight::editor::panels::menu::start_export(again.state_mut(), exr.clone());
+    again.state_mut().handle(AppCommand::ExportStill {
+        exr: exr.clone(),
+        tile: None,
+    });
     wait_for_export(&mut again);
     let cli = dir.join("painted-cli.exr");
     run_cli(&[
@@ -1374,7 +1380,7 @@ fn a_painted_session_saves_reopens_renders_headless_and_exports_its_hair() {
             out_file.as_os_str(),
         ]);
     }
-    let live = again.state().live.as_ref().unwrap().lock();
+    let live = again.state().live().unwrap().lock();
     let (points, strands) = (live.hair.point_count(), live.hair.strand_count());
     let bytes = std::fs::read(&hair_file).unwrap();
     let (back, _, _) =

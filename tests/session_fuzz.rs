@@ -90,7 +90,7 @@ fn mutated_recovery_files_never_panic() {
     let file = dir.join("recovery-1.slsession");
     let read = |bytes: &[u8]| {
         std::fs::write(&file, bytes).expect("written");
-        strandlight::editor::autosave::read_recovery(&file)
+        strandlight::session::autosave::read_recovery(&file)
     };
     // The seed itself must read back: a reader that rejected everything would otherwise pass.
     let (path, s, warning) = read(seed.as_bytes()).expect("the unmutated recovery file reads");
@@ -104,6 +104,7 @@ fn mutated_recovery_files_never_panic() {
             Ok(true)
         }
         Err(e) => {
+            let e = e.to_string();
             prop_assert!(e.contains("recovery-1.slsession"), "{e}");
             Ok(false)
         }

@@ -11,6 +11,8 @@ use std::sync::Arc;
 pub const PREVIEW_WIDTH: usize = 192;
 pub const PREVIEW_HEIGHT: usize = 96;
 
+/// The textures are handles: a clone shares them (the scene panel keeps one in egui's memory).
+#[derive(Clone)]
 pub struct EnvPreview {
     /// The environment it was made for (its name and light count).
     pub key: (String, usize),
@@ -93,6 +95,12 @@ pub fn pictures(env: &Environment, background: Arc<BackgroundMap>) -> EnvPicture
         relative_l2: env.lights.fit.as_ref().map(|f| f.relative_l2),
         background,
     }
+}
+
+/// The pictures of an environment loaded on its own (a file opened for an edit), with the
+/// background map made from it.
+pub fn pictures_of(env: &Environment) -> EnvPictures {
+    pictures(env, Arc::new(BackgroundMap::from_environment(env)))
 }
 
 /// The pictures as egui textures (the UI thread's part: an upload).

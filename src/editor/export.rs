@@ -3,10 +3,10 @@
 //! image's buffers exceed what the GPU binds at once (an 8K still on lavapipe), then written as EXR (with
 //! AOVs and the header `render` writes) and a PNG preview on a worker.
 
-use super::app::Level;
+use super::messages::Level;
 use crate::gpu::GpuContext;
+use crate::jobs::{Job, Wake};
 use crate::live::LiveDriver;
-use crate::live::jobs::Job;
 use crate::render::Renderer;
 use crate::render::camera::Tile;
 use crate::render::frame::Frame;
@@ -33,7 +33,7 @@ pub struct ExportJob {
     writing: Option<Job<Result<String, String>>>,
     pub started: Instant,
     pub fraction: f32,
-    wake: egui::Context,
+    wake: Wake,
 }
 
 impl ExportJob {
@@ -46,7 +46,7 @@ impl ExportJob {
         session: &Session,
         exr: PathBuf,
         png: Option<PathBuf>,
-        wake: egui::Context,
+        wake: Wake,
         tile: Option<u32>,
     ) -> Result<Self, String> {
         if live.needs_rebuild(session) {
@@ -87,7 +87,7 @@ impl ExportJob {
         scene: Scene,
         exr: PathBuf,
         png: Option<PathBuf>,
-        wake: egui::Context,
+        wake: Wake,
         tile: Option<u32>,
     ) -> Result<Self, String> {
         let (w, h) = (scene.settings.width, scene.settings.height);
@@ -204,7 +204,7 @@ impl ExportJob {
         let wake = self.wake.clone();
         self.writing = Some(Job::spawn(
             "writing the still",
-            move || wake.request_repaint(),
+            move || wake(),
             move |_| {
                 frame
                     .write_exr(&exr, &attributes, true, None)
@@ -231,5 +231,86 @@ impl ExportJob {
     /// The EXR path with `.png` for the preview.
     pub fn preview_path(exr: &std::path::Path) -> PathBuf {
         exr.with_extension("png")
+    }
+}
+
+/// The exports under way: a still (refined in UI frames) and a painted hair (written on a worker).
+#[derive(Default)]
+pub struct Exports {
+    still: Option<ExportJob>,
+    hair: Option<Job<Result<String, String>>>,
+}
+
+impl Exports {
+    /// The still under way: its progress and whether its files are being written.
+    pub fn still_progress(&self) -> Option<(f32, bool)> {
+        self.still.as_ref().map(|e| (e.fraction, e.writing()))
+    }
+
+    pub fn exporting_still(&self) -> bool {
+        self.still.is_some()
+    }
+
+    /// Stops the still (nothing is written; a device that went away takes it too).
+    pub fn cancel_still(&mut self) {
+        self.still = None;
+    }
+
+    /// Starts exporting the session's still to `exr` (and a PNG preview beside it), in tiles of at
+    /// most `tile` pixels a side (None: only when the image needs them).
+    pub fn start_still(
+        &mut self,
+        live: &LiveDriver,
+        luts: &crate::scattering::lut::Luts,
+        session: &Session,
+        exr: PathBuf,
+        tile: Option<u32>,
+        wake: Wake,
+    ) -> Result<(), String> {
+        if self.still.is_some() {
+            return Err("an export is running: cancel it or wait for it first".into());
+        }
+        let png = Some(ExportJob::preview_path(&exr));
+        let job = ExportJob::start(live, luts, session, exr, png, wake, tile)
+            .map_err(|e| format!("export: {e}"))?;
+        self.still = Some(job);
+        Ok(())
+    }
+
+    /// Writes the hair with its look and paint to `out` (.usda or .hair) on a worker.
+    pub fn start_hair(&mut self, live: &LiveDriver, session: &Session, out: PathBuf, wake: Wake) {
+        let (hair, sigma_a) = (live.hair.clone(), live.sigma_a.clone());
+        let look = session.look;
+        let scale = look.thickness_scale;
+        self.hair = Some(Job::spawn(
+            "exporting the hair",
+            move || wake(),
+            move |_| {
+                let mut h = (*hair).clone();
+                h.transform(|p| p, scale);
+                crate::session::export_hair::write_painted_hair(&h, &sigma_a, &look, &out)
+                    .map(|_| format!("exported {}", out.display()))
+            },
+        ));
+    }
+
+    /// Once a frame: advances the still and collects what finished. Returns the messages to show
+    /// and whether the still still runs (its renderer refines in UI frames: poll again soon).
+    pub fn poll(&mut self, gpu: Option<&GpuContext>) -> (Vec<(Level, String)>, bool) {
+        let mut done = Vec::new();
+        if let Some(job) = &mut self.still
+            && let Some(msg) = job.poll(gpu)
+        {
+            done.push(msg);
+            self.still = None;
+        }
+        if let Some(r) = self.hair.as_mut().and_then(|j| j.poll()) {
+            self.hair = None;
+            done.push(match r.and_then(|r| r) {
+                Ok(m) => (Level::Info, m),
+                Err(e) => (Level::Error, e),
+            });
+        }
+        (done, self.still.is_some())
     }
 }

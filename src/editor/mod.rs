@@ -1,18 +1,33 @@
 //! The editor (eframe + egui on wgpu): a session edited live in a window. The session model, scene
-//! assembly and renderer live in the library and serve the CLI too; this module holds the app state and
-//! frame loop ([`app`]), the live driver's image in egui ([`live`]), navigation, background jobs,
-//! autosave, export and one module per panel.
+//! assembly, autosave and the renderer live in the library and serve the CLI too; this module holds
+//! the frame loop ([`app`]) and what it owns, each in a module of its own: the document
+//! ([`document`]), the viewport's state and the live driver's image in egui ([`viewport`],
+//! [`live_scene`]), the tools ([`tools`]), loads and exports on workers ([`loading`], [`export`]),
+//! the device's health ([`device`]), messages, recent files and frame timing; the panels
+//! ([`panels`]) see a per-frame [`context`] and send [`command`]s, which the app handles in one
+//! place (`app/handling.rs`).
 
 pub mod app;
-pub mod autosave;
-pub mod brush_tool;
+pub mod command;
+pub mod context;
+pub mod device;
+pub mod dialogs;
+pub mod document;
 pub mod env_preview;
 pub mod export;
-pub mod live;
-pub mod navigation;
+pub mod live_scene;
+pub mod loading;
+pub mod messages;
+pub mod options;
 pub mod panels;
+pub mod recent;
+pub mod timing;
+pub mod tools;
+pub mod viewport;
 
-pub use app::{EditorApp, EditorOptions};
+pub use app::EditorApp;
+pub use command::AppCommand;
+pub use options::EditorOptions;
 
 use crate::gpu::GpuContext;
 use std::sync::Arc;

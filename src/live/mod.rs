@@ -12,6 +12,6 @@ pub mod picking;
 pub mod pump;
 pub mod tables;
 
-pub use dab::{Dab, DabError};
+pub use dab::{Dab, DabEdit, DabError};
 pub use driver::{LiveDriver, LiveError, Prepared, StepOutcome, ViewSettings, prepare};
 pub use pump::LiveHandle;

@@ -5,9 +5,13 @@
 //! received; the point's value is recomputed from those two, so dabs that overlap do not add up past
 //! the brush's strength (Blender's stroke behaviour) and the stroke's effect does not depend on how
 //! densely the dabs were spaced.
+//!
+//! A dab reads the layer and writes its changes to a [`DabLayer`] over it, which becomes a
+//! [`PaintDelta`]: the editor applies that as an edit like any other, so undo, autosave and the tests
+//! see strokes as data.
 
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// How strength falls off from the brush centre (r: distance over radius, in [0, 1]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -197,6 +201,62 @@ pub fn mix_toward(before: LayerValue, target: [f32; 3], a: f32) -> LayerValue {
     [c[0], c[1], c[2], w1]
 }
 
+/// Where a dab reads and writes layer values: a layer itself, or a [`DabLayer`] over one.
+pub trait LayerValues {
+    fn value(&self, i: u32) -> LayerValue;
+    fn set_value(&mut self, i: u32, v: LayerValue);
+}
+
+impl LayerValues for [LayerValue] {
+    fn value(&self, i: u32) -> LayerValue {
+        self[i as usize]
+    }
+
+    fn set_value(&mut self, i: u32, v: LayerValue) {
+        self[i as usize] = v;
+    }
+}
+
+/// A dab's changes over a layer that it leaves as it is: the dab reads through them (blur's
+/// neighbours see the values the dab wrote before, as on the layer itself), and they become the
+/// delta that the session applies.
+pub struct DabLayer<'a> {
+    layer: &'a [LayerValue],
+    changed: BTreeMap<u32, LayerValue>,
+}
+
+impl<'a> DabLayer<'a> {
+    pub fn new(layer: &'a [LayerValue]) -> Self {
+        Self {
+            layer,
+            changed: BTreeMap::new(),
+        }
+    }
+
+    /// The points written and their new values (sorted by index; None when nothing was written):
+    /// applied to the layer, it makes the dab's change.
+    pub fn into_delta(self) -> Option<PaintDelta> {
+        if self.changed.is_empty() {
+            return None;
+        }
+        let (indices, values) = self.changed.into_iter().unzip();
+        Some(PaintDelta { indices, values })
+    }
+}
+
+impl LayerValues for DabLayer<'_> {
+    fn value(&self, i: u32) -> LayerValue {
+        self.changed
+            .get(&i)
+            .copied()
+            .unwrap_or(self.layer[i as usize])
+    }
+
+    fn set_value(&mut self, i: u32, v: LayerValue) {
+        self.changed.insert(i, v);
+    }
+}
+
 /// One stroke under way: the layer values before it and the strongest dab each point received.
 #[derive(Default)]
 pub struct Stroke {
@@ -218,11 +278,11 @@ impl Stroke {
     /// returns the indices whose value changed. `base`: each point's absorption without paint;
     /// `strand_of`: the strand range of a point (blur's neighbours along it); `eumelanin`: the
     /// absorption of a unit eumelanin concentration (darken).
-    pub fn dab(
+    pub fn dab<L: LayerValues + ?Sized>(
         &mut self,
         brush: &Brush,
         under: &[Touch],
-        layer: &mut [LayerValue],
+        layer: &mut L,
         base: &[[f32; 3]],
         strand_of: impl Fn(u32) -> std::ops::Range<u32>,
         eumelanin: [f32; 3],
@@ -232,7 +292,7 @@ impl Stroke {
         let mean_under = if brush.mode == PaintMode::Blur && !under.is_empty() {
             let mut acc = [0.0f64; 3];
             for &(i, _) in under {
-                let e = effective(base[i as usize], layer[i as usize]);
+                let e = effective(base[i as usize], layer.value(i));
                 for c in 0..3 {
                     acc[c] += e[c] as f64;
                 }
@@ -244,7 +304,7 @@ impl Stroke {
         let mut changed = Vec::with_capacity(under.len());
         for &(i, a) in under {
             let iu = i as usize;
-            let entry = self.touched.entry(i).or_insert((layer[iu], 0.0));
+            let entry = self.touched.entry(i).or_insert((layer.value(i), 0.0));
             // The stroke's effect saturates at the strongest dab (blur keeps smoothing).
             let a = if brush.mode == PaintMode::Blur {
                 a
@@ -256,7 +316,7 @@ impl Stroke {
                 a
             };
             let before = if brush.mode == PaintMode::Blur {
-                layer[iu]
+                layer.value(i)
             } else {
                 entry.0
             };
@@ -277,15 +337,15 @@ impl Stroke {
                     let r = strand_of(i);
                     let (lo, hi) = (i.saturating_sub(1).max(r.start), (i + 1).min(r.end - 1));
                     let along: [f32; 3] = std::array::from_fn(|c| {
-                        let e = |k: u32| effective(base[k as usize], layer[k as usize])[c];
+                        let e = |k: u32| effective(base[k as usize], layer.value(k))[c];
                         (e(lo) + e(i) + e(hi)) / 3.0
                     });
                     let t = std::array::from_fn(|c| 0.5 * (along[c] + mean_under[c]));
                     mix_toward(before, t, a)
                 }
             };
-            if value != layer[iu] {
-                layer[iu] = value;
+            if value != layer.value(i) {
+                layer.set_value(i, value);
                 changed.push(i);
             }
         }
@@ -333,6 +393,46 @@ impl PaintDelta {
                 std::mem::swap(slot, v);
             }
         }
+    }
+
+    /// Adds the points of `later` that this delta does not hold yet, with their values in `later`:
+    /// for undo deltas, the earliest value of each point wins (a stroke's undo holds each point as
+    /// it was before the stroke). Both are sorted by index, and so is the result.
+    pub fn keep_earliest(&mut self, later: PaintDelta) {
+        let mut merged = Vec::with_capacity(self.indices.len() + later.indices.len());
+        let mut mine = self
+            .indices
+            .iter()
+            .copied()
+            .zip(self.values.iter().copied());
+        let mut theirs = later.indices.into_iter().zip(later.values).peekable();
+        for (i, v) in mine.by_ref() {
+            while let Some(&(j, w)) = theirs.peek()
+                && j < i
+            {
+                merged.push((j, w));
+                theirs.next();
+            }
+            if theirs.peek().is_some_and(|&(j, _)| j == i) {
+                theirs.next();
+            }
+            merged.push((i, v));
+        }
+        merged.extend(theirs);
+        (self.indices, self.values) = merged.into_iter().unzip();
+    }
+
+    /// Drops the points whose value here equals the layer's (a stroke that put a point back as it
+    /// was has no undo for it).
+    pub fn retain_differing(&mut self, layer: &[LayerValue]) {
+        let keep: Vec<(u32, LayerValue)> = self
+            .indices
+            .iter()
+            .zip(&self.values)
+            .filter(|(i, v)| layer.get(**i as usize) != Some(*v))
+            .map(|(i, v)| (*i, *v))
+            .collect();
+        (self.indices, self.values) = keep.into_iter().unzip();
     }
 
     /// Memory the delta holds, bytes.
@@ -439,6 +539,52 @@ mod tests {
         );
         let blurred = effective(base[1], layer[1]);
         assert!((blurred[0] - base[1][0]).abs() < (dyed[0] - base[1][0]).abs());
+    }
+
+    #[test]
+    fn a_dab_over_a_layer_gives_the_delta_the_layer_itself_gets() {
+        let base = vec![[0.4, 0.6, 1.0]; 5];
+        let mut direct = vec![[0.0; 4]; 5];
+        direct[2] = [1.0, 0.2, 0.1, 0.5];
+        let brush = Brush {
+            strength: 0.7,
+            mode: PaintMode::Blur,
+            ..Default::default()
+        };
+        let under: &[Touch] = &[(1, 0.6), (2, 1.0), (3, 0.3)];
+        let before = direct.clone();
+        let mut over = DabLayer::new(&before);
+        let changed = Stroke::new().dab(&brush, under, &mut over, &base, |_| 0..5, [0.4, 0.8, 1.6]);
+        let mut delta = over.into_delta().expect("a change");
+        assert_eq!(delta.indices, changed);
+        let changed_direct = Stroke::new().dab(
+            &brush,
+            under,
+            &mut direct[..],
+            &base,
+            |_| 0..5,
+            [0.4, 0.8, 1.6],
+        );
+        assert_eq!(changed, changed_direct);
+        let mut layer = before.clone();
+        delta.swap(&mut layer);
+        assert_eq!(layer, direct, "the delta is the dab, bit for bit");
+        // Undo deltas merge keeping each point's earliest value.
+        let mut first = PaintDelta {
+            indices: vec![1, 4],
+            values: vec![[1.0; 4], [4.0; 4]],
+        };
+        first.keep_earliest(PaintDelta {
+            indices: vec![0, 1, 2, 5],
+            values: vec![[0.5; 4], [9.0; 4], [2.0; 4], [5.0; 4]],
+        });
+        assert_eq!(first.indices, vec![0, 1, 2, 4, 5]);
+        assert_eq!(
+            first.values,
+            vec![[0.5; 4], [1.0; 4], [2.0; 4], [4.0; 4], [5.0; 4]]
+        );
+        first.retain_differing(&[[0.5; 4], [0.0; 4], [2.0; 4], [0.0; 4], [0.0; 4], [5.0; 4]]);
+        assert_eq!(first.indices, vec![1, 4]);
     }
 
     #[test]

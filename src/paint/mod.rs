@@ -7,6 +7,6 @@ pub mod dye;
 pub mod layer;
 pub mod pick;
 
-pub use brush::{Brush, PaintDelta, PaintMode, Stroke};
+pub use brush::{Brush, DabLayer, PaintDelta, PaintMode, Stroke};
 pub use dye::{AbsorptionSpec, sigma_a_from_colour};
 pub use layer::{PaintLayer, PaintLayerError, SharedLayer};

@@ -42,6 +42,15 @@ pub enum EditKind {
     Occluder,
 }
 
+impl EditKind {
+    /// Whether an edit of this kind, during a gesture whose step is of kind `step`, belongs to that
+    /// step: one of the same kind, or a paint stroke's dabs after the dab that made the layer (the
+    /// step's undo removes the whole layer).
+    pub fn extends(self, step: EditKind) -> bool {
+        self == step || (self == EditKind::Paint && step == EditKind::PaintLayer)
+    }
+}
+
 impl Edit {
     pub fn kind(&self) -> EditKind {
         match self {

@@ -1,8 +1,10 @@
 //! Undo and redo of [`Edit`]s. Each step holds one edit: on the undo stack the edit that undoes it,
 //! on the redo stack the edit that redoes it (applying an edit returns its inverse, so undo and redo
 //! swap them; a paint stroke's sparse delta is stored once). A gesture (a slider drag, a colour-picker
-//! drag) is one step: while it is open, edits of the same kind keep the step's undo edit. The history
-//! is bounded by a step count and a memory budget: the oldest steps are dropped first.
+//! drag, a brush stroke) is one step: while it is open, edits of the same kind keep the step's undo
+//! edit, and a stroke's dabs add the points they touch first to it, so the step undoes the whole
+//! gesture. The history is bounded by a step count and a memory budget: the oldest steps are dropped
+//! first.
 
 use super::edit::{Edit, EditKind, apply};
 use super::model::Session;
@@ -56,23 +58,34 @@ impl History {
             return false;
         }
         self.redo.clear();
-        if self.open != Some(kind) || self.undo.is_empty() {
-            self.push(inverse);
-        }
-        self.open = gesture.then_some(kind);
+        let step = match self.open {
+            Some(open) if kind.extends(open) && !self.undo.is_empty() => {
+                // The step's undo edit restores the state before the gesture; a dab's undo adds the
+                // points the stroke had not touched yet.
+                if let (Some(Edit::Paint(step)), Edit::Paint(earlier)) =
+                    (self.undo.last_mut(), inverse)
+                {
+                    step.keep_earliest(*earlier);
+                    self.trim();
+                }
+                open
+            }
+            _ => {
+                self.push(inverse);
+                kind
+            }
+        };
+        self.open = gesture.then_some(step);
         true
-    }
-
-    /// Records a change already made to the session (a paint stroke, applied dab by dab) as one step:
-    /// `undo` restores the state before it.
-    pub fn record(&mut self, undo: Edit) {
-        self.redo.clear();
-        self.open = None;
-        self.push(undo);
     }
 
     fn push(&mut self, undo: Edit) {
         self.undo.push(undo);
+        self.trim();
+    }
+
+    /// Drops the oldest steps beyond the step count or the memory budget (never the newest).
+    fn trim(&mut self) {
         let mut held: usize = self.undo.iter().map(Edit::bytes).sum();
         while self.undo.len() > 1 && (self.undo.len() > self.limit || held > self.budget) {
             held -= self.undo[0].bytes();
@@ -88,13 +101,26 @@ impl History {
     /// Closes the open gesture (the pointer was released): the next edit starts a new step. A drag
     /// that came back to where it started leaves no step.
     pub fn end_gesture(&mut self, session: &Session) {
-        if self.open.take().is_some()
-            && let Some(undo) = self.undo.last()
-        {
-            let mut s = session.clone();
-            if apply(&mut s, undo.clone()) == *undo {
-                self.undo.pop();
+        if self.open.take().is_none() {
+            return;
+        }
+        let Some(undo) = self.undo.last_mut() else {
+            return;
+        };
+        let unchanged = match (undo, &session.paint_layer) {
+            // A stroke: the points it left as they were need no undo (and the layer no copy to
+            // find out).
+            (Edit::Paint(delta), Some(layer)) => {
+                delta.retain_differing(&layer.get().points);
+                delta.indices.is_empty()
             }
+            (undo, _) => {
+                let mut s = session.clone();
+                apply(&mut s, undo.clone()) == *undo
+            }
+        };
+        if unchanged {
+            self.undo.pop();
         }
     }
 
@@ -218,18 +244,22 @@ mod tests {
         let step = 100 * 20 + std::mem::size_of::<Edit>();
         let mut h = History::with_budget(100, 2 * step + 10);
         for k in 0..3u32 {
-            let indices: Vec<u32> = (100 * k..100 * k + 100).collect();
-            let layer = s.paint_layer.as_mut().unwrap().make_mut();
-            let undo = PaintDelta {
-                values: indices.iter().map(|&i| layer.points[i as usize]).collect(),
-                indices: indices.clone(),
-            };
-            for &i in &indices {
-                layer.points[i as usize] = [1.0, 2.0, 3.0, 0.5 + 0.1 * k as f32];
+            // A stroke of four dabs over 25 points each: one step.
+            for dab in 0..4 {
+                let indices: Vec<u32> = (100 * k + 25 * dab..100 * k + 25 * dab + 25).collect();
+                let stroke = PaintDelta {
+                    values: vec![[1.0, 2.0, 3.0, 0.5 + 0.1 * k as f32]; indices.len()],
+                    indices,
+                };
+                assert!(h.perform(&mut s, Edit::Paint(Box::new(stroke)), true));
             }
-            assert_eq!(undo.bytes(), 100 * 20);
-            h.record(Edit::Paint(Box::new(undo)));
+            h.end_gesture(&s);
         }
+        assert_eq!(
+            h.undo.last().map(Edit::bytes),
+            Some(step),
+            "20 bytes a point"
+        );
         assert!(h.bytes() <= 2 * step + 10, "{}", h.bytes());
         let painted = s.clone();
         assert!(h.undo(&mut s).is_some() && h.undo(&mut s).is_some());
@@ -241,6 +271,69 @@ mod tests {
         h.redo(&mut s);
         assert!(s == painted, "redo restores the strokes bit for bit");
         assert!(s != before);
+    }
+
+    #[test]
+    fn a_stroke_that_made_the_layer_undoes_to_no_layer() {
+        use crate::paint::{PaintDelta, PaintLayer, SharedLayer};
+        let mut s = Session::default();
+        let before = s.clone();
+        let mut h = History::default();
+        let mut layer = PaintLayer::empty(10, 2);
+        layer.points[1] = [1.0; 4];
+        let made = Edit::PaintLayer(Box::new((Some(SharedLayer::new(layer)), None)));
+        assert!(h.perform(&mut s, made, true));
+        let dab = PaintDelta {
+            indices: vec![2, 3],
+            values: vec![[2.0; 4]; 2],
+        };
+        assert!(h.perform(&mut s, Edit::Paint(Box::new(dab)), true));
+        h.end_gesture(&s);
+        let painted = s.clone();
+        assert_eq!(h.undo_label(), Some("paint layer"));
+        h.undo(&mut s);
+        assert!(s == before && !h.can_undo(), "one step, back to no layer");
+        h.redo(&mut s);
+        assert!(s == painted);
+    }
+
+    #[test]
+    fn a_stroke_replays_from_its_edits_as_data() {
+        use crate::paint::{PaintDelta, PaintLayer, SharedLayer};
+        let start = Session::default();
+        let mut layer = PaintLayer::empty(8, 2);
+        layer.points[0] = [0.5; 4];
+        let dabs = vec![
+            Edit::PaintLayer(Box::new((Some(SharedLayer::new(layer)), None))),
+            Edit::Paint(Box::new(PaintDelta {
+                indices: vec![0, 5],
+                values: vec![[1.0; 4], [2.0; 4]],
+            })),
+            Edit::Paint(Box::new(PaintDelta {
+                indices: vec![5, 6],
+                values: vec![[3.0; 4], [4.0; 4]],
+            })),
+        ];
+        let mut s = start.clone();
+        let mut h = History::default();
+        for e in &dabs {
+            assert!(h.perform(&mut s, e.clone(), true));
+        }
+        h.end_gesture(&s);
+        // What autosave or a test would keep: the edits as text, applied to the same start.
+        let text = serde_json::to_string(&dabs).unwrap();
+        let mut replayed = start.clone();
+        for e in serde_json::from_str::<Vec<Edit>>(&text).unwrap() {
+            apply(&mut replayed, e);
+        }
+        assert!(replayed == s, "the replay paints the same layer");
+        let points = &replayed.paint_layer.as_ref().unwrap().get().points;
+        assert_eq!(
+            (points[0], points[5], points[6]),
+            ([1.0; 4], [3.0; 4], [4.0; 4])
+        );
+        h.undo(&mut s);
+        assert!(s == start && !h.can_undo(), "one undo step for the stroke");
     }
 
     #[test]

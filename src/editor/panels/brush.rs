@@ -2,8 +2,10 @@
 //! radius, strength, falloff, reach, root-to-tip mask, mirror, spacing.
 
 use super::widgets::{linear_to_srgb8, srgb8_to_linear};
-use crate::editor::app::EditorApp;
-use crate::editor::brush_tool::Tool;
+use crate::editor::command::AppCommand;
+use crate::editor::context::PanelContext;
+use crate::editor::tools::brush::BrushTool;
+use crate::editor::tools::{Tool, Tools};
 use crate::paint::brush::{FRONT_DEPTH, Falloff, PaintMode};
 use crate::paint::dye::{DEFAULT_BETA_N, colour_from_sigma_a};
 use crate::paint::sigma_a_from_colour;
@@ -49,24 +51,28 @@ fn swatch(sigma_a: [f32; 3]) -> egui::Color32 {
     egui::Color32::from_rgb(r, g, b)
 }
 
-pub fn tools(app: &mut EditorApp, ui: &mut egui::Ui) {
+/// The tool row, and the brush's settings when it is the tool.
+pub fn tools(ctx: &PanelContext, tools: &mut Tools, ui: &mut egui::Ui) {
+    let mut tool = tools.active();
     ui.horizontal(|ui| {
         ui.label("Tool");
-        ui.selectable_value(&mut app.tool, Tool::Navigate, "navigate")
+        ui.selectable_value(&mut tool, Tool::Navigate, "navigate")
             .on_hover_text("Orbit, pan and zoom (V or Esc)");
-        ui.selectable_value(&mut app.tool, Tool::Brush, "brush")
+        ui.selectable_value(&mut tool, Tool::Brush, "brush")
             .on_hover_text(
                 "Paint absorption onto the strands under the cursor (B): left-drag paints, the middle \
                  button and the wheel still navigate",
             );
     });
-    if app.tool == Tool::Brush {
-        panel(app, ui);
+    tools.select(tool);
+    if tool == Tool::Brush {
+        panel(ctx, tools.brush_mut(), ui);
     }
 }
 
-fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
-    let b = &mut app.brush;
+fn panel(ctx: &PanelContext, brush: &mut BrushTool, ui: &mut egui::Ui) {
+    let st = brush.stats();
+    let b = brush.settings_mut();
     ui.horizontal_wrapped(|ui| {
         for m in PaintMode::ALL {
             ui.selectable_value(&mut b.mode, m, m.name())
@@ -209,15 +215,14 @@ fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
         .on_hover_text("Also paint the footprint mirrored across the hair's symmetry plane (even where that side is hidden)");
     ui.add(egui::Slider::new(&mut b.spacing, 0.05..=1.0).text("spacing"))
         .on_hover_text("Dab spacing along the stroke, as a fraction of the radius");
-    let painted = app.session.paint_layer.is_some() || app.session.paint.is_some();
+    let painted = ctx.session.paint_layer.is_some() || ctx.session.paint.is_some();
     if ui
         .add_enabled(painted, egui::Button::new("Clear paint"))
         .on_hover_text("Remove the paint layer: the hair shows the look alone (one undo step)")
         .clicked()
     {
-        app.clear_paint();
+        ctx.send(AppCommand::ClearPaint);
     }
-    let st = app.brush_stats;
     if st.dabs > 0 {
         ui.weak(format!(
             "{} dabs · last {:.2} ms, {} points · mean {:.2} ms",

@@ -3,8 +3,9 @@
 
 use super::widgets::{Changed, slider, slider32};
 use crate::colour::{srgb_decode, srgb_encode};
-use crate::editor::app::EditorApp;
-use crate::editor::panels::menu;
+use crate::editor::command::{AppCommand, Dialog};
+use crate::editor::context::PanelContext;
+use crate::editor::env_preview::EnvPreview;
 use crate::hair::procedural::{Style, StyleParams};
 use crate::render::display::{Solo, ViewTransform};
 use crate::render::passes::background::Background;
@@ -20,22 +21,22 @@ const STYLES: [(Style, &str); 6] = [
     (Style::SidePart, "side part"),
 ];
 
-pub fn panel(app: &mut EditorApp, ui: &mut egui::Ui) {
+pub fn panel(ctx: &PanelContext, ui: &mut egui::Ui) {
     ui.heading("Hair");
-    hair(app, ui);
+    hair(ctx, ui);
     ui.separator();
     ui.heading("Environment");
-    environment(app, ui);
+    environment(ctx, ui);
     ui.separator();
     ui.heading("Render");
-    render(app, ui);
+    render(ctx, ui);
     ui.separator();
     ui.heading("Viewport");
-    view(app, ui);
+    view(ctx, ui);
 }
 
-fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
-    match &app.session.hair {
+fn hair(ctx: &PanelContext, ui: &mut egui::Ui) {
+    match &ctx.session.hair {
         HairSource::File { path, .. } => {
             ui.label(format!("file {}", path.display()));
         }
@@ -44,12 +45,12 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
         }
     }
     if ui.button("Open hair file…").clicked() {
-        menu::hair_dialog(app);
+        ctx.send(AppCommand::Dialog(Dialog::OpenHair));
     }
-    generator(app, ui);
-    head(app, ui);
+    generator(ctx, ui);
+    head(ctx, ui);
     let mut dye = None;
-    if let Some(live) = &app.live {
+    if let Some(live) = ctx.live() {
         // The driver's bounds, found once per hair (not every frame over every point).
         let (strands, points, (lo, hi), coloured) = {
             let d = live.lock();
@@ -82,14 +83,17 @@ fn hair(app: &mut EditorApp, ui: &mut egui::Ui) {
     }
     if let Some(layer) = dye {
         let layer = crate::paint::SharedLayer::new(layer);
-        app.perform(Edit::PaintLayer(Box::new((Some(layer), None))), false);
+        ctx.send(AppCommand::Edit {
+            edit: Edit::PaintLayer(Box::new((Some(layer), None))),
+            gesture: false,
+        });
     }
 }
 
 /// The head the hair sits on: shown or not, its skin colour, and its mesh (the hair's own: the
 /// generated head, or the mesh a glTF hair carries; or a mesh file).
-fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
-    let mut o = app.session.occluder.clone();
+fn head(ctx: &PanelContext, ui: &mut egui::Ui) {
+    let mut o = ctx.session.occluder.clone();
     let mut gesture = false;
     ui.horizontal(|ui| {
         ui.checkbox(&mut o.show, "Head").on_hover_text(
@@ -108,8 +112,8 @@ fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
     });
     ui.horizontal(|ui| {
         let own = match (
-            &app.session.hair,
-            app.live.as_ref().map(|l| l.lock().hair_mesh.is_some()),
+            &ctx.session.hair,
+            ctx.live().map(|l| l.lock().hair_mesh.is_some()),
         ) {
             (HairSource::Generated { .. }, _) => "the generated head",
             (_, Some(true)) => "the hair file's mesh",
@@ -126,7 +130,7 @@ fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
             .on_hover_text("An OBJ or glTF mesh, in the hair file's units and axes")
             .clicked()
         {
-            menu::occluder_dialog(app);
+            ctx.send(AppCommand::Dialog(Dialog::OpenOccluder));
         }
         if o.mesh.is_some()
             && ui
@@ -137,8 +141,11 @@ fn head(app: &mut EditorApp, ui: &mut egui::Ui) {
             o.mesh = None;
         }
     });
-    if o != app.session.occluder {
-        app.perform(Edit::Occluder(Box::new(o)), gesture);
+    if o != ctx.session.occluder {
+        ctx.send(AppCommand::Edit {
+            edit: Edit::Occluder(Box::new(o)),
+            gesture,
+        });
     }
 }
 
@@ -189,11 +196,11 @@ impl Generator {
 
 /// The procedural generator (style, counts, seed, length, clumping, frizz): Generate makes the
 /// settings the session's hair.
-fn generator(app: &mut EditorApp, ui: &mut egui::Ui) {
+fn generator(ctx: &PanelContext, ui: &mut egui::Ui) {
     let id = ui.scope_id().with("generator");
     let mut g = ui
         .data_mut(|d| d.get_temp::<Generator>(id))
-        .unwrap_or_else(|| Generator::of(&app.session.hair));
+        .unwrap_or_else(|| Generator::of(&ctx.session.hair));
     egui::CollapsingHeader::new("Generator")
         .default_open(false)
         .show(ui, |ui| {
@@ -244,10 +251,13 @@ fn generator(app: &mut EditorApp, ui: &mut egui::Ui) {
             ui.horizontal(|ui| {
                 let source = g.source();
                 if ui
-                    .add_enabled(source != app.session.hair, egui::Button::new("Generate"))
+                    .add_enabled(source != ctx.session.hair, egui::Button::new("Generate"))
                     .clicked()
                 {
-                    app.perform(Edit::Hair(source), false);
+                    ctx.send(AppCommand::Edit {
+                        edit: Edit::Hair(source),
+                        gesture: false,
+                    });
                 }
                 if ui.button("Defaults").on_hover_text("The style's default shape").clicked() {
                     let style = STYLES[g.style].0;
@@ -259,30 +269,30 @@ fn generator(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.data_mut(|d| d.insert_temp(id, g));
 }
 
-fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
-    match &app.session.environment {
+fn environment(ctx: &PanelContext, ui: &mut egui::Ui) {
+    match &ctx.session.environment {
         EnvironmentSource::Builtin => ui.label("built-in sunny sky"),
         EnvironmentSource::File { path, .. } => ui.label(path.display().to_string()),
     };
     ui.horizontal(|ui| {
         if ui.button("Open…").clicked() {
-            menu::environment_dialog(app);
+            ctx.send(AppCommand::Dialog(Dialog::OpenEnvironment));
         }
         if ui
             .add_enabled(
-                app.session.environment != EnvironmentSource::Builtin,
+                ctx.session.environment != EnvironmentSource::Builtin,
                 egui::Button::new("Built-in"),
             )
             .clicked()
         {
-            app.perform(
-                Edit::Environment(Box::new(EnvironmentSource::Builtin)),
-                false,
-            );
-            app.load_scene();
+            ctx.send(AppCommand::Edit {
+                edit: Edit::Environment(Box::new(EnvironmentSource::Builtin)),
+                gesture: false,
+            });
+            ctx.send(AppCommand::ReloadScene);
         }
     });
-    let mut yaw = app.session.env_yaw;
+    let mut yaw = ctx.session.env_yaw;
     let c = slider(
         ui,
         "yaw",
@@ -294,9 +304,16 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
         "Turns the environment about the vertical axis (no refit), degrees",
     );
     if c.changed {
-        app.perform(Edit::EnvYaw(yaw), c.gesture);
+        ctx.send(AppCommand::Edit {
+            edit: Edit::EnvYaw(yaw),
+            gesture: c.gesture,
+        });
     }
-    if let Some(live) = &app.live {
+    // The pictures' textures, uploaded once per environment and kept with the panel's other state
+    // in egui's memory.
+    let id = ui.scope_id().with("environment pictures");
+    let mut preview: Option<EnvPreview> = ui.data(|d| d.get_temp(id));
+    if let Some(live) = ctx.live() {
         let (count, name) = {
             let d = live.lock();
             (
@@ -305,12 +322,14 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
             )
         };
         let pictures = live.environment_pictures.clone();
-        if app.env_preview.as_ref().map(|p| &p.key) != Some(&pictures.key) {
-            app.env_preview = Some(crate::editor::env_preview::upload(ui.ctx(), &pictures));
+        if preview.as_ref().map(|p| &p.key) != Some(&pictures.key) {
+            let uploaded = crate::editor::env_preview::upload(ui.ctx(), &pictures);
+            ui.data_mut(|d| d.insert_temp(id, uploaded.clone()));
+            preview = Some(uploaded);
         }
         ui.weak(format!("{count} SRBF lights · {name}"));
     }
-    if let Some(p) = &app.env_preview {
+    if let Some(p) = &preview {
         let w = ui.available_width().min(250.0);
         let size = egui::vec2(w, 0.5 * w);
         if let Some(image) = &p.image {
@@ -326,8 +345,8 @@ fn environment(app: &mut EditorApp, ui: &mut egui::Ui) {
     }
 }
 
-fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
-    let mut r: RenderOptions = app.session.render;
+fn render(ctx: &PanelContext, ui: &mut egui::Ui) {
+    let mut r: RenderOptions = ctx.session.render;
     let mut c = Changed::default();
     c.changed |= ui
         .checkbox(&mut r.shadows, "Self-shadowing")
@@ -438,12 +457,16 @@ fn render(app: &mut EditorApp, ui: &mut egui::Ui) {
             }
         }
     });
-    if c.changed && r != app.session.render {
-        app.perform(Edit::Render(r), c.gesture);
+    if c.changed && r != ctx.session.render {
+        ctx.send(AppCommand::Edit {
+            edit: Edit::Render(r),
+            gesture: c.gesture,
+        });
     }
 }
 
-fn view(app: &mut EditorApp, ui: &mut egui::Ui) {
+fn view(ctx: &PanelContext, ui: &mut egui::Ui) {
+    let mut view = ctx.viewport.view();
     ui.horizontal(|ui| {
         ui.label("view");
         for (t, name, tip) in [
@@ -455,18 +478,18 @@ fn view(app: &mut EditorApp, ui: &mut egui::Ui) {
             (ViewTransform::Standard, "standard", "Clamped sRGB"),
         ] {
             if ui
-                .selectable_label(app.view.transform == t, name)
+                .selectable_label(view.transform == t, name)
                 .on_hover_text(tip)
                 .clicked()
             {
-                app.view.transform = t;
+                view.transform = t;
             }
         }
     });
     slider32(
         ui,
         "view exposure",
-        &mut app.view.exposure,
+        &mut view.exposure,
         -6.0..=6.0,
         " EV",
         1,
@@ -476,19 +499,19 @@ fn view(app: &mut EditorApp, ui: &mut egui::Ui) {
     ui.horizontal_wrapped(|ui| {
         ui.label("show");
         if ui
-            .selectable_label(app.view.solo == Solo::Beauty, "beauty")
+            .selectable_label(view.solo == Solo::Beauty, "beauty")
             .on_hover_text("All scattering components")
             .clicked()
         {
-            app.view.solo = Solo::Beauty;
+            view.solo = Solo::Beauty;
         }
         for (k, name) in COMPONENTS.iter().enumerate() {
             if ui
-                .selectable_label(app.view.solo == Solo::Component(k), *name)
+                .selectable_label(view.solo == Solo::Component(k), *name)
                 .on_hover_text("This component alone (the EXR's AOV layer of the same name)")
                 .clicked()
             {
-                app.view.solo = Solo::Component(k);
+                view.solo = Solo::Component(k);
             }
         }
     });
@@ -496,12 +519,15 @@ fn view(app: &mut EditorApp, ui: &mut egui::Ui) {
         ui.label("resolution");
         for s in [0.25f32, 0.5, 1.0] {
             if ui
-                .selectable_label(app.view.scale == s, format!("{:.0}%", s * 100.0))
+                .selectable_label(view.scale == s, format!("{:.0}%", s * 100.0))
                 .on_hover_text("Render resolution as a fraction of the viewport's pixels")
                 .clicked()
             {
-                app.view.scale = s;
+                view.scale = s;
             }
         }
     });
+    if view != ctx.viewport.view() {
+        ctx.send(AppCommand::SetView(view));
+    }
 }

@@ -1,16 +1,18 @@
 //! The status bar: adapter, hair and light counts, refinement progress, UI frame time, jobs, messages.
 
-use crate::editor::app::{EditorApp, Level};
+use crate::editor::command::AppCommand;
+use crate::editor::context::PanelContext;
+use crate::editor::messages::Level;
 use crate::render::refine::UNIT_PASSES;
 
-pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
+pub fn bar(ctx: &PanelContext, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
-        match &app.gpu {
+        match ctx.gpu {
             Some(g) => ui.label(format!("GPU: {} ({})", g.summary.name, g.summary.backend)),
             None => ui.colored_label(ui.visuals().error_fg_color, "no GPU"),
         };
         ui.separator();
-        if let Some(live) = &app.live {
+        if let Some(live) = ctx.live() {
             let s = {
                 let d = live.lock();
                 Snapshot {
@@ -31,7 +33,7 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
             ));
             ui.separator();
             let (w, h) = s.size;
-            ui.label(format!("{w}×{h} ({:.0} %)", 100.0 * app.view.scale))
+            ui.label(format!("{w}×{h} ({:.0} %)", 100.0 * ctx.viewport.view().scale))
                 .on_hover_text(
                     "The render size and its share of the viewport's pixels (the resolution buttons by the view transform)",
                 );
@@ -77,33 +79,31 @@ pub fn bar(app: &mut EditorApp, ui: &mut egui::Ui) {
                 }
             }
         }
-        if let Some(job) = &app.loading {
+        if let Some(label) = ctx.jobs.loading {
             ui.separator();
-            ui.label(format!("{}…", job.label));
+            ui.label(format!("{label}…"));
         }
-        let mut cancel = false;
-        if let Some(e) = &app.export {
+        if let Some((fraction, writing)) = ctx.jobs.export {
             ui.separator();
             ui.add(
-                egui::ProgressBar::new(e.fraction)
+                egui::ProgressBar::new(fraction)
                     .desired_width(100.0)
                     .text("export"),
             );
-            cancel = ui
-                .add_enabled(!e.writing(), egui::Button::new("cancel").small())
+            if ui
+                .add_enabled(!writing, egui::Button::new("cancel").small())
                 .on_hover_text("Stop the export (nothing is written)")
-                .clicked();
+                .clicked()
+            {
+                ctx.send(AppCommand::CancelExport);
+            }
         }
-        if cancel {
-            app.export = None;
-            app.message(Level::Info, "export cancelled");
-        }
-        if app.frame_ms > 0.0 {
+        if ctx.frame_ms > 0.0 {
             ui.separator();
-            ui.weak(format!("UI {:.1} ms", app.frame_ms))
+            ui.weak(format!("UI {:.1} ms", ctx.frame_ms))
                 .on_hover_text("The UI's own work per frame (the render thread refines apart)");
         }
-        if let Some(m) = app.messages.last() {
+        if let Some(m) = ctx.messages.last() {
             ui.separator();
             let colour = match m.level {
                 Level::Error => ui.visuals().error_fg_color,

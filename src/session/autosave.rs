@@ -1,16 +1,49 @@
-//! Autosave: a recovery file written atomically on a worker 30 s after a change (and on quit when there
-//! are unsaved changes), removed when the session is saved; the next start offers it.
+//! Autosave and recovery: a recovery file written atomically on a worker 30 s after a change (and on
+//! quit when there are unsaved changes), removed when the session is saved; the next start offers it.
+//! It is the session's business, not the window's: a [`Job`] does the writing and a wake function
+//! (the editor's asks egui for a repaint) says when to look again.
 //!
 //! Each running editor writes its own file, `recovery-<pid>.slsession` in the state folder, which
 //! records the session file it belongs to. At start, files of processes that are no longer running are
 //! offered (the newest); a file of a live process belongs to another open editor and is left alone.
 
+use super::io::SessionError;
+use super::model::Session;
 use crate::files::write_atomic;
-use crate::live::jobs::Job;
-use crate::session::Session;
+use crate::jobs::{Job, Wake};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+/// Why a recovery file could not be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum AutosaveError {
+    #[error("autosave: cannot create {}: {source}", dir.display())]
+    CreateDir {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("autosave to {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: cannot read the recovery file: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a recovery file: {source}", path.display())]
+    Format {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// The worker writing the file stopped without a result.
+    #[error("{0}")]
+    Worker(String),
+}
 
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(30);
 const PREFIX: &str = "recovery-";
@@ -41,7 +74,7 @@ pub struct Autosave {
     session_path: Option<PathBuf>,
     dirty_since: Option<Instant>,
     pub interval: Duration,
-    writing: Option<Job<Result<(), String>>>,
+    writing: Option<Job<Result<(), AutosaveError>>>,
     /// The session was saved while a write was in flight: delete the file when it lands.
     delete_when_written: bool,
     /// Recovery files written (tests).
@@ -95,39 +128,47 @@ impl Autosave {
         remove_recovery(&self.path);
     }
 
-    /// Once a frame: starts the write when due; returns an error message when a write failed (it is
-    /// retried one interval later).
-    pub fn tick(&mut self, session: &Session, ctx: &egui::Context) -> Option<String> {
+    /// Once a frame: starts the write when due (the worker calls `wake` when it is done). Returns
+    /// how long until a write is due, for the caller to look again then; an error when a write
+    /// failed (it is retried one interval later).
+    pub fn tick(
+        &mut self,
+        session: &Session,
+        wake: &Wake,
+    ) -> Result<Option<Duration>, AutosaveError> {
         if let Some(job) = &mut self.writing {
-            let result = job.poll()?;
+            let Some(result) = job.poll() else {
+                return Ok(None);
+            };
             self.writing = None;
             if std::mem::take(&mut self.delete_when_written) {
                 self.remove();
             }
-            match result.and_then(|r| r) {
+            match result.map_err(AutosaveError::Worker).and_then(|r| r) {
                 Ok(()) => self.writes += 1,
                 Err(e) => {
                     self.dirty_since.get_or_insert_with(Instant::now);
-                    return Some(e);
+                    return Err(e);
                 }
             }
         }
-        let since = self.dirty_since?;
+        let Some(since) = self.dirty_since else {
+            return Ok(None);
+        };
         let elapsed = since.elapsed();
         if elapsed < self.interval {
-            ctx.request_repaint_after(self.interval - elapsed);
-            return None;
+            return Ok(Some(self.interval - elapsed));
         }
         self.dirty_since = None;
         let contents = self.contents(session);
         let path = self.path.clone();
-        let wake = ctx.clone();
+        let wake = wake.clone();
         self.writing = Some(Job::spawn(
             "autosave",
-            move || wake.request_repaint(),
+            move || wake(),
             move |_| write_recovery(&path, &contents),
         ));
-        None
+        Ok(None)
     }
 
     /// The session was saved: no recovery needed (a write in flight is deleted when it lands).
@@ -140,7 +181,7 @@ impl Autosave {
 
     /// On quit (or before another session replaces an unsaved one): keep unsaved work in the
     /// recovery file, else remove it.
-    pub fn on_exit(&mut self, session: &Session, modified: bool) -> Result<(), String> {
+    pub fn on_exit(&mut self, session: &Session, modified: bool) -> Result<(), AutosaveError> {
         // A write in flight targets the same file: it must land before this one (or the deletion).
         while let Some(job) = &mut self.writing {
             if job.poll().is_some() {
@@ -184,13 +225,18 @@ impl Autosave {
 
 /// A recovery file's session and the session file it belongs to (empty: an unsaved session).
 /// A warning comes with it when the layer beside it could not be read (the rest of the work opens).
-pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session, Option<String>), String> {
-    let text = std::fs::read_to_string(file)
-        .map_err(|e| format!("{}: cannot read the recovery file: {e}", file.display()))?;
-    let r: Recovery = serde_json::from_str(&text)
-        .map_err(|e| format!("{}: not a recovery file: {e}", file.display()))?;
-    let json = serde_json::to_string(&r.session).map_err(|e| e.to_string())?;
-    let mut session = Session::from_json(&json, file).map_err(|e| e.to_string())?;
+pub fn read_recovery(file: &Path) -> Result<(PathBuf, Session, Option<String>), AutosaveError> {
+    let text = std::fs::read_to_string(file).map_err(|source| AutosaveError::Read {
+        path: file.into(),
+        source,
+    })?;
+    let format = |source| AutosaveError::Format {
+        path: file.into(),
+        source,
+    };
+    let r: Recovery = serde_json::from_str(&text).map_err(format)?;
+    let json = serde_json::to_string(&r.session).map_err(format)?;
+    let mut session = Session::from_json(&json, file)?;
     let mut warning = None;
     if let Some(layer) = &r.paint_layer {
         // A missing or damaged layer costs the paint, not the rest of the work.
@@ -215,20 +261,27 @@ fn process_alive(pid: u32) -> bool {
     Path::new("/proc").join(pid.to_string()).exists()
 }
 
-fn write_recovery(path: &Path, contents: &Contents) -> Result<(), String> {
+fn write_recovery(path: &Path, contents: &Contents) -> Result<(), AutosaveError> {
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("autosave: cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|source| AutosaveError::CreateDir {
+            dir: dir.into(),
+            source,
+        })?;
     }
+    let write = |file: &Path, bytes: &[u8]| {
+        write_atomic(file, bytes).map_err(|source| AutosaveError::Write {
+            path: file.into(),
+            source,
+        })
+    };
     // The layer first: a recovery file never names a layer that is not there.
     match &contents.layer {
-        Some((file, layer)) => write_atomic(file, &layer.get().encode())
-            .map_err(|e| format!("autosave to {}: {e}", file.display()))?,
+        Some((file, layer)) => write(file, &layer.get().encode())?,
         None => {
             let _ = std::fs::remove_file(path.with_extension("slpaint"));
         }
     }
-    write_atomic(path, &contents.json).map_err(|e| format!("autosave to {}: {e}", path.display()))
+    write(path, &contents.json)
 }
 
 /// Removes a recovery file and the paint layer beside it.

@@ -1,9 +1,80 @@
-//! Viewport navigation with Blender's habits, as pure functions of the orbit camera: orbit (middle
-//! drag, Alt+left drag), pan (Shift+middle drag), zoom (wheel, Ctrl+middle drag), frame the hair
-//! (Home, numpad-style '.'), front/side/top views (1/3/7, Ctrl for the opposite side).
+//! The navigate tool, always at hand: viewport navigation with Blender's habits, as pure functions
+//! of the orbit camera, and the viewport input that drives them: orbit (middle drag, Alt+left
+//! drag), pan (Shift+middle drag), zoom (wheel, Ctrl+middle drag), frame the hair (Home,
+//! numpad-style '.'), front/side/top views (1/3/7, Ctrl for the opposite side). It holds no state
+//! between frames: the camera is the viewport's, and a move is a command.
 
+use crate::editor::command::AppCommand;
+use crate::editor::context::PanelContext;
 use crate::render::Camera;
 use glam::Vec3;
+
+/// The viewport's pointer and keys for navigation; camera moves go to the app as commands.
+pub fn input(ctx: &PanelContext, ui: &egui::Ui, response: &egui::Response, rect: egui::Rect) {
+    let Some(mut c) = ctx.viewport.camera() else {
+        return;
+    };
+    let (mods, scroll) = ui.input(|i| (i.modifiers, i.smooth_scroll_delta.y));
+    let delta = response.drag_delta();
+    let mut moved = false;
+    if response.dragged_by(egui::PointerButton::Middle) && delta != egui::Vec2::ZERO {
+        if mods.shift {
+            pan(&mut c, delta.x, delta.y, rect.height());
+        } else if mods.ctrl {
+            zoom(&mut c, -delta.y * 2.0);
+        } else {
+            orbit(&mut c, delta.x, delta.y);
+        }
+        moved = true;
+    } else if response.dragged_by(egui::PointerButton::Primary)
+        && mods.alt
+        && delta != egui::Vec2::ZERO
+    {
+        orbit(&mut c, delta.x, delta.y);
+        moved = true;
+    }
+    if response.hovered() && scroll != 0.0 {
+        zoom(&mut c, scroll);
+        moved = true;
+    }
+    if moved {
+        ctx.send(AppCommand::SetCamera(c));
+    }
+    if (response.hovered() || response.has_focus()) && !ui.ctx().egui_wants_keyboard_input() {
+        keys(ctx, ui.ctx(), c);
+    }
+}
+
+/// Navigation keys over the viewport: Home or '.' frames the hair, 1 / 3 / 7 the axis views.
+fn keys(ctx: &PanelContext, egui_ctx: &egui::Context, mut c: Camera) {
+    use egui::Key;
+    let (home, one, three, seven, ctrl) = egui_ctx.input(|i| {
+        (
+            i.key_pressed(Key::Home) || i.key_pressed(Key::Period),
+            i.key_pressed(Key::Num1),
+            i.key_pressed(Key::Num3),
+            i.key_pressed(Key::Num7),
+            i.modifiers.ctrl,
+        )
+    });
+    if home {
+        ctx.send(AppCommand::FrameHair);
+        return;
+    }
+    let view = if one {
+        Some(AxisView::Front)
+    } else if three {
+        Some(AxisView::Side)
+    } else if seven {
+        Some(AxisView::Top)
+    } else {
+        None
+    };
+    if let Some(v) = view {
+        axis_view(&mut c, v, ctrl);
+        ctx.send(AppCommand::SetCamera(c));
+    }
+}
 
 /// Degrees of orbit per point of pointer motion.
 pub const ORBIT_DEG_PER_POINT: f32 = 0.4;
