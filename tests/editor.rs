@@ -117,7 +117,12 @@ fn converge(h: &mut Harness<'static, EditorApp>) {
 
 /// When the viewport's current refinement started (the last change).
 fn refine_started(h: &Harness<'static, EditorApp>) -> Instant {
-    h.state().live().expect("a scene").lock().refine_started
+    h.state()
+        .live()
+        .expect("a scene")
+        .lock()
+        .clock
+        .refine_started
 }
 
 /// The viewport's converged image, read back from the renderer.
@@ -200,11 +205,11 @@ fn refinement_proceeds_without_ui_frames_and_converges() {
     );
     let (units, shown) = {
         let d = live.lock();
-        let p = d.progress.expect("progress");
-        assert!(p.converged && d.converged_in.is_some() && !d.tables_pending());
+        let p = d.clock.progress.expect("progress");
+        assert!(p.converged && d.clock.converged_in.is_some() && !d.tables_pending());
         (
             p.stats.units,
-            d.first_image_in().is_some() && d.full_image_in.is_some(),
+            d.first_image_in().is_some() && d.clock.full_image_in.is_some(),
         )
     };
     assert_eq!(h.state().frames_measured(), frames, "no UI frame ran");
@@ -341,8 +346,8 @@ fn rebuilds_before_first_image(
         h.step();
         let live = h.state().live().expect("a scene").lock();
         // A rebuild submitted in the step that showed the full image came after it.
-        if live.refine_started > before
-            && let Some(full) = live.full_image_in
+        if live.clock.refine_started > before
+            && let Some(full) = live.clock.full_image_in
         {
             let first = live.first_image_in().unwrap_or(full);
             println!(
@@ -354,7 +359,7 @@ fn rebuilds_before_first_image(
             return rebuilds;
         }
         if matches!(
-            live.progress.and_then(|p| p.submitted),
+            live.clock.progress.and_then(|p| p.submitted),
             Some(
                 WorkUnit::ShadowGrid { .. }
                     | WorkUnit::GridSamples { .. }
@@ -677,7 +682,7 @@ fn navigation_orbits_zooms_and_frames() {
     // A slow orbit (a move per UI frame) shows previews while the button is held: each move waits
     // for the preview under way instead of restarting it.
     converge(&mut h);
-    let shown = h.state().live().expect("live").lock().previews_shown;
+    let shown = h.state().live().expect("live").lock().shown.previews_shown;
     h.hover_at(centre);
     h.step();
     h.event(egui::Event::PointerButton {
@@ -694,7 +699,7 @@ fn navigation_orbits_zooms_and_frames() {
         h.step();
         std::thread::sleep(Duration::from_millis(10));
     }
-    let during = h.state().live().expect("live").lock().previews_shown - shown;
+    let during = h.state().live().expect("live").lock().shown.previews_shown - shown;
     h.event(egui::Event::PointerButton {
         pos: centre + egui::vec2(60.0, 0.0),
         button: egui::PointerButton::Middle,
@@ -1126,7 +1131,7 @@ fn a_brush_stroke_dyes_the_hair_under_it_and_undo_redo_are_exact() {
     for (i, (s0, s1)) in sigma_before.iter().zip(sigma).enumerate() {
         let p = painted.binary_search(&(i as u32)).is_ok();
         let want = if p {
-            effective(live.base_sigma_a[i], layer.get().points[i])
+            effective(live.paint.base_sigma_a[i], layer.get().points[i])
         } else {
             *s0
         };

@@ -55,7 +55,7 @@ fn converged(ctx: &GpuContext, handle: &LiveHandle) -> Frame {
     assert!(handle.wait_idle(TIMEOUT), "the driver did not converge");
     let mut d = handle.lock();
     assert_eq!(d.take_errors(), Vec::<String>::new());
-    assert!(d.converged_in.is_some() && !d.tables_pending());
+    assert!(d.clock.converged_in.is_some() && !d.tables_pending());
     d.renderer.read_frame(ctx).expect("read back")
 }
 
@@ -99,7 +99,7 @@ fn the_driver_converges_to_render_frame_after_a_look_an_eta_a_camera_and_a_strok
         let want = fresh_frame(&ctx, &luts, session, camera);
         assert!(lit(&want), "{what}: the frame shows hair");
         let d = difference(&live, &want);
-        let units = handle.lock().progress.map_or(0, |p| p.stats.units);
+        let units = handle.lock().clock.progress.map_or(0, |p| p.stats.units);
         println!("{what}: converged in {units} units, difference to render_frame {d:.1e}");
         assert_eq!(d, 0.0, "{what}: the live image is render_frame's");
     };
@@ -174,7 +174,7 @@ fn the_render_thread_refines_with_nothing_but_a_kick() {
     // Nobody steps the driver: the thread alone refines it to convergence.
     assert!(handle.wait_idle(TIMEOUT), "the driver converged by itself");
     let mut d = handle.lock();
-    let stats = d.progress.expect("progress").stats;
+    let stats = d.clock.progress.expect("progress").stats;
     let gaps: Vec<f64> = d
         .renderer
         .take_idle_gaps()
@@ -190,5 +190,5 @@ fn the_render_thread_refines_with_nothing_but_a_kick() {
         gaps.len()
     );
     assert!(stats.units > 1 && !gaps.is_empty());
-    assert!(d.first_image_in().is_some() && d.full_image_in.is_some());
+    assert!(d.first_image_in().is_some() && d.clock.full_image_in.is_some());
 }

@@ -97,9 +97,9 @@ fn settle(handle: &LiveHandle) -> anyhow::Result<Times> {
     }
     Ok(Times {
         first_ms: d.first_image_in().map(ms),
-        sharp_ms: d.full_image_in.map(ms),
-        converged_ms: d.converged_in.map_or(f64::NAN, ms),
-        units: d.progress.map_or(0, |p| p.stats.units),
+        sharp_ms: d.clock.full_image_in.map(ms),
+        converged_ms: d.clock.converged_in.map_or(f64::NAN, ms),
+        units: d.clock.progress.map_or(0, |p| p.stats.units),
     })
 }
 

@@ -354,9 +354,10 @@ impl EditorApp {
     pub fn converged(&self) -> Option<Duration> {
         self.viewport.live().and_then(|l| {
             let l = l.lock();
-            l.progress
+            l.clock
+                .progress
                 .filter(|p| p.converged && !l.tables_pending())
-                .and(l.converged_in)
+                .and(l.clock.converged_in)
         })
     }
 }

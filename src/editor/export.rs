@@ -59,16 +59,16 @@ impl ExportJob {
         // The paint the viewport shows: a layer painted on another hair, or a file that cannot be
         // read, is left out as the viewport leaves it out.
         let mut session = session.clone();
-        let (layer, _) = crate::live::driver::paint_for(&session, &live.hair, &mut None);
+        let (layer, _) = crate::live::prepare::paint_for(&session, &live.hair, &mut None);
         if layer.is_none() {
             session.paint = None;
         }
         session.paint_layer = layer;
         let hair = LoadedHairSource {
             hair: (*live.hair).clone(),
-            name: live.hair_name.clone(),
+            name: live.sources.hair_name.clone(),
             warning: None,
-            mesh: live.hair_mesh.clone(),
+            mesh: live.sources.hair_mesh.clone(),
             normalization: live.normalization,
             look: None,
         };
@@ -112,7 +112,7 @@ impl ExportJob {
             &scene.camera,
         )
         .map_err(|e| e.to_string())?;
-        renderer.set_unit_budget(crate::live::driver::unit_budget(&live.ctx));
+        renderer.set_unit_budget(crate::live::settings::unit_budget(&live.ctx));
         renderer.set_occluder(&live.ctx, scene.occluder.as_ref());
         renderer
             .set_camera_tile(&live.ctx, &scene.camera, tiles[0])

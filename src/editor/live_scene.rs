@@ -9,7 +9,7 @@ use crate::render::scene::Environment;
 use crate::session::EnvironmentSource;
 use std::sync::{Arc, MutexGuard};
 
-pub use crate::live::driver::ViewSettings;
+pub use crate::live::settings::ViewSettings;
 
 pub struct LiveScene {
     handle: LiveHandle,

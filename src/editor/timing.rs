@@ -92,9 +92,9 @@ impl FrameTiming {
                 t.elapsed().as_secs_f64() * 1e3
             );
         }
-        let done = d.progress.is_some_and(|p| p.converged) && !d.tables_pending();
-        let (restarts, first, sharp) = (d.restarts(), d.first_image_in(), d.full_image_in);
-        let converged = d.converged_in.filter(|_| done);
+        let done = d.clock.progress.is_some_and(|p| p.converged) && !d.tables_pending();
+        let (restarts, first, sharp) = (d.restarts(), d.first_image_in(), d.clock.full_image_in);
+        let converged = d.clock.converged_in.filter(|_| done);
         self.frames_since_change += 1;
         let Some(converged) = converged else {
             return;

@@ -157,7 +157,8 @@ impl Viewport {
     pub fn shows_sources_of(&self, session: &Session) -> bool {
         self.live.as_ref().is_some_and(|l| {
             let d = l.lock();
-            d.hair_source == session.hair && d.environment_source == session.environment
+            d.sources.hair_source == session.hair
+                && d.sources.environment_source == session.environment
         })
     }
 
@@ -187,7 +188,7 @@ impl Viewport {
             let result = d.resize(w, h).and_then(|_| d.sync(session, &camera));
             d.set_view(self.view);
             d.set_picking(picking);
-            (result, d.paint_warning.take(), d.take_errors())
+            (result, d.paint.paint_warning.take(), d.take_errors())
         };
         live.kick();
         let lost = !live.handle().running();

@@ -117,7 +117,7 @@ impl LiveDriver {
                 brush,
                 u,
                 &mut over,
-                &self.base_sigma_a,
+                &self.paint.base_sigma_a,
                 |i| hair.strand_of_point(i),
                 eumelanin_unit(),
             );

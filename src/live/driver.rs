@@ -6,20 +6,19 @@
 //! shows what a finished unit left. It knows no UI: the editor wraps it (texture upload, repaints),
 //! and `bench` and the tests drive the same driver, on the same render thread ([`super::pump`]).
 
+use super::prepare::{Prepared, paint_for, paint_key, painted};
+use super::settings::*;
+use super::state::*;
 use super::tables::{HandedOver, TableWork};
 use crate::envmap::SrbfSet;
 use crate::gpu::GpuContext;
 use crate::hair::Hair;
-use crate::hair::TriangleMesh;
 use crate::hair::normalize::Normalization;
-use crate::paint::SharedLayer;
-use crate::paint::brush::effective;
-use crate::render::display::{DisplayInfo, DisplayPass, Solo, ViewTransform};
+use crate::render::display::{DisplayInfo, DisplayPass};
 use crate::render::passes::background::{Background, BackgroundMap};
 use crate::render::passes::occluder::Occluder;
 use crate::render::refine::preview::PreviewMode;
 use crate::render::refine::{ImageReady, Progress};
-use crate::render::renderer::{ParamTables, build_tables};
 use crate::render::scene::Environment;
 use crate::render::{Camera, HairLook, RenderError, Renderer};
 use crate::scattering::lut::Luts;
@@ -27,59 +26,9 @@ use crate::session::assemble::{
     LoadedHairSource, base_absorption, mean_absorption, occluder_mesh, renderer_look,
     shown_occluder, turned_lights,
 };
-use crate::session::{
-    AssembleError, EnvironmentSource, HairSource, Look, OccluderOptions, RenderOptions, Session,
-};
+use crate::session::{AssembleError, EnvironmentSource, Session};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// How the viewport shows the linear image (never the EXR).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewSettings {
-    pub transform: ViewTransform,
-    /// Viewport exposure, stops, on top of the session's.
-    pub exposure: f32,
-    /// Render resolution as a fraction of the viewport's pixels.
-    pub scale: f32,
-    /// The beauty or one component alone.
-    pub solo: Solo,
-}
-
-impl Default for ViewSettings {
-    /// Every pixel of the viewport rendered (a hardware GPU's default).
-    fn default() -> Self {
-        Self {
-            transform: ViewTransform::Filmic,
-            exposure: 0.0,
-            scale: 1.0,
-            solo: Solo::Beauty,
-        }
-    }
-}
-
-impl ViewSettings {
-    /// The default view for an adapter: the viewport at full resolution, but half of it on a
-    /// software GPU, where the live driver alone took 6.6 s to converge a 10000-strand scene at the
-    /// default window's full viewport (654x734; `render --session` 4.8 s) and 4.6 s at half of it
-    /// (3.7 s), before the editor's own frames: a first look at every change within a few seconds
-    /// matters more there than the last pixel; the resolution buttons raise it.
-    pub fn for_adapter(device_type: wgpu::DeviceType) -> Self {
-        Self {
-            scale: if device_type == wgpu::DeviceType::Cpu {
-                SOFTWARE_VIEW_SCALE
-            } else {
-                1.0
-            },
-            ..Self::default()
-        }
-    }
-}
-
-/// The default render scale on a software GPU ([`ViewSettings::for_adapter`]).
-pub const SOFTWARE_VIEW_SCALE: f32 = 0.5;
-
-/// The viewport's background (display-encoded grey).
-pub const BACKGROUND: [f32; 3] = [0.16, 0.16, 0.17];
 
 #[derive(Debug, thiserror::Error)]
 pub enum LiveError {
@@ -89,241 +38,34 @@ pub enum LiveError {
     Assemble(#[from] AssembleError),
 }
 
-/// The least time between two UI frames for refinement's progress on a software GPU: there a UI
-/// frame (egui's 1280x800 window rasterised and presented by lavapipe) costs ~75 ms of the same two
-/// cores the refinement runs on, and frames every 100 ms made the default scene converge in 14 s
-/// instead of 8.5 s; two a second keep the UI under a fifth of the machine. A hardware GPU draws at
-/// display rate.
-pub const SOFTWARE_WAKE_INTERVAL: Duration = Duration::from_millis(500);
-
-/// What one step of the render thread left ([`LiveDriver::pump_step`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepOutcome {
-    /// A unit (or a read-back) is on the GPU: wait for it before the next step.
-    pub gpu_busy: bool,
-    /// Work remains.
-    pub working: bool,
-    /// A new image (or a warning) for the UI.
-    pub news: bool,
-    /// The first image of a change, the converged image or an error: the UI draws it at once.
-    pub urgent: bool,
-}
-
-/// What a scene needs computed from the session and the hair before the renderer is built: the
-/// per-point absorption, the look in the renderer's form and its tables (all CPU work, done on the
-/// loading worker).
-pub struct Prepared {
-    pub sigma_a: Vec<[f32; 3]>,
-    /// The look's absorption before the paint (the brush mixes toward and away from it).
-    pub base_sigma_a: Vec<[f32; 3]>,
-    pub look: HairLook,
-    pub tables: ParamTables,
-    /// The session's paint could not be shown (a layer made for another hair, an unreadable file).
-    pub warning: Option<String>,
-}
-
-/// The refinement unit budget for this adapter: on a software GPU egui's own frames run on the same
-/// two cores and cost ~50 ms each, so units of the default 30 ms left the refinement a third of the
-/// machine; 35 ms units trade some UI rate for throughput there and keep every unit of the default
-/// scene under 50 ms (80 ms until the bands were sized by their segments: a UI frame then waited
-/// behind units of up to 0.7 s). A hardware GPU keeps the default.
-pub fn unit_budget(ctx: &GpuContext) -> std::time::Duration {
-    if ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
-        SOFTWARE_UNIT_BUDGET
-    } else {
-        crate::render::refine::DEFAULT_UNIT_BUDGET
-    }
-}
-
-pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_millis(35);
-
-/// The share of the unit budget the refinement's units after the preview get while tables are
-/// wanted or built on a worker (`building`): on a software GPU the build takes its cores, and units
-/// sized to the whole budget from costs measured without it ran 1.5 times as long (S1's eta edits,
-/// whose azimuthal table takes 1.3-1.6 s: units of up to 56-63 ms at 35 ms, lavapipe, two
-/// cores). A hardware GPU keeps the whole budget ([`Renderer::set_budget_share`]).
-pub fn budget_share(ctx: &GpuContext, building: bool) -> f64 {
-    if building && ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
-        SOFTWARE_SHARE_WHILE_BUILDING
-    } else {
-        1.0
-    }
-}
-
-pub const SOFTWARE_SHARE_WHILE_BUILDING: f64 = 2.0 / 3.0;
-
-/// Computes [`Prepared`] (off the UI thread).
-pub fn prepare(session: &Session, hair: &Hair) -> Result<Prepared, AssembleError> {
-    let base_sigma_a = base_absorption(&session.look, hair)?;
-    let (layer, warning) = paint_for(session, hair, &mut None);
-    let sigma_a = painted(&base_sigma_a, layer.as_ref());
-    let look = renderer_look(&session.look, mean_absorption(&sigma_a));
-    let tables = build_tables(&look.params, None);
-    Ok(Prepared {
-        sigma_a,
-        base_sigma_a,
-        look,
-        tables,
-        warning,
-    })
-}
-
-/// The session's paint for this hair: the layer in memory, else its file. A layer made for another
-/// hair is left out with a warning (the session keeps it: undoing the hair change brings it back).
-pub fn paint_for(
-    session: &Session,
-    hair: &Hair,
-    file: &mut PaintFileCache,
-) -> (Option<SharedLayer>, Option<String>) {
-    let (points, strands) = (hair.point_count(), hair.strand_count());
-    let layer = match (&session.paint_layer, &session.paint) {
-        (Some(l), _) => l.clone(),
-        (None, Some(path)) => {
-            // Read once per file (a colour drag asks every frame).
-            if file.as_ref().is_none_or(|(p, _)| p != path) {
-                let read = crate::paint::PaintLayer::read(path)
-                    .map(SharedLayer::new)
-                    .map_err(|e| format!("{e}; the hair is shown unpainted"));
-                *file = Some((path.clone(), read));
-            }
-            match file.as_ref().map(|(_, r)| r.clone()) {
-                Some(Ok(l)) => l,
-                Some(Err(e)) => return (None, Some(e)),
-                None => return (None, None),
-            }
-        }
-        (None, None) => return (None, None),
-    };
-    if layer.get().fits(points, strands) {
-        (Some(layer), None)
-    } else {
-        let l = layer.get();
-        let text = format!(
-            "the paint layer was painted on {} points in {} strands, this hair has {points} points in {strands} strands: it is not shown",
-            l.points.len(),
-            l.strand_count
-        );
-        (None, Some(text))
-    }
-}
-
-/// The paint file last read for a session without a layer in memory, and what it gave.
-pub type PaintFileCache = Option<(std::path::PathBuf, Result<SharedLayer, String>)>;
-
-/// Each point's absorption: the base with the layer over it.
-pub fn painted(base: &[[f32; 3]], layer: Option<&SharedLayer>) -> Vec<[f32; 3]> {
-    match layer {
-        Some(l) => base
-            .iter()
-            .zip(&l.get().points)
-            .map(|(b, v)| effective(*b, *v))
-            .collect(),
-        None => base.to_vec(),
-    }
-}
-
-/// What identifies the session's paint: its file and the revision of the layer in memory.
-fn paint_key(session: &Session) -> (Option<std::path::PathBuf>, Option<u64>) {
-    match &session.paint_layer {
-        // The layer in memory is the paint, whatever file it was saved to.
-        Some(l) => (None, Some(l.revision())),
-        None => (session.paint.clone(), None),
-    }
-}
-
-/// What the renderer was last told.
-#[derive(Clone, Debug, PartialEq)]
-struct Applied {
-    look: Look,
-    occluder: OccluderOptions,
-    paint: (Option<std::path::PathBuf>, Option<u64>),
-    env_yaw: f64,
-    render: RenderOptions,
-    camera: Camera,
-}
-
 pub struct LiveDriver {
     pub ctx: GpuContext,
     pub hair: Arc<Hair>,
     /// The hair's bounding box (the framed camera reads it every frame).
     pub bounds: (glam::Vec3, glam::Vec3),
-    pub hair_name: String,
-    pub hair_source: HairSource,
-    /// The hair's own occluder mesh and how the hair came into world space (an occluder file of the
-    /// session is brought into it too), and the occluder shown.
-    pub hair_mesh: Option<TriangleMesh>,
     pub normalization: Normalization,
-    /// The occluder's mesh (the session's file, or the hair's own), shown or not, and the occluder
-    /// shown.
-    occluder_mesh: Option<TriangleMesh>,
     pub occluder: Option<Occluder>,
     /// The environment with its lights unturned.
     pub environment: Environment,
-    /// What the viewport shows behind the hair (for the unturned lights).
-    background_map: Arc<BackgroundMap>,
-    pub environment_source: EnvironmentSource,
     pub renderer: Renderer,
     pub display: DisplayPass,
-    /// Counts the display textures made (each size makes one).
-    display_generation: u64,
     applied: Applied,
     /// The fibre thickness scale the renderer's points have.
-    thickness_scale: f32,
-    /// The mean absorption of the points (the dual tables' sigma_a), kept while only the look's other
-    /// parameters change.
-    pub(super) mean_sigma_a: [f64; 3],
-    /// Each point's absorption without paint, and with it (what the renderer has).
-    pub base_sigma_a: Vec<[f32; 3]>,
     pub sigma_a: Vec<[f32; 3]>,
-    /// The session's paint could not be shown (reported once by the app), the last such report, and
-    /// the paint file last read.
-    pub paint_warning: Option<String>,
-    last_paint_warning: Option<String>,
-    paint_file: PaintFileCache,
     /// The brush's view of the hair (view depth read back, points projected).
     pub(super) picking: super::picking::Picking,
-    /// A dab changed the absorption while a preview was under way: the refinement restarts when
-    /// it is done (a restart per dab would never let a preview finish).
-    pub(super) paint_restart: bool,
-    /// A stroke is under way (its dabs repaint the converged image; the volume and grid follow
-    /// once it ends).
-    pub(super) painting: bool,
-    /// The view the display shows, and the one asked for ([`LiveDriver::set_view`]).
-    view: Option<ViewSettings>,
-    wanted_view: ViewSettings,
     /// Keep a picker for the current view (the brush is the active tool).
     picking_wanted: bool,
-    /// Errors of steps taken on the render thread, for the UI to report; a step failed, and no
-    /// change has come since; the paint warning was announced to the UI.
-    errors: Vec<String>,
-    failed: bool,
-    warning_announced: bool,
-    /// Display passes submitted (each is an image the UI has not drawn yet), and the restart of
-    /// the last one.
-    shown_count: u64,
-    shown_restart: u64,
     /// The tables on their way to the renderer.
     tables: TableWork,
     /// A camera held back while a preview is under way.
     wanted_camera: Option<Camera>,
     /// The budget's share for units while tables are wanted or built ([`budget_share`], found once).
-    building_share: f64,
-    pub progress: Option<Progress>,
-    /// When the current refinement started, and how long it took to converge.
-    pub refine_started: Instant,
-    pub converged_in: Option<Duration>,
-    /// When the preview of the last change was shown, and the full image's first pass.
-    pub preview_in: Option<Duration>,
-    pub full_image_in: Option<Duration>,
-    /// The image the display shows, how many previews it has shown, and the full image's sharp rows
-    /// it drew over the last.
-    showing: ImageReady,
-    shown_sharp: u32,
-    pub previews_shown: u64,
-    /// Restarts of the refinement (a change or a refinement of it), and the one whose converged
-    /// image was displayed.
-    restarts: u64,
-    shown_converged: Option<u64>,
+    pub paint: PaintState,
+    pub shown: Shown,
+    pub clock: RefineClock,
+    pub health: Health,
+    pub sources: Sources,
 }
 
 impl LiveDriver {
@@ -386,28 +128,13 @@ impl LiveDriver {
         let mut live = Self {
             bounds: hair.hair.bounds(),
             hair: Arc::new(hair.hair),
-            hair_name: hair.name,
-            hair_source: session.hair.clone(),
-            hair_mesh: hair.mesh,
             normalization: hair.normalization,
-            occluder_mesh,
             occluder,
-            background_map,
             environment,
-            environment_source: session.environment.clone(),
             renderer,
             display,
-            display_generation: 0,
-            mean_sigma_a: look.params.sigma_a,
-            base_sigma_a,
             sigma_a,
-            last_paint_warning: warning.clone(),
-            paint_warning: warning,
-            paint_file: None,
             picking: Default::default(),
-            paint_restart: false,
-            painting: false,
-            thickness_scale: session.look.thickness_scale,
             applied: Applied {
                 look: session.look,
                 occluder: session.occluder.clone(),
@@ -415,28 +142,52 @@ impl LiveDriver {
                 env_yaw: session.env_yaw,
                 render: session.render,
                 camera: *camera,
+                thickness_scale: session.look.thickness_scale,
             },
-            view: None,
-            wanted_view: ViewSettings::default(),
             picking_wanted: false,
-            errors: Vec::new(),
-            failed: false,
-            warning_announced: false,
-            shown_count: 0,
-            shown_restart: 0,
-            tables: TableWork::new(),
+            tables: TableWork::new(budget_share(&ctx, true)),
             wanted_camera: None,
-            building_share: budget_share(&ctx, true),
-            progress: None,
-            refine_started: Instant::now(),
-            converged_in: None,
-            preview_in: None,
-            full_image_in: None,
-            showing: ImageReady::Full,
-            shown_sharp: 0,
-            previews_shown: 0,
-            restarts: 0,
-            shown_converged: None,
+            paint: PaintState {
+                mean_sigma_a: look.params.sigma_a,
+                base_sigma_a,
+                last_paint_warning: warning.clone(),
+                paint_warning: warning,
+                paint_file: None,
+                paint_restart: false,
+                painting: false,
+            },
+            shown: Shown {
+                display_generation: 0,
+                view: None,
+                wanted_view: ViewSettings::default(),
+                shown_count: 0,
+                shown_restart: 0,
+                showing: ImageReady::Full,
+                shown_sharp: 0,
+                previews_shown: 0,
+                shown_converged: None,
+            },
+            clock: RefineClock {
+                progress: None,
+                refine_started: Instant::now(),
+                converged_in: None,
+                preview_in: None,
+                full_image_in: None,
+                restarts: 0,
+            },
+            health: Health {
+                errors: Vec::new(),
+                failed: false,
+                warning_announced: false,
+            },
+            sources: Sources {
+                hair_name: hair.name,
+                hair_source: session.hair.clone(),
+                hair_mesh: hair.mesh,
+                occluder_mesh,
+                background_map,
+                environment_source: session.environment.clone(),
+            },
             ctx,
         };
         live.apply_background(session.render.background, session.env_yaw);
@@ -446,7 +197,7 @@ impl LiveDriver {
     /// The session's background to the renderer: the environment's map turned by the yaw (the
     /// display composites the image over it), or none (a flat colour is the display's alone).
     fn apply_background(&mut self, background: Background, env_yaw: f64) {
-        let map = &self.background_map;
+        let map = &self.sources.background_map;
         match background {
             Background::Environment => self.renderer.set_background(
                 &self.ctx,
@@ -455,16 +206,16 @@ impl LiveDriver {
             ),
             _ => self.renderer.set_background(&self.ctx, None, 0.0),
         }
-        self.view = None;
+        self.shown.view = None;
     }
 
     /// Whether the renderer must be rebuilt for this session (hair or render settings it cannot
     /// change in place); environment changes go through [`LiveDriver::set_environment`].
     pub fn needs_rebuild(&self, session: &Session) -> bool {
         let (a, b) = (&self.applied.render, &session.render);
-        self.hair_source != session.hair
+        self.sources.hair_source != session.hair
             || self.applied.occluder.mesh != session.occluder.mesh
-            || self.environment_source != session.environment
+            || self.sources.environment_source != session.environment
             || a.samples != b.samples
             || a.fragments != b.fragments
             || a.tail != b.tail
@@ -486,31 +237,31 @@ impl LiveDriver {
             let absorption_changed = base_changed || paint != self.applied.paint;
             if paint != self.applied.paint {
                 // Another file or layer: read it afresh.
-                self.paint_file = None;
+                self.paint.paint_file = None;
             }
             // Applied before anything can fail, so a failure is reported once, not every frame.
             self.applied.look = session.look;
             self.applied.paint = paint;
             let look = if absorption_changed {
                 if base_changed {
-                    self.base_sigma_a = base_absorption(&session.look, &self.hair)?;
+                    self.paint.base_sigma_a = base_absorption(&session.look, &self.hair)?;
                 }
-                let (layer, warning) = paint_for(session, &self.hair, &mut self.paint_file);
+                let (layer, warning) = paint_for(session, &self.hair, &mut self.paint.paint_file);
                 // Reported once, not once per frame of a colour drag.
-                if warning != self.last_paint_warning {
-                    self.paint_warning.clone_from(&warning);
-                    self.last_paint_warning = warning;
+                if warning != self.paint.last_paint_warning {
+                    self.paint.paint_warning.clone_from(&warning);
+                    self.paint.last_paint_warning = warning;
                 }
-                self.sigma_a = painted(&self.base_sigma_a, layer.as_ref());
+                self.sigma_a = painted(&self.paint.base_sigma_a, layer.as_ref());
                 // Shown at once; the volume and grid follow the first image (`step`).
                 self.renderer
                     .set_absorption_deferred(&self.ctx, &self.sigma_a)?;
-                self.mean_sigma_a = mean_absorption(&self.sigma_a);
+                self.paint.mean_sigma_a = mean_absorption(&self.sigma_a);
                 session.look.validate().map_err(AssembleError::Look)?;
-                renderer_look(&session.look, self.mean_sigma_a)
+                renderer_look(&session.look, self.paint.mean_sigma_a)
             } else {
                 session.look.validate().map_err(AssembleError::Look)?;
-                renderer_look(&session.look, self.mean_sigma_a)
+                renderer_look(&session.look, self.paint.mean_sigma_a)
             };
             self.set_look_deferred(look);
             changed = true;
@@ -518,7 +269,7 @@ impl LiveDriver {
         if session.env_yaw != self.applied.env_yaw {
             let lights = turned_lights(&self.environment.lights, session.env_yaw);
             self.renderer.set_lights(&self.ctx, &lights.lights);
-            let base = self.background_map.yaw;
+            let base = self.sources.background_map.yaw;
             self.renderer
                 .set_background_yaw(&self.ctx, base + session.env_yaw.to_radians() as f32);
             self.applied.env_yaw = session.env_yaw;
@@ -541,7 +292,8 @@ impl LiveDriver {
                     self.renderer.set_occluder_albedo(&self.ctx, albedo);
                 }
                 _ => {
-                    self.occluder = shown_occluder(&session.occluder, self.occluder_mesh.clone())?;
+                    self.occluder =
+                        shown_occluder(&session.occluder, self.sources.occluder_mesh.clone())?;
                     self.renderer
                         .set_occluder(&self.ctx, self.occluder.as_ref());
                 }
@@ -560,7 +312,7 @@ impl LiveDriver {
         if a.exposure != b.exposure {
             // Only the resolve changes: no restart, the display shows it at once.
             self.renderer.set_exposure(&self.ctx, b.exposure);
-            self.view = None;
+            self.shown.view = None;
         }
         self.applied.render = session.render;
         // During a drag the camera waits for the preview under way (a move per UI frame would restart
@@ -576,8 +328,8 @@ impl LiveDriver {
         // The fibre thickness, against what the renderer has (not the applied look: a look that failed
         // validation for another field must not leave the renderer's diameters behind).
         let t = session.look.thickness_scale;
-        if t != self.thickness_scale {
-            self.thickness_scale = t;
+        if t != self.applied.thickness_scale {
+            self.applied.thickness_scale = t;
             if !(t.is_finite() && (0.05..=20.0).contains(&t)) {
                 return Err(AssembleError::Look(format!(
                     "the fiber thickness scale lies in [0.05, 20], got {t}"
@@ -614,8 +366,8 @@ impl LiveDriver {
         let lights: SrbfSet = turned_lights(&environment.lights, env_yaw);
         self.renderer.set_lights(&self.ctx, &lights.lights);
         self.environment = environment;
-        self.background_map = background_map;
-        self.environment_source = source;
+        self.sources.background_map = background_map;
+        self.sources.environment_source = source;
         self.applied.env_yaw = env_yaw;
         self.apply_background(self.applied.render.background, env_yaw);
         self.restarted();
@@ -629,20 +381,20 @@ impl LiveDriver {
         }
         self.renderer.set_size(&self.ctx, width, height)?;
         self.display = DisplayPass::new(&self.ctx.device, width, height);
-        self.display_generation += 1;
-        self.view = None;
+        self.shown.display_generation += 1;
+        self.shown.view = None;
         self.restarted();
         Ok(())
     }
 
     /// What the viewport shows behind the hair (for the unturned lights).
     pub fn background_map(&self) -> &Arc<BackgroundMap> {
-        &self.background_map
+        &self.sources.background_map
     }
 
     /// Counts the display textures made (a viewport registers the texture anew when it changes).
     pub fn display_generation(&self) -> u64 {
-        self.display_generation
+        self.shown.display_generation
     }
 
     /// The session's paint as the renderer has it now (a dab wrote its points).
@@ -653,26 +405,26 @@ impl LiveDriver {
     /// A change the image does not show yet: times are measured from here (and a failed step is
     /// tried again).
     pub(super) fn restarted(&mut self) {
-        self.failed = false;
-        self.refine_started = Instant::now();
+        self.health.failed = false;
+        self.clock.refine_started = Instant::now();
         self.showing_anew();
     }
 
     /// The change's first image is still to come (a new eta's draft: the images before it kept the
     /// old index); its times count from the change.
     fn showing_anew(&mut self) {
-        self.preview_in = None;
-        self.full_image_in = None;
+        self.clock.preview_in = None;
+        self.clock.full_image_in = None;
         self.restarted_as_refinement();
     }
 
     /// A restart that refines the change on screen (its tables, its volume): its times still count
     /// from the change.
     fn restarted_as_refinement(&mut self) {
-        self.converged_in = None;
-        self.restarts += 1;
+        self.clock.converged_in = None;
+        self.clock.restarts += 1;
         // The last refinement's progress (converged, say) says nothing about this one.
-        self.progress = None;
+        self.clock.progress = None;
     }
 
     fn apply_camera(&mut self, camera: &Camera) {
@@ -697,8 +449,8 @@ impl LiveDriver {
             self.restarted();
         }
         // Likewise the dabs painted while a preview was under way.
-        if self.paint_restart && !self.renderer.preview_under_way() {
-            self.paint_restart = false;
+        if self.paint.paint_restart && !self.renderer.preview_under_way() {
+            self.paint.paint_restart = false;
             self.renderer.restart();
             self.restarted();
         }
@@ -706,7 +458,7 @@ impl LiveDriver {
         // frame does not read before its tables), at once without a preview, or for a new eta or
         // eccentricity: its draft at once, the table once the draft's preview shows.
         let change_shown = self.first_image_in().is_some()
-            || self.progress.is_some_and(|p| p.converged)
+            || self.clock.progress.is_some_and(|p| p.converged)
             || self.renderer.preview_factor() < 2;
         self.tables.start(change_shown);
         self.tables.poll();
@@ -715,40 +467,43 @@ impl LiveDriver {
         // change the refinement shows a preview, then the full image with the old grid: rebuild once
         // that full image is on screen ([`TableWork::hand_over`]); anything waiting goes over when the
         // refinement has nothing left to show.
-        let shown = self.full_image_in.is_some() || self.progress.is_some_and(|p| p.converged);
+        let shown =
+            self.clock.full_image_in.is_some() || self.clock.progress.is_some_and(|p| p.converged);
         match self.tables.hand_over(&self.ctx, &mut self.renderer, shown) {
             Some(HandedOver::Draft) => self.showing_anew(),
             Some(HandedOver::Tables) => self.restarted_as_refinement(),
             None => {}
         }
         // With tables on the way, the volume waits for them: they rebuild the grid too.
-        if shown && !self.tables.waiting() && !self.painting && self.renderer.rebuild_stale_volume()
+        if shown
+            && !self.tables.waiting()
+            && !self.paint.painting
+            && self.renderer.rebuild_stale_volume()
         {
             self.restarted_as_refinement();
         }
-        let building = self.tables.building();
-        self.renderer
-            .set_budget_share(if building { self.building_share } else { 1.0 });
+        self.renderer.set_budget_share(self.tables.budget_share());
         let progress = self.renderer.refine(&self.ctx)?;
         // A unit that finished between the two polls.
         self.note_ready(progress.ready);
         let ready = ready.or(progress.ready);
         // Converged without a unit in flight (nothing changed since) shows nothing new.
-        if progress.converged && self.converged_in.is_none() {
-            self.converged_in = Some(self.refine_started.elapsed());
+        if progress.converged && self.clock.converged_in.is_none() {
+            self.clock.converged_in = Some(self.clock.refine_started.elapsed());
         }
-        let converged_now = progress.converged && self.shown_converged != Some(self.restarts);
+        let converged_now =
+            progress.converged && self.shown.shown_converged != Some(self.clock.restarts);
         if converged_now {
-            self.shown_converged = Some(self.restarts);
-            self.showing = ImageReady::Full;
+            self.shown.shown_converged = Some(self.clock.restarts);
+            self.shown.showing = ImageReady::Full;
         }
         // The first pass sharpens the preview band by band.
-        let sharper =
-            self.showing == ImageReady::Preview && self.renderer.sharp_rows() > self.shown_sharp;
-        if ready.is_some() || converged_now || sharper || self.view != Some(view) {
+        let sharper = self.shown.showing == ImageReady::Preview
+            && self.renderer.sharp_rows() > self.shown.shown_sharp;
+        if ready.is_some() || converged_now || sharper || self.shown.view != Some(view) {
             self.show(view);
         }
-        self.progress = Some(progress);
+        self.clock.progress = Some(progress);
         Ok(progress)
     }
 
@@ -758,22 +513,22 @@ impl LiveDriver {
         let Some(image) = ready else {
             return;
         };
-        self.showing = image;
-        self.previews_shown += (image == ImageReady::Preview) as u64;
+        self.shown.showing = image;
+        self.shown.previews_shown += (image == ImageReady::Preview) as u64;
         let stats = self.renderer.refine_stats();
-        let since = self.refine_started.elapsed();
+        let since = self.clock.refine_started.elapsed();
         if stats.preview.is_some() {
-            self.preview_in.get_or_insert(since);
+            self.clock.preview_in.get_or_insert(since);
         }
         if stats.first_pass.is_some() {
-            self.full_image_in.get_or_insert(since);
+            self.clock.full_image_in.get_or_insert(since);
         }
     }
 
     /// When the first image of the last change was shown: its preview, or the full image's first
     /// pass.
     pub fn first_image_in(&self) -> Option<Duration> {
-        self.preview_in.or(self.full_image_in)
+        self.clock.preview_in.or(self.clock.full_image_in)
     }
 
     /// The display pass of the image shown, through the view transform.
@@ -805,24 +560,24 @@ impl LiveDriver {
             &self.ctx.device,
             &self.ctx.queue,
             &mut enc,
-            self.renderer.image(self.showing),
+            self.renderer.image(self.shown.showing),
             &info,
             view.solo,
         );
         self.ctx.queue.submit([enc.finish()]);
-        self.view = Some(view);
-        self.shown_sharp = self.renderer.sharp_rows();
-        self.shown_count += 1;
+        self.shown.view = Some(view);
+        self.shown.shown_sharp = self.renderer.sharp_rows();
+        self.shown.shown_count += 1;
     }
 
     /// Counts the refinement's restarts (a change, or a refinement of it).
     pub fn restarts(&self) -> u64 {
-        self.restarts
+        self.clock.restarts
     }
 
     /// The view the display should show (applied by the next step).
     pub fn set_view(&mut self, view: ViewSettings) {
-        self.wanted_view = view;
+        self.shown.wanted_view = view;
     }
 
     /// Keep a picker for the current view (while the brush is the active tool).
@@ -833,12 +588,12 @@ impl LiveDriver {
     /// Times of the current refinement count from `origin` (the editor's launch, for its first
     /// scene) instead of from when the driver was made.
     pub fn count_from(&mut self, origin: Instant) {
-        self.refine_started = origin;
+        self.clock.refine_started = origin;
     }
 
     /// The errors of the steps taken since the last call.
     pub fn take_errors(&mut self) -> Vec<String> {
-        std::mem::take(&mut self.errors)
+        std::mem::take(&mut self.health.errors)
     }
 
     /// How often at most the render thread wakes a UI for an image that only refines the one it
@@ -853,13 +608,13 @@ impl LiveDriver {
 
     /// Whether anything is left to do: refinement, tables, the picker.
     pub fn working(&self) -> bool {
-        !self.failed && self.work_left()
+        !self.health.failed && self.work_left()
     }
 
     fn work_left(&self) -> bool {
-        !self.progress.is_some_and(|p| p.converged)
+        !self.clock.progress.is_some_and(|p| p.converged)
             || self.tables_pending()
-            || self.view != Some(self.wanted_view)
+            || self.shown.view != Some(self.shown.wanted_view)
             || (self.picking_wanted && self.picking_pending())
     }
 
@@ -868,20 +623,20 @@ impl LiveDriver {
     /// ([`LiveDriver::take_errors`]).
     pub fn pump_step(&mut self) -> StepOutcome {
         // A step that failed is not retried until something changes (it would fail again).
-        if self.failed {
+        if self.health.failed {
             return StepOutcome::idle();
         }
-        let (shown, restarts) = (self.shown_count, self.restarts);
-        let fraction = self.progress.map(|p| p.fraction);
-        let result = self.step(self.wanted_view);
+        let (shown, restarts) = (self.shown.shown_count, self.clock.restarts);
+        let fraction = self.clock.progress.map(|p| p.fraction);
+        let result = self.step(self.shown.wanted_view);
         if self.picking_wanted {
             self.update_picking();
         }
         let progress = match result {
             Ok(p) => p,
             Err(e) => {
-                self.errors.push(e.to_string());
-                self.failed = true;
+                self.health.errors.push(e.to_string());
+                self.health.failed = true;
                 return StepOutcome {
                     news: true,
                     urgent: true,
@@ -889,17 +644,19 @@ impl LiveDriver {
                 };
             }
         };
-        let shown_new = self.shown_count != shown;
+        let shown_new = self.shown.shown_count != shown;
         // The first image of a change, and the converged one, are drawn at once.
         let urgent = shown_new
-            && (self.shown_restart != restarts || self.restarts != restarts || progress.converged);
+            && (self.shown.shown_restart != restarts
+                || self.clock.restarts != restarts
+                || progress.converged);
         if shown_new {
-            self.shown_restart = self.restarts;
+            self.shown.shown_restart = self.clock.restarts;
         }
         // A warning for the UI is news once; the progress bar's advance is news too (paced).
-        let warning = self.paint_warning.is_some() && !self.warning_announced;
-        self.warning_announced = self.paint_warning.is_some();
-        let advanced = self.progress.map(|p| p.fraction) != fraction;
+        let warning = self.paint.paint_warning.is_some() && !self.health.warning_announced;
+        self.health.warning_announced = self.paint.paint_warning.is_some();
+        let advanced = self.clock.progress.map(|p| p.fraction) != fraction;
         StepOutcome {
             gpu_busy: progress.busy
                 || progress.submitted.is_some()
@@ -913,10 +670,10 @@ impl LiveDriver {
     /// A step panicked on the render thread: reported, and no step is taken until something
     /// changes (the driver may be half-way through that step; a change restarts the refinement).
     pub fn step_panicked(&mut self, why: &str) {
-        self.errors.push(format!(
+        self.health.errors.push(format!(
             "the viewport's refinement stopped: {why}; change something to restart it"
         ));
-        self.failed = true;
+        self.health.failed = true;
     }
 
     /// Whether tables are still being built or not yet handed to the renderer, or a deferred

@@ -3,7 +3,8 @@
 //! the file), the renderer's CPU work prepared and the driver built. The editor runs this on a worker;
 //! `bench` runs it as it is.
 
-use super::driver::{LiveDriver, prepare};
+use super::driver::LiveDriver;
+use super::prepare::prepare;
 use crate::gpu::GpuContext;
 use crate::render::passes::background::BackgroundMap;
 use crate::scattering::lut::Luts;

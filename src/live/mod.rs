@@ -9,9 +9,14 @@ pub mod driver;
 pub mod jobs;
 pub mod load;
 pub mod picking;
+pub mod prepare;
 pub mod pump;
+pub mod settings;
+pub mod state;
 pub mod tables;
 
 pub use dab::{Dab, DabEdit, DabError};
-pub use driver::{LiveDriver, LiveError, Prepared, StepOutcome, ViewSettings, prepare};
+pub use driver::{LiveDriver, LiveError};
+pub use prepare::{Prepared, prepare};
 pub use pump::LiveHandle;
+pub use settings::{StepOutcome, ViewSettings};

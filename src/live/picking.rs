@@ -101,19 +101,19 @@ impl LiveDriver {
         let points = &layer.get().points;
         for &i in changed {
             let i = i as usize;
-            self.sigma_a[i] = effective(self.base_sigma_a[i], points[i]);
+            self.sigma_a[i] = effective(self.paint.base_sigma_a[i], points[i]);
         }
         self.renderer
             .set_absorption_points_deferred(&self.ctx, &self.sigma_a, changed)?;
         self.note_paint(session);
         // The volume and grid wait for the stroke's end (a rebuild between dabs would take the
         // converged image the next dab repaints).
-        self.painting = true;
+        self.paint.painting = true;
         if self.renderer.repaint_points(changed) {
             // Converged: the dab's segments alone are shaded again, at full resolution.
             self.restarted();
         } else if self.renderer.preview_under_way() {
-            self.paint_restart = true;
+            self.paint.paint_restart = true;
         } else {
             self.renderer.restart();
             self.restarted();
@@ -123,15 +123,15 @@ impl LiveDriver {
 
     /// A stroke ended (the volume and grid may follow whatever it left).
     pub fn end_painting(&mut self) {
-        self.painting = false;
+        self.paint.painting = false;
     }
 
     /// The stroke ended. Nothing more to send: the volume and shadow grid follow the dabs by
     /// themselves (a deferred rebuild once the image shows), and every table reads each point's own
     /// absorption, so the points' mean (kept for the look's uniform) changes no table.
     pub fn paint_finished(&mut self, _session: &Session) -> Result<(), LiveError> {
-        self.painting = false;
-        self.mean_sigma_a = mean_absorption(&self.sigma_a);
+        self.paint.painting = false;
+        self.paint.mean_sigma_a = mean_absorption(&self.sigma_a);
         Ok(())
     }
 }

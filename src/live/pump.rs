@@ -6,7 +6,8 @@
 //! Why a thread and not one unit per UI frame: on a software GPU a UI frame costs ~100 ms, so units
 //! paced by frames ran one per ~130 ms whatever their own cost (a 5 s frame took over a minute).
 
-use super::driver::{LiveDriver, StepOutcome};
+use super::driver::LiveDriver;
+use super::settings::StepOutcome;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -196,18 +197,6 @@ fn run(shared: &Shared) {
             if !c.kicked && !c.stop {
                 let _ = shared.kick.wait_timeout(c, IDLE_TICK);
             }
-        }
-    }
-}
-
-impl StepOutcome {
-    /// Nothing more to do, nothing to show.
-    pub fn idle() -> Self {
-        Self {
-            gpu_busy: false,
-            working: false,
-            news: false,
-            urgent: false,
         }
     }
 }

@@ -26,6 +26,8 @@ pub(super) struct TableWork {
     held: Option<Tables>,
     /// The last build died (a draft in the renderer then stays).
     failed: bool,
+    /// The budget's share for units while tables are wanted or built (`budget_share`).
+    building_share: f64,
 }
 
 /// What handing tables over did to the image.
@@ -37,8 +39,9 @@ pub(super) enum HandedOver {
 }
 
 impl TableWork {
-    pub(super) fn new() -> Self {
+    pub(super) fn new(building_share: f64) -> Self {
         Self {
+            building_share,
             job: None,
             building: None,
             wanted: None,
@@ -160,9 +163,14 @@ impl TableWork {
         self.wanted.is_some() || self.job.is_some() || self.held.is_some()
     }
 
-    /// Tables are wanted or being built (units then get the budget's smaller share).
-    pub(super) fn building(&self) -> bool {
-        self.wanted.is_some() || self.job.is_some()
+    /// The share of the unit budget refinement gets: smaller while tables are wanted or being
+    /// built, which take the same cores.
+    pub(super) fn budget_share(&self) -> f64 {
+        if self.wanted.is_some() || self.job.is_some() {
+            self.building_share
+        } else {
+            1.0
+        }
     }
 
     /// Whether the image still waits for tables: being built, not yet handed over, or a draft

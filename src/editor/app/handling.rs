@@ -411,7 +411,7 @@ impl EditorApp {
                 let session = self.doc.session();
                 if let Some(live) = self.viewport.live_mut()
                     && !loading
-                    && live.lock().hair_source == session.hair
+                    && live.lock().sources.hair_source == session.hair
                 {
                     live.set_environment(*environment, *pictures, source, session.env_yaw);
                 }

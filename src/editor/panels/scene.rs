@@ -113,7 +113,7 @@ fn head(ctx: &PanelContext, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         let own = match (
             &ctx.session.hair,
-            ctx.live().map(|l| l.lock().hair_mesh.is_some()),
+            ctx.live().map(|l| l.lock().sources.hair_mesh.is_some()),
         ) {
             (HairSource::Generated { .. }, _) => "the generated head",
             (_, Some(true)) => "the hair file's mesh",

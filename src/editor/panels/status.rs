@@ -20,11 +20,11 @@ pub fn bar(ctx: &PanelContext, ui: &mut egui::Ui) {
                     points: d.hair.point_count(),
                     lights: d.renderer.light_count(),
                     size: (d.display.width, d.display.height),
-                    progress: d.progress,
+                    progress: d.clock.progress,
                     final_image: !d.tables_pending(),
                     first: d.first_image_in(),
-                    sharp: d.full_image_in,
-                    converged: d.converged_in,
+                    sharp: d.clock.full_image_in,
+                    converged: d.clock.converged_in,
                 }
             };
             ui.label(format!(

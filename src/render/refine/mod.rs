@@ -374,7 +374,7 @@ impl Renderer {
     /// Sizes units to `share` (0.1 to 1) of the budget, all but the preview's shading bands (which
     /// keep all of it, as the preview's target does): for a software GPU while a CPU job (the
     /// tables' build) takes part of its cores, which stretches units past their measured costs
-    /// ([`crate::live::driver::budget_share`]).
+    /// ([`crate::live::settings::budget_share`]).
     pub fn set_budget_share(&mut self, share: f64) {
         self.refinement.costs.budget_share = share.clamp(0.1, 1.0);
     }
