@@ -51,7 +51,7 @@ fn every_wgsl_module_validates_and_struct_layouts_match() {
                 }
                 Some("Camera") => std::mem::size_of::<strandlight::render::camera::CameraUniform>(),
                 Some("ShadeBatch") => {
-                    std::mem::size_of::<strandlight::render::passes::shading::ShadeBatch>()
+                    std::mem::size_of::<strandlight::render::passes::batch::ShadeBatch>()
                 }
                 Some("GpuLight") => {
                     std::mem::size_of::<strandlight::render::passes::shading::GpuLight>()

@@ -1068,7 +1068,7 @@ fn a_preview_comes_first_and_the_frame_still_converges_to_render_frame() {
 /// visibility pass.
 #[test]
 fn bands_are_sized_by_the_segments_their_rows_list() {
-    use strandlight::render::refine::row_segments::row_segments;
+    use strandlight::render::passes::row_segments::row_segments;
     let ctx = context();
     let luts = Luts::default_tables();
     let lights = sunny_lights();

@@ -8,6 +8,7 @@ use crate::envmap::srbf::SrbfFileError;
 use crate::envmap::{EnvError, EnvMap, FitOptions, SrbfSet, load_env};
 use crate::hair::Hair;
 use crate::hair::procedural::{Style, StyleParams, generate};
+use crate::render::passes::background::{BackgroundMap, RECONSTRUCTION_WIDTH};
 use std::path::Path;
 
 const SUNNY_SRBF: &str = include_str!("../../envmaps/sunny.srbf.json");
@@ -152,5 +153,22 @@ impl StandardScene {
             Style::StraightLong
         };
         generated_hair(style, self.strands, self.points, 1)
+    }
+}
+
+/// The background map of an environment is made here, where environments are, so that the
+/// background pass needs nothing of scenes.
+impl BackgroundMap {
+    /// The environment's image (turned by the lights' yaw), or, without one, the reconstruction of its
+    /// lights (already turned).
+    pub fn from_environment(env: &Environment) -> Self {
+        match &env.image {
+            Some(image) => Self::from_map(image, env.lights.yaw as f32),
+            None => Self::from_map(
+                &env.lights
+                    .render(RECONSTRUCTION_WIDTH, RECONSTRUCTION_WIDTH / 2),
+                0.0,
+            ),
+        }
     }
 }

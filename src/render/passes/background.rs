@@ -8,7 +8,6 @@
 
 use crate::envmap::EnvMap;
 use crate::envmap::direction::{rotate_yaw, uv_from_direction};
-use crate::render::scene::Environment;
 use glam::{DVec3, Vec3};
 use std::fmt;
 use std::str::FromStr;
@@ -93,19 +92,6 @@ pub struct BackgroundMap {
 }
 
 impl BackgroundMap {
-    /// The environment's image (turned by the lights' yaw), or, without one, the reconstruction of its
-    /// lights (already turned).
-    pub fn from_environment(env: &Environment) -> Self {
-        match &env.image {
-            Some(image) => Self::from_map(image, env.lights.yaw as f32),
-            None => Self::from_map(
-                &env.lights
-                    .render(RECONSTRUCTION_WIDTH, RECONSTRUCTION_WIDTH / 2),
-                0.0,
-            ),
-        }
-    }
-
     pub fn from_map(map: &EnvMap, yaw: f32) -> Self {
         let factor = map.width.div_ceil(MAX_BACKGROUND_WIDTH).max(1);
         let small;

@@ -3,9 +3,11 @@
 //! segment), the resolve into the frame's targets, and the background behind it.
 
 pub mod background;
+pub mod batch;
 pub mod kbuffer;
 pub mod occluder;
 pub mod resolve;
+pub mod row_segments;
 pub mod segment_shading;
 pub mod shading;
 pub mod shadow_grid;

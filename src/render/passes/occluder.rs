@@ -11,9 +11,9 @@ use crate::gpu::context::{bind_buffers, compute_pipeline};
 use crate::gpu::shaders;
 use crate::hair::TriangleMesh;
 use crate::render::camera::CameraUniform;
-use crate::render::passes::shading::{ShadeBatch, ShadingInputs};
+use crate::render::passes::batch::{ShadeBatch, ShadingInputs};
 use crate::render::passes::targets::FrameTargets;
-use crate::render::reference::shade::GridShadows;
+use crate::shadow::grid::GridValues;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -114,7 +114,7 @@ pub fn shade_occluder(
     n: Vec3,
     lights: &[SrbfLight],
     first: usize,
-    shadows: Option<GridShadows>,
+    shadows: Option<&GridValues>,
     offset: f32,
 ) -> [f32; 3] {
     let q = p + offset * n;
@@ -153,7 +153,7 @@ pub fn shade_occluder_frame(
     camera: &CameraUniform,
     occluder: &Occluder,
     lights: &[SrbfLight],
-    shadows: Option<GridShadows>,
+    shadows: Option<&GridValues>,
     offset: f32,
 ) -> Vec<[f32; 3]> {
     use rayon::prelude::*;

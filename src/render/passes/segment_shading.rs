@@ -11,7 +11,7 @@
 //! binding.
 
 use crate::gpu::context::{bind_entries as bind, compute_pipeline};
-use crate::render::passes::shading::{ShadeBatch, ShadingInputs};
+use crate::render::passes::batch::{ShadeBatch, ShadingInputs};
 use crate::render::passes::targets::FrameTargets;
 
 /// Samples of single scattering along a segment: its ends and its midpoint (t = 0, 1/2, 1).

@@ -162,8 +162,8 @@ pub(in crate::render) struct CostModel {
     pub(super) preview_bands: Bands,
     /// The frame's visible segments per row, topmost row (None: not read back for this view yet);
     /// shading by segment, a band's cost is about its rows' count times `segment_cost` per light
-    /// ([`crate::render::refine::row_segments`]).
-    pub(super) row_segments: Option<Vec<u32>>,
+    /// ([`crate::render::passes::row_segments`]).
+    pub(in crate::render) row_segments: Option<Vec<u32>>,
     /// Measured seconds per listed segment and light of a shading unit, and per pixel of its rows.
     pub(super) segment_cost: Option<f64>,
     pub(super) pixel_cost: Option<f64>,

@@ -3,7 +3,8 @@
 
 use super::WorkUnit;
 use crate::gpu::GpuContext;
-use crate::render::passes::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadeBatch, ShadingPass};
+use crate::render::passes::batch::ShadeBatch;
+use crate::render::passes::shading::{FLAG_SEGMENTS, FLAG_SINGLE_KEPT, ShadingPass};
 use crate::render::passes::shadow_grid::SWEEP_SLOTS;
 use crate::render::renderer::Renderer;
 

@@ -30,7 +30,6 @@ pub mod encode;
 pub mod plan;
 pub mod preview;
 pub mod repaint;
-pub mod row_segments;
 
 use crate::gpu::GpuContext;
 use crate::render::passes::targets::FrameTargets;

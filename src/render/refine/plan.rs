@@ -3,8 +3,9 @@
 
 use super::costs::*;
 use super::{ImageReady, Progress, RefineStats, Stage, WorkUnit};
+use crate::render::passes::batch::ShadeBatch;
 use crate::render::passes::segment_shading::last_light_batch;
-use crate::render::passes::shading::{FLAG_SEGMENTS, ShadeBatch};
+use crate::render::passes::shading::FLAG_SEGMENTS;
 use crate::render::passes::shadow_grid::SWEEP_SLOTS;
 use crate::render::refine::preview::preview_target;
 use crate::render::renderer::Renderer;

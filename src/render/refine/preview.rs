@@ -10,9 +10,10 @@
 use crate::gpu::GpuContext;
 use crate::render::camera::CameraUniform;
 use crate::render::frame::Frame;
+use crate::render::passes::batch::{ShadeBatch, ShadingInputs};
 use crate::render::passes::kbuffer::{SegmentSubset, Tail};
 use crate::render::passes::shading::{
-    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
+    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadingPass,
 };
 use crate::render::passes::targets::FrameTargets;
 use crate::render::renderer::{RenderError, Renderer};
@@ -66,9 +67,9 @@ pub(in crate::render) struct Preview {
     pub camera: wgpu::Buffer,
     /// The visibility pass has drawn the current camera (a parameter change reuses it).
     pub visible: bool,
-    /// Its K-buffer's visible segments per row ([`crate::render::refine::row_segments`]) and their read-back.
+    /// Its K-buffer's visible segments per row ([`crate::render::passes::row_segments`]) and their read-back.
     pub row_segments: Option<Vec<u32>>,
-    pub row_readback: Option<crate::render::refine::row_segments::RowSegmentsReadback>,
+    pub row_readback: Option<crate::render::passes::row_segments::RowSegmentsReadback>,
 }
 
 impl Preview {

@@ -5,9 +5,10 @@ use super::{MAX_SEGMENT_ANGLE, RenderError, Renderer};
 use crate::gpu::GpuContext;
 use crate::gpu::density_pyramid::DensityPyramidPass;
 use crate::gpu::fiber_density::FiberDensityPass;
+use crate::render::passes::batch::{ShadeBatch, ShadingInputs};
 use crate::render::passes::resolve::ResolvePass;
 use crate::render::passes::shading::{
-    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadeBatch, ShadingInputs, ShadingPass,
+    FLAG_MULTIPLE_SCATTERING, FLAG_SEGMENTS, FLAG_SHADOWS, ShadingPass,
 };
 use crate::render::passes::shadow_grid::{ShadowGridInputs, ShadowGridPass};
 use crate::render::passes::visibility::VisibilityPass;

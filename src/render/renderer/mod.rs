@@ -108,7 +108,7 @@ pub struct Renderer {
     pub(in crate::render) by_segment: bool,
     /// The visible segments per row, read back after the frame's visibility (band sizes).
     pub(in crate::render) row_readback:
-        Option<crate::render::refine::row_segments::RowSegmentsReadback>,
+        Option<crate::render::passes::row_segments::RowSegmentsReadback>,
     pub(in crate::render) timer: Option<PassTimer>,
     pub(in crate::render) last_ran: Vec<&'static str>,
     /// Where progressive refinement ([`Renderer::refine`]) stands.
