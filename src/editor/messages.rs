@@ -24,7 +24,7 @@ pub struct Messages {
     list: Vec<Message>,
 }
 
-/// Messages kept: enough for the errors window, bounded in a long session.
+/// Messages kept: enough for the errors window, bounded however long the editor runs.
 const MESSAGES_KEPT: usize = 50;
 
 impl Messages {

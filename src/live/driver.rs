@@ -50,7 +50,7 @@ pub struct LiveDriver {
     pub renderer: Renderer,
     pub display: DisplayPass,
     applied: Applied,
-    /// The fibre thickness scale the renderer's points have.
+    /// Each point's absorption with the paint over it (what the renderer has).
     pub sigma_a: Vec<[f32; 3]>,
     /// The brush's view of the hair (view depth read back, points projected).
     pub(super) picking: super::picking::Picking,
@@ -60,17 +60,21 @@ pub struct LiveDriver {
     tables: TableWork,
     /// A camera held back while a preview is under way.
     wanted_camera: Option<Camera>,
-    /// The budget's share for units while tables are wanted or built ([`budget_share`], found once).
+    /// The absorption without paint, the paint file and its warnings, a stroke under way.
     pub paint: PaintState,
+    /// The image the display shows and the view it shows it in.
     pub shown: Shown,
+    /// When the current refinement started and when its images came.
     pub clock: RefineClock,
+    /// Errors of the render thread's steps, for the UI.
     pub health: Health,
+    /// Where the hair, head and environment came from.
     pub sources: Sources,
 }
 
 impl LiveDriver {
     /// Builds the renderer for `session` with a loaded hair and environment at a viewport size, from
-    /// what [`prepare`] computed off the UI thread.
+    /// what [`crate::live::prepare::prepare`] computed off the UI thread.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: GpuContext,

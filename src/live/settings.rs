@@ -61,7 +61,7 @@ pub const BACKGROUND: [f32; 3] = [0.16, 0.16, 0.17];
 /// display rate.
 pub const SOFTWARE_WAKE_INTERVAL: Duration = Duration::from_millis(500);
 
-/// What one step of the render thread left ([`LiveDriver::pump_step`]).
+/// What one step of the render thread left ([`crate::live::LiveDriver::pump_step`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepOutcome {
     /// A unit (or a read-back) is on the GPU: wait for it before the next step.
@@ -93,7 +93,7 @@ pub const SOFTWARE_UNIT_BUDGET: std::time::Duration = std::time::Duration::from_
 /// wanted or built on a worker (`building`): on a software GPU the build takes its cores, and units
 /// sized to the whole budget from costs measured without it ran 1.5 times as long (S1's eta edits,
 /// whose azimuthal table takes 1.3-1.6 s: units of up to 56-63 ms at 35 ms, lavapipe, two
-/// cores). A hardware GPU keeps the whole budget ([`Renderer::set_budget_share`]).
+/// cores). A hardware GPU keeps the whole budget ([`crate::render::Renderer::set_budget_share`]).
 pub fn budget_share(ctx: &GpuContext, building: bool) -> f64 {
     if building && ctx.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
         SOFTWARE_SHARE_WHILE_BUILDING

@@ -41,7 +41,7 @@ pub struct ShadingInputs<'a> {
     pub azimuthal_table: &'a wgpu::Buffer,
     /// The occluder, shaded with the first slot's batches (and the preview's).
     pub occluder: Option<&'a GpuOccluder>,
-    /// The frame's per-segment buffers (batches flagged [`FLAG_SEGMENTS`] use them).
+    /// The frame's per-segment buffers (batches flagged [`crate::render::passes::shading::FLAG_SEGMENTS`] use them).
     pub segment_targets: Option<&'a SegmentTargets>,
 }
 

@@ -139,7 +139,7 @@ pub(super) struct BandShape {
 /// The cost model of refinement's units (owned by the [`super::Refinement`]).
 pub(in crate::render) struct CostModel {
     pub(super) budget: Duration,
-    /// The part of the budget units are sized to, but the preview's shading ([`Renderer::set_budget_share`]).
+    /// The part of the budget units are sized to, but the preview's shading ([`crate::render::Renderer::set_budget_share`]).
     pub(super) budget_share: f64,
     /// Seconds per shadow-grid entry, per sample of its sweeps and per deposited segment (None: not
     /// measured yet).

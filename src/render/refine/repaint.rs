@@ -27,8 +27,8 @@ impl Renderer {
     /// A brush dab on an image converged by segment: the segments that join the changed points
     /// `changed` are shaded again under every light, with the multiple scattering of their partners
     /// whose pair the dab joined or split ([`Renderer::repaint_partner`])
-    /// ([`WorkUnit::Repaint`] units, light batch by light batch, each in parts sized to the budget),
-    /// and the image is gathered from the segments ([`WorkUnit::RepaintGather`] bands), in place of
+    /// ([`crate::render::refine::WorkUnit::Repaint`] units, light batch by light batch, each in parts sized to the budget),
+    /// and the image is gathered from the segments ([`crate::render::refine::WorkUnit::RepaintGather`] bands), in place of
     /// a restart. The dab shows at full resolution after work on its segments alone; every other
     /// segment's radiance depends on its own points (and its pair's sharing, whose changes are
     /// shaded here) only and stays.

@@ -41,7 +41,7 @@ impl Renderer {
     /// point's absorption, and only the points `changed` (sorted) are written, in runs (gaps of a few
     /// unchanged points are written along rather than split). Every point not in `changed` must
     /// hold what the renderer has already (the runs write some of them, and the pairs' sharing,
-    /// [`Renderer::ms_pairs`], reads the changed points' neighbours from `sigma_a`).
+    /// `repaint.ms_pairs`, reads the changed points' neighbours from `sigma_a`).
     pub fn set_absorption_points_deferred(
         &mut self,
         ctx: &GpuContext,
@@ -196,7 +196,7 @@ impl Renderer {
     }
 
     /// A new shadow-grid buffer holds zeros, not finished entries: its groups count as unbuilt (its
-    /// samples are the old grid's, [`GpuShadowGrid::with_lights`], or unbuilt in a new renderer).
+    /// samples are the old grid's, [`crate::render::passes::shadow_grid::GpuShadowGrid::with_lights`], or unbuilt in a new renderer).
     pub(super) fn grid_buffer_made(&mut self) {
         let group = self
             .settings

@@ -21,10 +21,10 @@ pub(in crate::render) struct SceneBuffers {
     /// The occluder (the head) drawn, shaded and held in the volume as a solid.
     pub(in crate::render) occluder: Option<SceneOccluder>,
     /// The hair's longest segment and its bounds (whether segments are short enough, as the eye sees
-    /// them, to be shaded once each: [`MAX_SEGMENT_ANGLE`]).
+    /// them, to be shaded once each: [`crate::render::renderer::MAX_SEGMENT_ANGLE`]).
     pub(in crate::render) segment_extent: (f32, Vec3, Vec3),
     /// Each segment's first point, in segment order (the brush's repaint finds the segments at the
-    /// points a dab changed: [`Renderer::repaint_points`]).
+    /// points a dab changed: [`crate::render::Renderer::repaint_points`]).
     pub(in crate::render) segment_first: Vec<u32>,
     /// Every [`crate::render::refine::preview::PREVIEW_STRAND_STRIDE`]-th strand's segments, which a coarse
     /// preview draws (None for a hair of few strands).

@@ -12,7 +12,7 @@ pub struct RenderSettings {
     pub height: u32,
     /// Multisampling of the occluder in the visibility pass (2 or 4).
     pub samples: u32,
-    /// Hair fragments kept per pixel by the K-buffer (1 to [`MAX_FRAGMENTS`]).
+    /// Hair fragments kept per pixel by the K-buffer (1 to [`crate::render::passes::kbuffer::MAX_FRAGMENTS`]).
     pub fragments: u32,
     /// What becomes of the fragments behind the kept ones.
     pub tail: Tail,

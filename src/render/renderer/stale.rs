@@ -7,7 +7,7 @@ pub(in crate::render) struct Staleness {
     /// progressive refinement, resolve normalised); u32::MAX after `render_frame`.
     pub(in crate::render) converged_rows: u32,
     /// The absorption changed but the volume (and the shadow grid's forward terms) still hold the old
-    /// one ([`Renderer::set_absorption_deferred`]).
+    /// one ([`crate::render::Renderer::set_absorption_deferred`]).
     pub(in crate::render) volume_stale: bool,
     /// The stale volume's density changed too (a deferred thickness change): its rebuild changes the
     /// grid's transmittance, which single scattering reads.

@@ -6,7 +6,7 @@
 //!
 //! Estimator, per visible point and path (unbiased up to the depth cut-off):
 //! - the kernel is the exact model, K(omega_i, omega_o) = S(omega_i, omega_o) cos(theta_i) per lobe
-//!   ([`scattering_s`] with [`REFERENCE_VARIANT`] and the look's longitudinal function); radiance
+//!   ([`crate::scattering::marschner::scattering_s`] with [`REFERENCE_VARIANT`] and the look's longitudinal function); radiance
 //!   L_o = integral K L_i d omega_i;
 //! - next-event estimation with a shadow ray through the fibers (any crossing blocks). The
 //!   environment image is sampled afresh for every point and vertex (texels by luminance x solid
