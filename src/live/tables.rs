@@ -160,13 +160,18 @@ impl TableWork {
     /// Tables are wanted, being built or held: the volume waits for them (they rebuild the grid
     /// too).
     pub(super) fn waiting(&self) -> bool {
-        self.wanted.is_some() || self.job.is_some() || self.held.is_some()
+        self.building() || self.held.is_some()
+    }
+
+    /// Tables are wanted or being built.
+    fn building(&self) -> bool {
+        self.wanted.is_some() || self.job.is_some()
     }
 
     /// The share of the unit budget refinement gets: smaller while tables are wanted or being
     /// built, which take the same cores.
     pub(super) fn budget_share(&self) -> f64 {
-        if self.wanted.is_some() || self.job.is_some() {
+        if self.building() {
             self.building_share
         } else {
             1.0
